@@ -1,0 +1,466 @@
+//! The discrete non-penetration conditions of the paper on each straight piece of
+//! Gamma_C: K_h^I (node-on-segment interpolation) and K_h^pi (the mortar projection pi_h^1
+//! with modified end functions, M^{-1} D from exact integration over merged breakpoints).
+//!
+//! Both give one constraint row per body-1 node of each piece: a corner node carries one
+//! row per piece. A row reads `u^1(y_i).nu^1 + sum_q P_iq u^2(x_q).nu^2 <= 0`.
+
+use crate::error::{Error, Result};
+use crate::fe::{FIXED, Model};
+use crate::mesh::RawMesh;
+
+/// Which discrete cone.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// K_h^pi, the global mortar-type condition.
+    Mortar,
+    /// K_h^I, the local node-on-segment condition.
+    Nts,
+}
+
+impl Method {
+    /// Name used on the command line and in files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Mortar => "mortar",
+            Method::Nts => "nts",
+        }
+    }
+    /// Parse "mortar" or "nts".
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "mortar" => Some(Method::Mortar),
+            "nts" => Some(Method::Nts),
+            _ => None,
+        }
+    }
+}
+
+/// One straight piece of Gamma_C with both trace meshes on it.
+#[derive(Debug, Clone)]
+pub struct Piece {
+    /// Start point c_a.
+    pub a: [f64; 2],
+    /// Unit tangent from a to b.
+    pub tangent: [f64; 2],
+    /// Length of the piece.
+    pub length: f64,
+    /// Outward unit normal of body 1 (nu^1; nu^2 = -nu^1).
+    pub normal: [f64; 2],
+    /// Body-1 (global) nodes ordered along the piece, and their abscissae.
+    pub slave_nodes: Vec<usize>,
+    /// Abscissae of the body-1 nodes, from 0 to `length`.
+    pub slave_s: Vec<f64>,
+    /// Body-2 (global) nodes ordered along the piece.
+    pub master_nodes: Vec<usize>,
+    /// Abscissae of the body-2 nodes, from 0 to `length`.
+    pub master_s: Vec<f64>,
+}
+
+/// Gamma_C as straight pieces.
+#[derive(Debug, Clone)]
+pub struct Interface {
+    /// The pieces.
+    pub pieces: Vec<Piece>,
+}
+
+/// One constraint row: on `piece`, at body-1 node index `i` of that piece; sparse entries
+/// over global dofs.
+#[derive(Debug, Clone)]
+pub struct Row {
+    /// Piece index.
+    pub piece: usize,
+    /// Index of the body-1 node within the piece.
+    pub i: usize,
+    /// (global dof, coefficient).
+    pub entries: Vec<(usize, f64)>,
+    /// Lumped trace weight of the node on the piece (length units).
+    pub weight: f64,
+}
+
+/// Chain edges (pairs of global nodes) into polylines; error if branched.
+fn chains(edges: &[[usize; 2]], what: &str, file: &std::path::Path) -> Result<Vec<Vec<usize>>> {
+    use std::collections::HashMap;
+    let mut adj: HashMap<usize, Vec<usize>> = HashMap::new();
+    for e in edges {
+        adj.entry(e[0]).or_default().push(e[1]);
+        adj.entry(e[1]).or_default().push(e[0]);
+    }
+    if adj.values().any(|v| v.len() > 2) {
+        return Err(Error::input(file, what, "the contact curve branches; Gamma_C must be a simple polyline"));
+    }
+    let mut seen = std::collections::HashSet::new();
+    let mut ends: Vec<usize> = adj.iter().filter(|(_, v)| v.len() == 1).map(|(k, _)| *k).collect();
+    ends.sort();
+    let mut out = Vec::new();
+    for s in ends {
+        if seen.contains(&s) {
+            continue;
+        }
+        let mut chain = vec![s];
+        seen.insert(s);
+        let mut cur = s;
+        loop {
+            let next = adj[&cur].iter().copied().find(|n| !seen.contains(n));
+            match next {
+                Some(n) => {
+                    seen.insert(n);
+                    chain.push(n);
+                    cur = n;
+                }
+                None => break,
+            }
+        }
+        out.push(chain);
+    }
+    if seen.len() != adj.len() {
+        return Err(Error::input(file, what, "the contact curve is closed; Gamma_C must have two end points"));
+    }
+    Ok(out)
+}
+
+impl Interface {
+    /// Build Gamma_C from the scene's slave and master curves.
+    pub fn new(model: &Model, raw: &RawMesh) -> Result<Self> {
+        let file = &model.mesh_file;
+        let sc = &model.scene;
+        for c in [&sc.slave_curve, &sc.master_curve] {
+            if raw.physical_tag(1, c).is_none() {
+                return Err(Error::input(
+                    file,
+                    c.as_str(),
+                    format!("the mesh has no physical curve named '{c}' (it has: {}); fix contact.*_curve in the scene or the .geo", raw.names_of_dim(1).join(", ")),
+                ));
+            }
+        }
+        let off = model.node_offset;
+        let slave_edges: Vec<[usize; 2]> = model.meshes[0].curve_edges(raw, &sc.slave_curve).iter().map(|e| [e[0] + off[0], e[1] + off[0]]).collect();
+        let master_edges: Vec<[usize; 2]> = model.meshes[1].curve_edges(raw, &sc.master_curve).iter().map(|e| [e[0] + off[1], e[1] + off[1]]).collect();
+        if slave_edges.is_empty() {
+            return Err(Error::input(&sc.file, "contact.slave_curve", format!("curve '{}' has no edge on the slave body '{}'", sc.slave_curve, sc.bodies[0].surface)));
+        }
+        if master_edges.is_empty() {
+            return Err(Error::input(&sc.file, "contact.master_curve", format!("curve '{}' has no edge on the master body '{}'", sc.master_curve, sc.bodies[1].surface)));
+        }
+        let pos = |g: usize| model.position(g);
+        let mut pieces = Vec::new();
+        for chain in chains(&slave_edges, "contact.slave_curve", &sc.file)? {
+            // Split at corners.
+            let mut start = 0;
+            for k in 1..chain.len() {
+                let last = k == chain.len() - 1;
+                let corner = !last && {
+                    let (p0, p1, p2) = (pos(chain[k - 1]), pos(chain[k]), pos(chain[k + 1]));
+                    let d1 = [p1[0] - p0[0], p1[1] - p0[1]];
+                    let d2 = [p2[0] - p1[0], p2[1] - p1[1]];
+                    let cross = d1[0] * d2[1] - d1[1] * d2[0];
+                    cross.abs() > 1e-8 * d1[0].hypot(d1[1]) * d2[0].hypot(d2[1])
+                };
+                if corner || last {
+                    pieces.push(Self::piece(model, &chain[start..=k], &master_edges)?);
+                    start = k;
+                }
+            }
+        }
+        Ok(Interface { pieces })
+    }
+
+    fn piece(model: &Model, slave: &[usize], master_edges: &[[usize; 2]]) -> Result<Piece> {
+        let file = &model.scene.file;
+        let a = model.position(slave[0]);
+        let b = model.position(*slave.last().unwrap());
+        let length = (b[0] - a[0]).hypot(b[1] - a[1]);
+        let tangent = [(b[0] - a[0]) / length, (b[1] - a[1]) / length];
+        let mut normal = [tangent[1], -tangent[0]];
+        // Outward for body 1: away from the third vertex of a triangle on the first edge.
+        let (n0, n1) = (slave[0], slave[1]);
+        let tri = model.elements.iter().find(|e| e.body == 0 && e.nodes.contains(&n0) && e.nodes.contains(&n1)).ok_or_else(|| {
+            Error::input(file, "contact.slave_curve", "a contact edge does not belong to a slave triangle; the curve must lie on the slave body's boundary")
+        })?;
+        let third = tri.nodes.iter().copied().find(|&n| n != n0 && n != n1).unwrap();
+        let pt = model.position(third);
+        if (pt[0] - a[0]) * normal[0] + (pt[1] - a[1]) * normal[1] > 0.0 {
+            normal = [-normal[0], -normal[1]];
+        }
+        let tol = 1e-9 * length;
+        let abscissa = |p: [f64; 2]| (p[0] - a[0]) * tangent[0] + (p[1] - a[1]) * tangent[1];
+        let offset = |p: [f64; 2]| ((p[0] - a[0]) * normal[0] + (p[1] - a[1]) * normal[1]).abs();
+        let slave_s: Vec<f64> = slave.iter().map(|&n| abscissa(model.position(n))).collect();
+        if slave_s.windows(2).any(|w| w[1] <= w[0]) {
+            return Err(Error::input(file, "contact.slave_curve", "slave nodes are not ordered along the piece"));
+        }
+        // Master nodes on this piece (both ends of an edge on the segment).
+        let on = |p: [f64; 2]| offset(p) <= tol && abscissa(p) >= -tol && abscissa(p) <= length + tol;
+        let mut mnodes: Vec<usize> = Vec::new();
+        let mut medges = 0;
+        for e in master_edges {
+            if on(model.position(e[0])) && on(model.position(e[1])) {
+                mnodes.extend_from_slice(e);
+                medges += 1;
+            }
+        }
+        mnodes.sort_unstable();
+        mnodes.dedup();
+        mnodes.sort_by(|&p, &q| abscissa(model.position(p)).total_cmp(&abscissa(model.position(q))));
+        let master_s: Vec<f64> = mnodes.iter().map(|&n| abscissa(model.position(n))).collect();
+        if mnodes.len() < 2 || medges != mnodes.len() - 1 || master_s[0].abs() > tol || (master_s.last().unwrap() - length).abs() > tol {
+            return Err(Error::input(
+                file,
+                "contact.master_curve",
+                format!(
+                    "the master curve does not cover the piece from {a:?} to {b:?} with nodes at both ends; the end points and corners of Gamma_C must be geometry points of both bodies"
+                ),
+            ));
+        }
+        let mut master_s = master_s;
+        master_s[0] = 0.0;
+        *master_s.last_mut().unwrap() = length;
+        let mut slave_s = slave_s;
+        slave_s[0] = 0.0;
+        *slave_s.last_mut().unwrap() = length;
+        Ok(Piece { a, tangent, length, normal, slave_nodes: slave.to_vec(), slave_s, master_nodes: mnodes, master_s })
+    }
+
+    /// Smallest distance between an interior body-1 node and any body-2 node on Gamma_C,
+    /// relative to the largest trace element length (0 when nodes coincide).
+    pub fn min_relative_separation(&self) -> f64 {
+        let mut best = f64::INFINITY;
+        for p in &self.pieces {
+            let hmax = p.slave_s.windows(2).chain(p.master_s.windows(2)).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+            for &s in &p.slave_s[1..p.slave_s.len() - 1] {
+                let k = p.master_s.partition_point(|&m| m < s);
+                for j in [k.saturating_sub(1), k.min(p.master_s.len() - 1)] {
+                    best = best.min((p.master_s[j] - s).abs() / hmax);
+                }
+            }
+        }
+        best
+    }
+
+    /// Total length of Gamma_C.
+    pub fn length(&self) -> f64 {
+        self.pieces.iter().map(|p| p.length).sum()
+    }
+}
+
+impl Piece {
+    /// The matrix P (rows: body-1 nodes, columns: body-2 nodes) mapping body-2 trace
+    /// values to the body-1 trace values of I_h^1 (nts) or pi_h^1 (mortar), dense.
+    pub fn transfer(&self, method: Method) -> Vec<Vec<f64>> {
+        match method {
+            Method::Nts => self.interpolation(),
+            Method::Mortar => self.mortar(),
+        }
+    }
+
+    fn interpolation(&self) -> Vec<Vec<f64>> {
+        let nm = self.master_s.len();
+        self.slave_s
+            .iter()
+            .map(|&s| {
+                let mut row = vec![0.0; nm];
+                let q = (self.master_s.partition_point(|&m| m <= s).max(1) - 1).min(nm - 2);
+                let theta = ((s - self.master_s[q]) / (self.master_s[q + 1] - self.master_s[q])).clamp(0.0, 1.0);
+                row[q] += 1.0 - theta;
+                row[q + 1] += theta;
+                row
+            })
+            .collect()
+    }
+
+    fn mortar(&self) -> Vec<Vec<f64>> {
+        let (ss, ms) = (&self.slave_s, &self.master_s);
+        let m = ss.len() - 1; // body-1 elements
+        let nm = ms.len();
+        let mut p = vec![vec![0.0; nm]; m + 1];
+        p[0][0] = 1.0;
+        p[m][nm - 1] = 1.0;
+        if m < 2 {
+            return p;
+        }
+        // Merged breakpoints.
+        let mut br: Vec<f64> = ss.iter().chain(ms.iter()).copied().collect();
+        br.sort_by(f64::total_cmp);
+        br.dedup_by(|x, y| (*x - *y).abs() <= 1e-14 * self.length);
+        // Integrals I[j][k] = int lambda_j lambda_k (slave-slave, tridiagonal, k in j-1..=j+1)
+        // and J[j][q] = int lambda_j mu_q, exact by Simpson on each sub-interval (the
+        // integrands are products of two linear functions there).
+        let mut ss_int = vec![[0.0f64; 3]; m + 1]; // [k=j-1, k=j, k=j+1]
+        let mut sm_int: Vec<Vec<(usize, f64)>> = vec![Vec::new(); m + 1];
+        let hat = |nodes: &Vec<f64>, e: usize, x: f64| -> [f64; 2] {
+            let t = (x - nodes[e]) / (nodes[e + 1] - nodes[e]);
+            [1.0 - t, t]
+        };
+        for w in br.windows(2) {
+            let (x0, x1) = (w[0], w[1]);
+            let len = x1 - x0;
+            if len <= 0.0 {
+                continue;
+            }
+            let xm = 0.5 * (x0 + x1);
+            let e = (ss.partition_point(|&s| s <= xm).max(1) - 1).min(m - 1);
+            let f = (ms.partition_point(|&s| s <= xm).max(1) - 1).min(nm - 2);
+            let pts = [x0, xm, x1];
+            let wts = [len / 6.0, 4.0 * len / 6.0, len / 6.0];
+            for (x, wt) in pts.iter().zip(wts) {
+                let l = hat(ss, e, *x);
+                let mu = hat(ms, f, *x);
+                for a in 0..2 {
+                    for b in 0..2 {
+                        // slave j = e + a, k = e + b => offset k - j + 1
+                        ss_int[e + a][1 + b - a] += wt * l[a] * l[b];
+                        let entry = &mut sm_int[e + a];
+                        let q = f + b;
+                        match entry.iter_mut().find(|(qq, _)| *qq == q) {
+                            Some(v) => v.1 += wt * l[a] * mu[b],
+                            None => entry.push((q, wt * l[a] * mu[b])),
+                        }
+                    }
+                }
+            }
+        }
+        // Test functions psi_j (j = 1..m-1): lambda_j, plus lambda_0 for j = 1 and lambda_m
+        // for j = m-1 (the end elements' functions made constant).
+        // M[j][k] = int psi_j lambda_k for k = 1..m-1; R[j][q] = int psi_j mu_q minus the
+        // end-value contributions int psi_j (lambda_0 phi(c_a) + lambda_m phi(c_b)).
+        let n = m - 1;
+        let get = |j: usize, k: usize| -> f64 {
+            if k + 1 < j || k > j + 1 { 0.0 } else { ss_int[j][k + 1 - j] }
+        };
+        let psi_lambda = |j: usize, k: usize| -> f64 {
+            let mut v = get(j, k);
+            if j == 1 {
+                v += get(0, k);
+            }
+            if j == m - 1 {
+                v += get(m, k);
+            }
+            v
+        };
+        let mut lower = vec![0.0; n];
+        let mut diag = vec![0.0; n];
+        let mut upper = vec![0.0; n];
+        let mut rhs = vec![vec![0.0; nm]; n];
+        for r in 0..n {
+            let j = r + 1;
+            diag[r] = psi_lambda(j, j);
+            if r > 0 {
+                lower[r] = psi_lambda(j, j - 1);
+            }
+            if r + 1 < n {
+                upper[r] = psi_lambda(j, j + 1);
+            }
+            let mut add_row = |jj: usize| {
+                for &(q, v) in &sm_int[jj] {
+                    rhs[r][q] += v;
+                }
+            };
+            add_row(j);
+            if j == 1 {
+                add_row(0);
+            }
+            if j == m - 1 {
+                add_row(m);
+            }
+            rhs[r][0] -= psi_lambda(j, 0);
+            rhs[r][nm - 1] -= psi_lambda(j, m);
+        }
+        // Thomas algorithm: M is diagonally dominant (a mass matrix with lumped ends).
+        for r in 1..n {
+            let factor = lower[r] / diag[r - 1];
+            diag[r] -= factor * upper[r - 1];
+            let (prev, cur) = rhs.split_at_mut(r);
+            for (c, pv) in cur[0].iter_mut().zip(&prev[r - 1]) {
+                *c -= factor * pv;
+            }
+        }
+        for r in (0..n).rev() {
+            if r + 1 < n {
+                let (cur, next) = rhs.split_at_mut(r + 1);
+                for (c, nv) in cur[r].iter_mut().zip(&next[0]) {
+                    *c -= upper[r] * nv;
+                }
+            }
+            let d = diag[r];
+            for c in rhs[r].iter_mut() {
+                *c /= d;
+            }
+        }
+        for r in 0..n {
+            p[r + 1] = std::mem::take(&mut rhs[r]);
+        }
+        p
+    }
+}
+
+/// Constraint rows of the chosen cone over global dofs; constrained dofs are dropped.
+/// Entries of P below 1e-15 of the row's largest are dropped: the mortar rows decay
+/// geometrically away from the node, and such entries are below round-off.
+pub fn constraint_rows(model: &Model, interface: &Interface, method: Method) -> Vec<Row> {
+    let mut rows = Vec::new();
+    for (pi, p) in interface.pieces.iter().enumerate() {
+        let tr = p.transfer(method);
+        for (i, &node) in p.slave_nodes.iter().enumerate() {
+            let mut entries = Vec::new();
+            let mut push = |node: usize, coef: f64| {
+                for c in 0..2 {
+                    let d = 2 * node + c;
+                    let v = coef * p.normal[c];
+                    if model.equation[d] != FIXED && v != 0.0 {
+                        entries.push((d, v));
+                    }
+                }
+            };
+            push(node, 1.0);
+            let big = tr[i].iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            for (q, &v) in tr[i].iter().enumerate() {
+                if v.abs() > 1e-15 * big {
+                    push(p.master_nodes[q], -v);
+                }
+            }
+            let left = if i > 0 { p.slave_s[i] - p.slave_s[i - 1] } else { 0.0 };
+            let right = if i + 1 < p.slave_s.len() { p.slave_s[i + 1] - p.slave_s[i] } else { 0.0 };
+            rows.push(Row { piece: pi, i, entries, weight: 0.5 * (left + right) });
+        }
+    }
+    rows
+}
+
+/// Apply rows to a global displacement vector: `(C u)_i`.
+pub fn apply_rows(rows: &[Row], u: &[f64]) -> Vec<f64> {
+    rows.iter().map(|r| r.entries.iter().map(|&(d, v)| v * u[d]).sum()).collect()
+}
+
+/// Add `C^T lambda` to a global-dof vector.
+pub fn add_transpose(rows: &[Row], lambda: &[f64], out: &mut [f64]) {
+    for (r, l) in rows.iter().zip(lambda) {
+        for &(d, v) in &r.entries {
+            out[d] += v * l;
+        }
+    }
+}
+
+/// Normal jump [u.nu] = u^1.nu^1 + u^2.nu^2 at every trace node of both bodies (both
+/// traces interpolated), positive where the bodies interpenetrate. Length units.
+pub fn normal_jumps(interface: &Interface, u: &[f64]) -> Vec<(usize, f64, f64)> {
+    let mut out = Vec::new();
+    let un = |n: usize, nu: [f64; 2]| u[2 * n] * nu[0] + u[2 * n + 1] * nu[1];
+    let interp = |nodes: &[usize], s_nodes: &[f64], s: f64, nu: [f64; 2]| -> f64 {
+        let q = (s_nodes.partition_point(|&m| m <= s).max(1) - 1).min(s_nodes.len() - 2);
+        let t = ((s - s_nodes[q]) / (s_nodes[q + 1] - s_nodes[q])).clamp(0.0, 1.0);
+        (1.0 - t) * un(nodes[q], nu) + t * un(nodes[q + 1], nu)
+    };
+    for (pi, p) in interface.pieces.iter().enumerate() {
+        let nu1 = p.normal;
+        let nu2 = [-nu1[0], -nu1[1]];
+        for (i, &n) in p.slave_nodes.iter().enumerate() {
+            let s = p.slave_s[i];
+            out.push((pi, s, un(n, nu1) + interp(&p.master_nodes, &p.master_s, s, nu2)));
+        }
+        for (q, &n) in p.master_nodes.iter().enumerate() {
+            let s = p.master_s[q];
+            out.push((pi, s, interp(&p.slave_nodes, &p.slave_s, s, nu1) + un(n, nu2)));
+        }
+    }
+    out
+}

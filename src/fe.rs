@@ -1,0 +1,390 @@
+//! P1 finite elements on the two bodies: degrees of freedom with Dirichlet and roller
+//! conditions, the sparse pattern with its entry-to-slot map (computed once per mesh),
+//! loads from tractions and body forces, and assembly of internal force and tangent.
+
+use crate::error::{Error, Result};
+use crate::material::{Material, Strain, Stress};
+use crate::mesh::{BodyMesh, RawMesh};
+use crate::scene::Scene;
+use nalgebra::{Matrix3, SMatrix, SVector};
+use std::path::Path;
+
+/// Marker for a constrained degree of freedom.
+pub const FIXED: usize = usize::MAX;
+
+/// One P1 triangle of either body, with its geometry precomputed.
+#[derive(Debug, Clone)]
+pub struct Element {
+    /// 0 for body 1 (slave), 1 for body 2 (master).
+    pub body: usize,
+    /// Global node indices.
+    pub nodes: [usize; 3],
+    /// Area.
+    pub area: f64,
+    /// Shape-function gradients (d/dx, d/dy) of the three hats.
+    pub grads: [[f64; 2]; 3],
+}
+
+/// Strain-displacement matrix with engineering shear: rows e11, e22, 2 e12.
+pub type BMatrix = SMatrix<f64, 3, 6>;
+
+impl Element {
+    /// The B matrix (engineering shear row), so that `sigma . (B v) = sigma : eps(v)`.
+    pub fn b_matrix(&self) -> BMatrix {
+        let mut b = BMatrix::zeros();
+        for (a, g) in self.grads.iter().enumerate() {
+            b[(0, 2 * a)] = g[0];
+            b[(1, 2 * a + 1)] = g[1];
+            b[(2, 2 * a)] = g[1];
+            b[(2, 2 * a + 1)] = g[0];
+        }
+        b
+    }
+    /// Tensor strain of the element for the global displacement vector `u`.
+    pub fn strain(&self, u: &[f64]) -> Strain {
+        let mut e = Strain::zeros();
+        for (a, g) in self.grads.iter().enumerate() {
+            let (ux, uy) = (u[2 * self.nodes[a]], u[2 * self.nodes[a] + 1]);
+            e[0] += g[0] * ux;
+            e[1] += g[1] * uy;
+            e[2] += 0.5 * (g[1] * ux + g[0] * uy);
+        }
+        e
+    }
+    /// Global dof indices of the element (x, y per node).
+    pub fn dofs(&self) -> [usize; 6] {
+        let n = self.nodes;
+        [2 * n[0], 2 * n[0] + 1, 2 * n[1], 2 * n[1] + 1, 2 * n[2], 2 * n[2] + 1]
+    }
+}
+
+/// Area and hat-function gradients of a triangle.
+pub fn p1_gradients(p: [[f64; 2]; 3]) -> (f64, [[f64; 2]; 3]) {
+    let area = crate::mesh::signed_area(p[0], p[1], p[2]);
+    let mut g = [[0.0; 2]; 3];
+    for a in 0..3 {
+        let (j, k) = ((a + 1) % 3, (a + 2) % 3);
+        g[a] = [(p[j][1] - p[k][1]) / (2.0 * area), (p[k][0] - p[j][0]) / (2.0 * area)];
+    }
+    (area, g)
+}
+
+/// A compressed-sparse-column pattern with sorted rows, and a lookup of entry slots.
+#[derive(Debug, Clone)]
+pub struct Pattern {
+    /// Matrix dimension (square).
+    pub n: usize,
+    /// Column pointers.
+    pub col_ptr: Vec<usize>,
+    /// Row indices, sorted within each column.
+    pub row_idx: Vec<usize>,
+}
+
+impl Pattern {
+    /// Build from (row, col) pairs (duplicates allowed).
+    pub fn from_entries(n: usize, mut entries: Vec<(usize, usize)>) -> Self {
+        entries.sort_unstable_by_key(|&(r, c)| (c, r));
+        entries.dedup();
+        let mut col_ptr = vec![0usize; n + 1];
+        let mut row_idx = Vec::with_capacity(entries.len());
+        for &(r, c) in &entries {
+            col_ptr[c + 1] += 1;
+            row_idx.push(r);
+        }
+        for c in 0..n {
+            col_ptr[c + 1] += col_ptr[c];
+        }
+        Pattern { n, col_ptr, row_idx }
+    }
+    /// Slot of entry (row, col); panics if absent (a construction error).
+    pub fn slot(&self, row: usize, col: usize) -> usize {
+        let s = &self.row_idx[self.col_ptr[col]..self.col_ptr[col + 1]];
+        self.col_ptr[col] + s.binary_search(&row).expect("entry in pattern")
+    }
+    /// Number of stored entries.
+    pub fn nnz(&self) -> usize {
+        self.row_idx.len()
+    }
+}
+
+/// The discrete model: both bodies' elements, dof numbering and boundary data.
+#[derive(Debug, Clone)]
+pub struct Model {
+    /// The two body meshes (index 0 = body 1, the slave).
+    pub meshes: [BodyMesh; 2],
+    /// Materials per body.
+    pub materials: [Material; 2],
+    /// First global node index of each body.
+    pub node_offset: [usize; 2],
+    /// Total number of nodes.
+    pub n_nodes: usize,
+    /// All elements of both bodies.
+    pub elements: Vec<Element>,
+    /// For each global dof, its equation number, or [`FIXED`].
+    pub equation: Vec<usize>,
+    /// Number of free dofs (equations).
+    pub n_free: usize,
+    /// Traction edges: (curve index in scene.tractions, global node pair).
+    pub traction_edges: Vec<(usize, [usize; 2])>,
+    /// The scene it was built from.
+    pub scene: Scene,
+    /// The mesh file (for messages).
+    pub mesh_file: std::path::PathBuf,
+}
+
+fn edges_of(raw: &RawMesh, meshes: &[BodyMesh; 2], offsets: [usize; 2], curve: &str, mesh_file: &Path) -> Result<Vec<(usize, [usize; 2])>> {
+    if raw.physical_tag(1, curve).is_none() {
+        return Err(Error::input(
+            mesh_file,
+            curve,
+            format!("the mesh has no physical curve named '{curve}' (it has: {}); fix the scene's curve name or add `Physical Curve(\"{curve}\")` to the .geo", raw.names_of_dim(1).join(", ")),
+        ));
+    }
+    let mut out = Vec::new();
+    for b in 0..2 {
+        for e in meshes[b].curve_edges(raw, curve) {
+            out.push((b, [e[0] + offsets[b], e[1] + offsets[b]]));
+        }
+    }
+    if out.is_empty() {
+        return Err(Error::input(mesh_file, curve, format!("physical curve '{curve}' has no edge on either body; check the .geo")));
+    }
+    Ok(out)
+}
+
+impl Model {
+    /// Build the model of `scene` on the mesh `raw` read from `mesh_file`.
+    pub fn new(scene: &Scene, raw: &RawMesh, mesh_file: &Path) -> Result<Self> {
+        let m0 = BodyMesh::from_raw(raw, &scene.bodies[0].surface, mesh_file)?;
+        let m1 = BodyMesh::from_raw(raw, &scene.bodies[1].surface, mesh_file)?;
+        let meshes = [m0, m1];
+        let node_offset = [0, meshes[0].nodes.len()];
+        let n_nodes = node_offset[1] + meshes[1].nodes.len();
+        let mut elements = Vec::new();
+        for b in 0..2 {
+            for t in &meshes[b].triangles {
+                let p = t.map(|i| meshes[b].nodes[i]);
+                let (area, grads) = p1_gradients(p);
+                elements.push(Element { body: b, nodes: t.map(|i| i + node_offset[b]), area, grads });
+            }
+        }
+        let mut fixed = vec![false; 2 * n_nodes];
+        for c in &scene.clamps {
+            for (_, e) in edges_of(raw, &meshes, node_offset, c, mesh_file)? {
+                for n in e {
+                    fixed[2 * n] = true;
+                    fixed[2 * n + 1] = true;
+                }
+            }
+        }
+        let model_pos = |g: usize| -> [f64; 2] {
+            if g < node_offset[1] { meshes[0].nodes[g] } else { meshes[1].nodes[g - node_offset[1]] }
+        };
+        for r in &scene.rollers {
+            for (_, e) in edges_of(raw, &meshes, node_offset, &r.curve, mesh_file)? {
+                let (a, b) = (model_pos(e[0]), model_pos(e[1]));
+                let d = [b[0] - a[0], b[1] - a[1]];
+                let len = d[0].hypot(d[1]);
+                // A roller holding u_x lies on a vertical edge, one holding u_y on a horizontal one.
+                if d[r.component].abs() > 1e-9 * len {
+                    return Err(Error::input(
+                        &scene.file,
+                        format!("roller '{}'", r.curve),
+                        format!("a roller holding u_{} needs a {} curve, but an edge runs from {a:?} to {b:?}; use a clamp or fix the geometry", ["x", "y"][r.component], ["vertical", "horizontal"][r.component]),
+                    ));
+                }
+                for n in e {
+                    fixed[2 * n + r.component] = true;
+                }
+            }
+        }
+        let mut equation = vec![FIXED; 2 * n_nodes];
+        let mut n_free = 0;
+        for (d, f) in fixed.iter().enumerate() {
+            if !f {
+                equation[d] = n_free;
+                n_free += 1;
+            }
+        }
+        let mut traction_edges = Vec::new();
+        for (i, t) in scene.tractions.iter().enumerate() {
+            for (_, e) in edges_of(raw, &meshes, node_offset, &t.curve, mesh_file)? {
+                traction_edges.push((i, e));
+            }
+        }
+        Ok(Model {
+            materials: [scene.bodies[0].material, scene.bodies[1].material],
+            meshes,
+            node_offset,
+            n_nodes,
+            elements,
+            equation,
+            n_free,
+            traction_edges,
+            scene: scene.clone(),
+            mesh_file: mesh_file.to_path_buf(),
+        })
+    }
+
+    /// Coordinates of global node `g`.
+    pub fn position(&self, g: usize) -> [f64; 2] {
+        if g < self.node_offset[1] { self.meshes[0].nodes[g] } else { self.meshes[1].nodes[g - self.node_offset[1]] }
+    }
+
+    /// Largest element diameter over both bodies.
+    pub fn h(&self) -> f64 {
+        self.meshes[0].h().max(self.meshes[1].h())
+    }
+
+    /// Pattern of the stiffness matrix over free dofs, and for every element its 36
+    /// slots (row-major over the element dofs; `FIXED` where a dof is constrained).
+    pub fn stiffness_pattern(&self, extra: &[(usize, usize)], n_total: usize) -> (Pattern, Vec<[usize; 36]>) {
+        let mut entries = Vec::with_capacity(self.elements.len() * 36 + extra.len());
+        for e in &self.elements {
+            let eq = e.dofs().map(|d| self.equation[d]);
+            for &r in &eq {
+                for &c in &eq {
+                    if r != FIXED && c != FIXED {
+                        entries.push((r, c));
+                    }
+                }
+            }
+        }
+        entries.extend_from_slice(extra);
+        let pattern = Pattern::from_entries(n_total, entries);
+        let slots = self
+            .elements
+            .iter()
+            .map(|e| {
+                let eq = e.dofs().map(|d| self.equation[d]);
+                let mut s = [FIXED; 36];
+                for i in 0..6 {
+                    for j in 0..6 {
+                        if eq[i] != FIXED && eq[j] != FIXED {
+                            s[6 * i + j] = pattern.slot(eq[i], eq[j]);
+                        }
+                    }
+                }
+                s
+            })
+            .collect();
+        (pattern, slots)
+    }
+
+    /// External load vector F(t) over global dofs: tractions (4-point Gauss per edge) and
+    /// body forces (6-point degree-4 rule per triangle).
+    pub fn load(&self, t: f64) -> Result<Vec<f64>> {
+        let mut f = vec![0.0; 2 * self.n_nodes];
+        const GX: [f64; 4] = [-0.861_136_311_594_052_6, -0.339_981_043_584_856_3, 0.339_981_043_584_856_3, 0.861_136_311_594_052_6];
+        const GW: [f64; 4] = [0.347_854_845_137_453_9, 0.652_145_154_862_546_1, 0.652_145_154_862_546_1, 0.347_854_845_137_453_9];
+        for &(i, [a, b]) in &self.traction_edges {
+            let (pa, pb) = (self.position(a), self.position(b));
+            let len = (pb[0] - pa[0]).hypot(pb[1] - pa[1]);
+            for q in 0..4 {
+                let s = 0.5 * (1.0 + GX[q]);
+                let x = pa[0] + s * (pb[0] - pa[0]);
+                let y = pa[1] + s * (pb[1] - pa[1]);
+                let g = self.scene.tractions[i].g.eval(x, y, t, &self.scene.file, &format!("traction '{}'.g", self.scene.tractions[i].curve))?;
+                let w = 0.5 * GW[q] * len;
+                for c in 0..2 {
+                    f[2 * a + c] += w * (1.0 - s) * g[c];
+                    f[2 * b + c] += w * s * g[c];
+                }
+            }
+        }
+        // Dunavant degree-4 rule (6 points).
+        const TRI: [(f64, f64, f64); 6] = [
+            (0.445_948_490_915_965, 0.445_948_490_915_965, 0.223_381_589_678_011),
+            (0.445_948_490_915_965, 0.108_103_018_168_070, 0.223_381_589_678_011),
+            (0.108_103_018_168_070, 0.445_948_490_915_965, 0.223_381_589_678_011),
+            (0.091_576_213_509_771, 0.091_576_213_509_771, 0.109_951_743_655_322),
+            (0.091_576_213_509_771, 0.816_847_572_980_459, 0.109_951_743_655_322),
+            (0.816_847_572_980_459, 0.091_576_213_509_771, 0.109_951_743_655_322),
+        ];
+        for e in &self.elements {
+            let Some(bf) = &self.scene.bodies[e.body].body_force else { continue };
+            let p = e.nodes.map(|n| self.position(n));
+            for &(l1, l2, w) in &TRI {
+                let lam = [1.0 - l1 - l2, l1, l2];
+                let x = lam[0] * p[0][0] + lam[1] * p[1][0] + lam[2] * p[2][0];
+                let y = lam[0] * p[0][1] + lam[1] * p[1][1] + lam[2] * p[2][1];
+                let v = bf.eval(x, y, t, &self.scene.file, &format!("bodies '{}'.body_force", self.scene.bodies[e.body].surface))?;
+                for a in 0..3 {
+                    for c in 0..2 {
+                        f[2 * e.nodes[a] + c] += w * e.area * lam[a] * v[c];
+                    }
+                }
+            }
+        }
+        Ok(f)
+    }
+
+    /// Restrict a global-dof vector to the free equations.
+    pub fn restrict(&self, v: &[f64]) -> Vec<f64> {
+        let mut r = vec![0.0; self.n_free];
+        for (d, &eq) in self.equation.iter().enumerate() {
+            if eq != FIXED {
+                r[eq] = v[d];
+            }
+        }
+        r
+    }
+
+    /// Expand free-equation values to global dofs (constrained dofs are zero).
+    pub fn expand(&self, v: &[f64]) -> Vec<f64> {
+        self.equation.iter().map(|&eq| if eq == FIXED { 0.0 } else { v[eq] }).collect()
+    }
+
+    /// Constitutive update of every element: `sigma = sigma_prev + E (eps(u) - eps(u_prev))
+    /// + k G(sigma)`. Returns the stresses and, if `tangent`, the consistent tangents.
+    pub fn update_stresses(&self, u: &[f64], u_prev: &[f64], sigma_prev: &[Stress], k: f64, tangent: bool) -> (Vec<Stress>, Vec<Matrix3<f64>>) {
+        let mut sig = Vec::with_capacity(self.elements.len());
+        let mut tan = Vec::with_capacity(if tangent { self.elements.len() } else { 0 });
+        for (i, e) in self.elements.iter().enumerate() {
+            let m = &self.materials[e.body];
+            let de = e.strain(u) - e.strain(u_prev);
+            let trial = sigma_prev[i] + m.elastic.apply(&de);
+            let (s, d) = m.update(&trial, k);
+            sig.push(s);
+            if tangent {
+                tan.push(d);
+            }
+        }
+        (sig, tan)
+    }
+
+    /// Internal force `sum_T |T| B^T sigma_T` over global dofs.
+    pub fn internal_force(&self, sigma: &[Stress]) -> Vec<f64> {
+        let mut f = vec![0.0; 2 * self.n_nodes];
+        for (e, s) in self.elements.iter().zip(sigma) {
+            let fe = e.b_matrix().transpose() * s * e.area;
+            for (k, d) in e.dofs().iter().enumerate() {
+                f[*d] += fe[k];
+            }
+        }
+        f
+    }
+
+    /// Add the element tangents `|T| B^T D S B` (S halves the engineering shear) into
+    /// `values` using the slot map.
+    pub fn add_tangent(&self, tangents: &[Matrix3<f64>], slots: &[[usize; 36]], values: &mut [f64]) {
+        let s = Matrix3::from_diagonal(&SVector::<f64, 3>::new(1.0, 1.0, 0.5));
+        for ((e, d), sl) in self.elements.iter().zip(tangents).zip(slots) {
+            let b = e.b_matrix();
+            let ke = b.transpose() * (d * s) * b * e.area;
+            for i in 0..6 {
+                for j in 0..6 {
+                    let slot = sl[6 * i + j];
+                    if slot != FIXED {
+                        values[slot] += ke[(i, j)];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Elastic tangents of all elements (E of each body).
+    pub fn elastic_tangents(&self) -> Vec<Matrix3<f64>> {
+        self.elements.iter().map(|e| self.materials[e.body].elastic.matrix()).collect()
+    }
+}

@@ -1,0 +1,25 @@
+//! contact-rates: measured convergence of two discrete non-penetration conditions (the
+//! mortar-type K_h^pi and the node-on-segment K_h^I) for quasistatic frictionless contact
+//! of two elastic-viscoplastic bodies on non-matching meshes.
+//!
+//! The modules follow the pipeline: [`mesh`] -> [`fe`] -> [`material`] -> [`contact`] ->
+//! [`solve`] -> [`case`] / [`metrics`] -> [`io`]. Scenes are data ([`scene`]).
+
+pub mod error;
+pub mod mesh;
+pub mod scene;
+pub mod material;
+pub mod fe;
+pub mod contact;
+pub mod solve;
+pub mod case;
+pub mod metrics;
+pub mod io;
+
+pub use error::{Error, Result};
+
+/// Use faer's sequential mode: a second thread was measured not to speed up the numeric
+/// Cholesky at 2e5-2e6 dofs on this class of machine (SPEC section 10).
+pub fn init() {
+    faer::set_global_parallelism(faer::Par::Seq);
+}

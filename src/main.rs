@@ -1,0 +1,139 @@
+//! Command-line interface: a thin layer over the library.
+
+use anyhow::Context;
+use clap::{Parser, Subcommand};
+use contact_rates::case::Case;
+use contact_rates::contact::Method;
+use contact_rates::solve::{self, Settings, SolverKind};
+use contact_rates::{io, metrics, scene::Scene};
+use serde::Serialize;
+use std::path::PathBuf;
+
+#[derive(Parser)]
+#[command(name = "contact-rates", version, about = "Convergence rates of mortar and node-on-segment contact on non-matching meshes")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Solve one scene on one mesh level and write solution.vtu and summary.csv.
+    Solve {
+        /// Built-in scene name or path to a scene .toml.
+        #[arg(long)]
+        scene: String,
+        /// Contact condition: mortar (K_h^pi) or nts (K_h^I).
+        #[arg(long, default_value = "mortar")]
+        method: String,
+        /// Solver: newton, paper or qp.
+        #[arg(long, default_value = "newton")]
+        solver: String,
+        /// Mesh refinement level (0 = the .geo's own mesh; each level splits every triangle in 4).
+        #[arg(long, default_value_t = 0)]
+        level: usize,
+        /// Number of time steps (default: the scene's).
+        #[arg(long)]
+        steps: Option<usize>,
+        /// Output folder.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// Penalty parameter omega of the paper solver (default: automatic).
+        #[arg(long)]
+        omega: Option<f64>,
+        /// Relaxation rho of the paper solver, in (0, 1].
+        #[arg(long, default_value_t = 1.0)]
+        rho: f64,
+        /// Relative tolerance of the solvers.
+        #[arg(long, default_value_t = 1e-10)]
+        tol: f64,
+        /// gmsh parameter overrides, NAME=VALUE (repeatable).
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
+    },
+}
+
+/// One row of summary.csv.
+#[derive(Serialize)]
+struct Summary {
+    scene: String,
+    method: String,
+    solver: String,
+    level: usize,
+    h: f64,
+    dofs: usize,
+    steps: usize,
+    iterations: usize,
+    max_step_iterations: usize,
+    wall_s: f64,
+    max_penetration: f64,
+    contact_fraction: f64,
+    plastic_fraction: f64,
+    converged: bool,
+}
+
+fn parse_sets(set: &[String]) -> anyhow::Result<Vec<(String, f64)>> {
+    set.iter()
+        .map(|s| {
+            let (k, v) = s.split_once('=').with_context(|| format!("--set {s}: expected NAME=VALUE"))?;
+            let v: f64 = v.parse().with_context(|| format!("--set {s}: '{v}' is not a number"))?;
+            Ok((k.to_string(), v))
+        })
+        .collect()
+}
+
+fn run() -> anyhow::Result<()> {
+    contact_rates::init();
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Solve { scene, method, solver, level, steps, out, omega, rho, tol, set } => {
+            let method = Method::parse(&method).with_context(|| format!("--method: unknown cone '{method}'; use mortar (K_h^pi) or nts (K_h^I)"))?;
+            let kind = SolverKind::parse(&solver).with_context(|| format!("--solver: unknown solver '{solver}'; use newton, paper or qp"))?;
+            if !(tol > 0.0) {
+                anyhow::bail!("--tol: the tolerance must be positive, got {tol}");
+            }
+            let scene = Scene::load(&scene)?;
+            let steps = steps.unwrap_or(scene.steps);
+            if steps == 0 {
+                anyhow::bail!("--steps: the number of time steps must be at least 1");
+            }
+            let t0 = std::time::Instant::now();
+            let case = Case::build(&scene, level, method, &parse_sets(&set)?)?;
+            let settings = Settings { kind, tol, omega, rho, ..Settings::default() };
+            let sol = solve::solve(&case.problem, &settings, steps, false)?;
+            let last = sol.last();
+            let p = &case.problem;
+            let summary = Summary {
+                scene: scene.name.clone(),
+                method: method.name().into(),
+                solver: kind.name().into(),
+                level,
+                h: case.h,
+                dofs: p.model.n_free,
+                steps,
+                iterations: sol.iterations(),
+                max_step_iterations: sol.max_step_iterations(),
+                wall_s: t0.elapsed().as_secs_f64(),
+                max_penetration: metrics::max_penetration(p, last),
+                contact_fraction: metrics::contact_fraction(p, last),
+                plastic_fraction: metrics::plastic_fraction(p, last),
+                converged: true,
+            };
+            io::write_atomic(&out.join("solution.vtu"), io::vtu(&p.model, last).as_bytes())?;
+            io::write_atomic(&out.join("summary.csv"), &io::csv_bytes(&[&summary])?)?;
+            println!(
+                "{} {} {} level {level}: h = {:.4}, {} dofs, {steps} steps, {} iterations (max {} per step), {:.3} s; max penetration {:.3e}, contact fraction {:.3}, plastic fraction {:.3}",
+                summary.scene, summary.method, summary.solver, summary.h, summary.dofs, summary.iterations, summary.max_step_iterations, summary.wall_s, summary.max_penetration, summary.contact_fraction, summary.plastic_fraction
+            );
+            println!("wrote {} and {}", out.join("solution.vtu").display(), out.join("summary.csv").display());
+        }
+    }
+    Ok(())
+}
+
+fn main() {
+    if let Err(e) = run() {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}

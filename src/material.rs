@@ -1,0 +1,199 @@
+//! Constitutive laws of SPEC section 1: plane-stress elasticity `E` and the Perzyna
+//! viscoplastic function `G(sigma) = -(1/(2 lambda)) E (sigma - P_B sigma)`, with `P_B` the
+//! projection onto the von Mises set `B` in the `(tau, E tau)` inner product.
+//!
+//! Stresses and strains are stored as tensor components `[11, 22, 12]` (not Voigt's
+//! engineering shear). All three quadratic forms involved (von Mises, the E-norm and E
+//! itself) are diagonal in the coordinates `p = (s11 + s22)/2`, `d = (s11 - s22)/2`,
+//! `t = s12`, with equal weights on `d` and `t`; the backward-Euler update therefore reduces
+//! to one scalar equation, solved to machine precision.
+
+use nalgebra::{Matrix3, Vector3};
+
+/// Stress tensor components `[s11, s22, s12]` (force per length in 2D, scene units).
+pub type Stress = Vector3<f64>;
+/// Strain tensor components `[e11, e22, e12]` (dimensionless).
+pub type Strain = Vector3<f64>;
+
+/// Plane-stress isotropic elasticity: `E tau = a tr(tau) I + b tau`,
+/// `a = E nu / (1 - nu^2)`, `b = E / (1 + nu)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Elasticity {
+    /// Young's modulus E (stress units).
+    pub young: f64,
+    /// Poisson's ratio nu (dimensionless, in (-1, 0.5)).
+    pub poisson: f64,
+}
+
+/// Perzyna viscoplasticity parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Viscoplasticity {
+    /// Viscosity lambda (stress x time units).
+    pub lambda: f64,
+    /// Uniaxial yield stress sigma_Y (stress units).
+    pub yield_stress: f64,
+}
+
+/// A body's material: elastic, and viscoplastic when a yield stress is given.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Material {
+    /// The elasticity tensor E.
+    pub elastic: Elasticity,
+    /// Perzyna parameters; `None` for a purely elastic body (no plasticity cost at all).
+    pub viscoplastic: Option<Viscoplasticity>,
+}
+
+/// Von Mises norm `sqrt(t11^2 + t22^2 - t11 t22 + 3 t12^2)`.
+pub fn von_mises(s: &Stress) -> f64 {
+    (s[0] * s[0] + s[1] * s[1] - s[0] * s[1] + 3.0 * s[2] * s[2]).max(0.0).sqrt()
+}
+
+/// `(p, d, t)` coordinates of a tensor `[11, 22, 12]`.
+fn to_pdt(s: &Stress) -> Vector3<f64> {
+    Vector3::new(0.5 * (s[0] + s[1]), 0.5 * (s[0] - s[1]), s[2])
+}
+
+fn from_pdt(v: &Vector3<f64>) -> Stress {
+    Vector3::new(v[0] + v[1], v[0] - v[1], v[2])
+}
+
+/// Root of a convex, strictly decreasing function with `f(0) > 0`, by Newton from 0:
+/// the iterates increase monotonically to the root, so no safeguard is needed.
+fn convex_decreasing_root(f: impl Fn(f64) -> (f64, f64)) -> f64 {
+    let mut mu = 0.0;
+    for _ in 0..200 {
+        let (v, dv) = f(mu);
+        if v <= 0.0 || dv >= 0.0 {
+            break;
+        }
+        let step = -v / dv;
+        mu += step;
+        if step <= 4.0 * f64::EPSILON * mu {
+            break;
+        }
+    }
+    mu
+}
+
+impl Elasticity {
+    /// `a = E nu / (1 - nu^2)`.
+    pub fn a(&self) -> f64 {
+        self.young * self.poisson / (1.0 - self.poisson * self.poisson)
+    }
+    /// `b = E / (1 + nu)`.
+    pub fn b(&self) -> f64 {
+        self.young / (1.0 + self.poisson)
+    }
+    /// Matrix of E acting on tensor components `[11, 22, 12]`.
+    pub fn matrix(&self) -> Matrix3<f64> {
+        let (a, b) = (self.a(), self.b());
+        Matrix3::new(a + b, a, 0.0, a, a + b, 0.0, 0.0, 0.0, b)
+    }
+    /// `E tau`.
+    pub fn apply(&self, tau: &Vector3<f64>) -> Vector3<f64> {
+        self.matrix() * tau
+    }
+    /// `E^{-1} sigma` (the strain of a stress).
+    pub fn compliance(&self, s: &Stress) -> Strain {
+        let (a, b) = (self.a(), self.b());
+        // E = a tr I + b I  =>  E^{-1} s = (s - a tr(s)/(2a + b) I) / b.
+        let tr = s[0] + s[1];
+        let m = a * tr / (2.0 * a + b);
+        Vector3::new((s[0] - m) / b, (s[1] - m) / b, s[2] / b)
+    }
+    /// Weights of the E-norm squared in `(p, d, t)`: `alpha p^2 + beta (d^2 + t^2)`.
+    fn norm_weights(&self) -> (f64, f64) {
+        (4.0 * self.a() + 2.0 * self.b(), 2.0 * self.b())
+    }
+}
+
+impl Material {
+    /// Projection `P_B sigma` onto `{|tau|_VM <= sigma_Y}` in the E-inner product.
+    /// Identity for an elastic body.
+    pub fn project(&self, s: &Stress) -> Stress {
+        let Some(vp) = self.viscoplastic else { return *s };
+        let y2 = vp.yield_stress * vp.yield_stress;
+        if von_mises(s) * von_mises(s) <= y2 {
+            return *s;
+        }
+        let (alpha, beta) = self.elastic.norm_weights();
+        let v = to_pdt(s);
+        let (p, r2) = (v[0], v[1] * v[1] + v[2] * v[2]);
+        // Stationarity: P_p = alpha p / (alpha + mu), P_q = beta q / (beta + 3 mu).
+        let mu = convex_decreasing_root(|mu| {
+            let fa = alpha / (alpha + mu);
+            let fb = beta / (beta + 3.0 * mu);
+            let val = p * p * fa * fa + 3.0 * r2 * fb * fb - y2;
+            let der = -2.0 * p * p * fa * fa / (alpha + mu) - 18.0 * r2 * fb * fb / (beta + 3.0 * mu);
+            (val, der)
+        });
+        let fa = alpha / (alpha + mu);
+        let fb = beta / (beta + 3.0 * mu);
+        from_pdt(&Vector3::new(v[0] * fa, v[1] * fb, v[2] * fb))
+    }
+
+    /// Perzyna function `G(sigma) = -(1/(2 lambda)) E (sigma - P_B sigma)` (stress per time).
+    pub fn g(&self, s: &Stress) -> Stress {
+        match self.viscoplastic {
+            None => Stress::zeros(),
+            Some(vp) => -(0.5 / vp.lambda) * self.elastic.apply(&(s - self.project(s))),
+        }
+    }
+
+    /// Whether `s` lies outside the elastic set B (viscoplastic flow active).
+    pub fn is_plastic(&self, s: &Stress) -> bool {
+        self.viscoplastic.is_some_and(|vp| von_mises(s) > vp.yield_stress * (1.0 + 1e-12))
+    }
+
+    /// Backward-Euler update of one triangle:
+    /// solve `sigma = sigma_trial + k G(sigma)` with `sigma_trial = sigma_prev + E d_eps`.
+    /// Returns sigma and the consistent tangent `d sigma / d eps` (tensor components).
+    pub fn update(&self, sigma_trial: &Stress, k: f64) -> (Stress, Matrix3<f64>) {
+        let e = self.elastic.matrix();
+        let Some(vp) = self.viscoplastic else { return (*sigma_trial, e) };
+        let y2 = vp.yield_stress * vp.yield_stress;
+        let vm = von_mises(sigma_trial);
+        if vm * vm <= y2 {
+            return (*sigma_trial, e);
+        }
+        let (alpha, beta) = self.elastic.norm_weights();
+        let c = 0.5 * k / vp.lambda;
+        let v = to_pdt(sigma_trial);
+        let (p, r2) = (v[0], v[1] * v[1] + v[2] * v[2]);
+        // With mu the multiplier of the projection of sigma (not of the trial):
+        // P_p = p_tr / A(mu), P_q = q_tr / Bq(mu), A = 1 + mu (1/alpha + c/2),
+        // Bq = 1 + 3 mu (1/beta + c/2), and h(mu) = P_p^2 + 3 |P_q|^2 - sigma_Y^2 = 0.
+        let da = 1.0 / alpha + 0.5 * c;
+        let db = 3.0 * (1.0 / beta + 0.5 * c);
+        let mu = convex_decreasing_root(|mu| {
+            let a = 1.0 + mu * da;
+            let bq = 1.0 + mu * db;
+            let val = p * p / (a * a) + 3.0 * r2 / (bq * bq) - y2;
+            let der = -2.0 * p * p * da / (a * a * a) - 6.0 * r2 * db / (bq * bq * bq);
+            (val, der)
+        });
+        let a = 1.0 + mu * da;
+        let bq = 1.0 + mu * db;
+        // sigma_p = P_p (1 + mu/alpha), sigma_q = P_q (1 + 3 mu / beta).
+        let phi = (1.0 + mu / alpha) / a;
+        let psi = (1.0 + 3.0 * mu / beta) / bq;
+        let sigma = from_pdt(&Vector3::new(v[0] * phi, v[1] * psi, v[2] * psi));
+        // Tangent in (p, d, t): diag(phi, psi, psi) + (p phi', q psi') (grad mu)^T.
+        let dphi = -0.5 * c / (a * a);
+        let dpsi = -1.5 * c / (bq * bq);
+        let h_mu = -2.0 * p * p * da / (a * a * a) - 6.0 * r2 * db / (bq * bq * bq);
+        let grad_h = Vector3::new(2.0 * v[0] / (a * a), 6.0 * v[1] / (bq * bq), 6.0 * v[2] / (bq * bq));
+        let grad_mu = -grad_h / h_mu;
+        let col = Vector3::new(v[0] * dphi, v[1] * dpsi, v[2] * dpsi);
+        let j_pdt = Matrix3::from_diagonal(&Vector3::new(phi, psi, psi)) + col * grad_mu.transpose();
+        // Chain rule: tensor -> (p, d, t) -> tensor.
+        let to = Matrix3::new(0.5, 0.5, 0.0, 0.5, -0.5, 0.0, 0.0, 0.0, 1.0);
+        let from = Matrix3::new(1.0, 1.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, 1.0);
+        (sigma, from * j_pdt * to * e)
+    }
+
+    /// Lipschitz-type scale `|E| / (2 lambda)` of G (1/time); zero for elastic bodies.
+    pub fn g_rate_scale(&self) -> f64 {
+        self.viscoplastic.map_or(0.0, |vp| self.elastic.matrix().norm() / (2.0 * vp.lambda))
+    }
+}

@@ -1,0 +1,149 @@
+//! Running gmsh on a `.geo` with parameters, uniform refinement by splitting, and a
+//! content-addressed cache of the generated meshes outside git.
+
+use crate::error::{Error, Result};
+use sha2::{Digest, Sha256};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+
+/// The folder where generated meshes are cached: `$CONTACT_RATES_CACHE` if set,
+/// otherwise `target/mesh-cache` under the crate.
+pub fn cache_dir() -> PathBuf {
+    match std::env::var_os("CONTACT_RATES_CACHE") {
+        Some(p) if !p.is_empty() => PathBuf::from(p),
+        _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("target").join("mesh-cache"),
+    }
+}
+
+/// The name of the gmsh executable: `$CONTACT_RATES_GMSH` if set (tests use it), else `gmsh`.
+fn gmsh_command() -> String {
+    std::env::var("CONTACT_RATES_GMSH").unwrap_or_else(|_| "gmsh".to_string())
+}
+
+fn missing_gmsh(cmd: &str) -> Error {
+    Error::Gmsh(format!(
+        "the command `{cmd}` was not found on PATH; install it (Debian: `apt-get update && apt-get install -y gmsh`) and run again"
+    ))
+}
+
+/// The gmsh version string (e.g. "4.8.4"), asked once per process.
+pub fn gmsh_version() -> Result<String> {
+    static VERSION: OnceLock<std::result::Result<String, String>> = OnceLock::new();
+    let cmd = gmsh_command();
+    let v = VERSION.get_or_init(|| match Command::new(&cmd).arg("--version").output() {
+        Ok(out) if out.status.success() => {
+            let s = String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+            Ok(s.trim().to_string())
+        }
+        Ok(out) => Err(format!("`{cmd} --version` failed with {}", out.status)),
+        Err(_) => Err(missing_gmsh(&cmd).to_string()),
+    });
+    v.clone().map_err(|e| Error::Gmsh(e.trim_start_matches("gmsh: ").to_string()))
+}
+
+/// Hex SHA-256 of a byte string.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    let mut h = Sha256::new();
+    h.update(bytes);
+    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// Run gmsh with `args`; on failure return its error lines. `out` must exist afterwards.
+fn run_gmsh(args: &[String], out: &Path, what: &Path) -> Result<()> {
+    let cmd = gmsh_command();
+    let output = Command::new(&cmd).args(args).output().map_err(|e| {
+        if e.kind() == std::io::ErrorKind::NotFound { missing_gmsh(&cmd) } else { Error::Gmsh(format!("could not start `{cmd}`: {e}")) }
+    })?;
+    let text = String::from_utf8_lossy(&output.stdout).to_string() + &String::from_utf8_lossy(&output.stderr);
+    let errors: Vec<&str> = text.lines().filter(|l| l.starts_with("Error")).collect();
+    if !output.status.success() || !errors.is_empty() {
+        let _ = std::fs::remove_file(out);
+        let detail = if errors.is_empty() { text.lines().last().unwrap_or("").to_string() } else { errors.join(" | ") };
+        return Err(Error::Input {
+            file: what.to_path_buf(),
+            field: "gmsh".into(),
+            message: format!("gmsh failed ({}): {detail}; fix the geometry or its parameters", output.status),
+        });
+    }
+    if !out.exists() {
+        return Err(Error::input(what, "gmsh", "gmsh exited 0 but wrote no mesh; check the .geo defines Physical Surface groups"));
+    }
+    Ok(())
+}
+
+/// A generated mesh file with its provenance.
+#[derive(Debug, Clone)]
+pub struct GeneratedMesh {
+    /// The cached MSH 4.1 file.
+    pub path: PathBuf,
+    /// SHA-256 of the .geo file's bytes.
+    pub geo_hash: String,
+    /// gmsh version used.
+    pub gmsh_version: String,
+}
+
+/// Generate (or fetch from the cache) the mesh of `geo` with `params` refined `level` times
+/// by uniform splitting. Level 0 is gmsh's own 2D mesh; level L splits level L-1 (nested).
+pub fn generate(geo: &Path, params: &[(String, f64)], level: usize) -> Result<GeneratedMesh> {
+    let bytes = std::fs::read(geo).map_err(|e| Error::io(geo, e))?;
+    let version = gmsh_version()?;
+    let geo_hash = sha256_hex(&bytes);
+    let mut key = bytes.clone();
+    for (k, v) in params {
+        key.extend_from_slice(format!("\n{k}={v:e}").as_bytes());
+    }
+    key.extend_from_slice(version.as_bytes());
+    let hash = &sha256_hex(&key)[..20];
+    let dir = cache_dir();
+    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+    let stem = geo.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh");
+    let path_of = |l: usize| dir.join(format!("{stem}-{hash}-L{l}.msh"));
+    // Find the finest cached level at or below `level`.
+    let mut have = None;
+    for l in (0..=level).rev() {
+        if path_of(l).exists() {
+            have = Some(l);
+            break;
+        }
+    }
+    let tmp = |l: usize| dir.join(format!("{stem}-{hash}-L{l}.{}.tmp.msh", std::process::id()));
+    let start = match have {
+        Some(l) => l + 1,
+        None => {
+            let mut args: Vec<String> = vec![geo.display().to_string(), "-2".into()];
+            for (k, v) in params {
+                args.extend(["-setnumber".into(), k.clone(), format!("{v:e}")]);
+            }
+            args.extend(["-format".into(), "msh41".into(), "-o".into()]);
+            let t = tmp(0);
+            args.push(t.display().to_string());
+            run_gmsh(&args, &t, geo)?;
+            // Validate before publishing: a failed gmsh run can leave a broken file.
+            super::msh::read_msh(&t).map_err(|e| {
+                let _ = std::fs::remove_file(&t);
+                Error::input(geo, "gmsh", format!("gmsh wrote an unusable mesh ({e}); fix the .geo"))
+            })?;
+            std::fs::rename(&t, path_of(0)).map_err(|e| Error::io(path_of(0), e))?;
+            1
+        }
+    };
+    for l in start..=level {
+        let t = tmp(l);
+        let args: Vec<String> = vec![
+            path_of(l - 1).display().to_string(),
+            "-refine".into(),
+            "-format".into(),
+            "msh41".into(),
+            "-o".into(),
+            t.display().to_string(),
+        ];
+        run_gmsh(&args, &t, geo)?;
+        super::msh::read_msh(&t).map_err(|e| {
+            let _ = std::fs::remove_file(&t);
+            Error::input(geo, "gmsh", format!("gmsh -refine wrote an unusable mesh ({e})"))
+        })?;
+        std::fs::rename(&t, path_of(l)).map_err(|e| Error::io(path_of(l), e))?;
+    }
+    Ok(GeneratedMesh { path: path_of(level), geo_hash, gmsh_version: version })
+}

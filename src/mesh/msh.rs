@@ -1,0 +1,311 @@
+//! Reader for gmsh's MSH 4.1 ASCII format: nodes, 2-node lines, 3-node triangles and
+//! physical groups by name.
+//!
+//! Written by hand because the maintained reader (mshio 0.4) ignores `$PhysicalNames`,
+//! which is how scenes refer to bodies and boundary parts; the subset used here is small.
+
+use crate::error::{Error, Result};
+use std::collections::HashMap;
+use std::path::Path;
+
+/// A mesh as gmsh wrote it: all nodes, and the elements that belong to physical groups.
+#[derive(Debug, Clone, Default)]
+pub struct RawMesh {
+    /// Node coordinates (x, y), indexed by position (gmsh tags mapped to 0..n).
+    pub nodes: Vec<[f64; 2]>,
+    /// Triangles (node indices, counter-clockwise not guaranteed) with their physical tag.
+    pub triangles: Vec<([usize; 3], i32)>,
+    /// 2-node boundary lines with their physical tag.
+    pub lines: Vec<([usize; 2], i32)>,
+    /// Physical names by (dimension, tag).
+    pub physical_names: HashMap<(usize, i32), String>,
+}
+
+impl RawMesh {
+    /// The tag of the physical group of dimension `dim` named `name`, if any.
+    pub fn physical_tag(&self, dim: usize, name: &str) -> Option<i32> {
+        self.physical_names
+            .iter()
+            .find(|((d, _), n)| *d == dim && n.as_str() == name)
+            .map(|((_, t), _)| *t)
+    }
+
+    /// Sorted names of the physical groups of dimension `dim`.
+    pub fn names_of_dim(&self, dim: usize) -> Vec<String> {
+        let mut v: Vec<String> =
+            self.physical_names.iter().filter(|((d, _), _)| *d == dim).map(|(_, n)| n.clone()).collect();
+        v.sort();
+        v
+    }
+}
+
+struct Tokens<'a> {
+    it: std::iter::Peekable<std::str::SplitWhitespace<'a>>,
+    path: &'a Path,
+    section: &'static str,
+}
+
+impl<'a> Tokens<'a> {
+    fn err(&self, msg: impl Into<String>) -> Error {
+        Error::input(
+            self.path,
+            self.section,
+            format!("{}; the file is not a valid gmsh MSH 4.1 ASCII mesh: delete it and let the program regenerate it", msg.into()),
+        )
+    }
+    fn next_str(&mut self) -> Result<&'a str> {
+        self.it.next().ok_or_else(|| self.err("unexpected end of file"))
+    }
+    fn usize(&mut self) -> Result<usize> {
+        let s = self.next_str()?;
+        s.parse().map_err(|_| self.err(format!("expected a non-negative integer, found '{s}'")))
+    }
+    fn i32(&mut self) -> Result<i32> {
+        let s = self.next_str()?;
+        s.parse().map_err(|_| self.err(format!("expected an integer, found '{s}'")))
+    }
+    fn f64(&mut self) -> Result<f64> {
+        let s = self.next_str()?;
+        let v: f64 = s.parse().map_err(|_| self.err(format!("expected a number, found '{s}'")))?;
+        if !v.is_finite() {
+            return Err(self.err(format!("non-finite coordinate '{s}'")));
+        }
+        Ok(v)
+    }
+    fn expect(&mut self, what: &str) -> Result<()> {
+        let s = self.next_str()?;
+        if s != what {
+            return Err(self.err(format!("expected '{what}', found '{s}'")));
+        }
+        Ok(())
+    }
+}
+
+/// Guard against absurd counts in corrupted files before allocating.
+fn check_count(t: &Tokens, n: usize, what: &str) -> Result<()> {
+    if n > 200_000_000 {
+        return Err(t.err(format!("{what} count {n} is not plausible")));
+    }
+    Ok(())
+}
+
+/// Read a MSH 4.1 ASCII file.
+pub fn read_msh(path: &Path) -> Result<RawMesh> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    parse_msh(&text, path)
+}
+
+/// Parse the text of a MSH 4.1 ASCII file; `path` is used in error messages only.
+pub fn parse_msh(text: &str, path: &Path) -> Result<RawMesh> {
+    let mut mesh = RawMesh::default();
+    // Physical tags of each (dim, entity tag).
+    let mut entity_phys: HashMap<(usize, i32), Vec<i32>> = HashMap::new();
+    let mut node_index: HashMap<usize, usize> = HashMap::new();
+    let mut have_format = false;
+    let mut have_nodes = false;
+    let mut have_elements = false;
+    // $PhysicalNames has quoted names that may contain spaces: handle it by lines first.
+    let mut rest = text;
+    let mut out_text = String::new();
+    while let Some(start) = rest.find("$PhysicalNames") {
+        out_text.push_str(&rest[..start]);
+        let after = &rest[start + "$PhysicalNames".len()..];
+        let end = after.find("$EndPhysicalNames").ok_or_else(|| {
+            Error::input(path, "$PhysicalNames", "section is not closed by $EndPhysicalNames; delete the file and regenerate it")
+        })?;
+        let block = &after[..end];
+        let mut lines = block.lines().map(str::trim).filter(|l| !l.is_empty());
+        let n: usize = lines
+            .next()
+            .and_then(|l| l.parse().ok())
+            .ok_or_else(|| Error::input(path, "$PhysicalNames", "missing count; delete the file and regenerate it"))?;
+        for _ in 0..n {
+            let l = lines
+                .next()
+                .ok_or_else(|| Error::input(path, "$PhysicalNames", "fewer names than announced; delete the file and regenerate it"))?;
+            let mut parts = l.splitn(3, char::is_whitespace);
+            let dim: Option<usize> = parts.next().and_then(|s| s.parse().ok());
+            let tag: Option<i32> = parts.next().and_then(|s| s.parse().ok());
+            let name = parts.next().map(|s| s.trim().trim_matches('"').to_string());
+            match (dim, tag, name) {
+                (Some(d), Some(t), Some(nm)) if d <= 3 => {
+                    mesh.physical_names.insert((d, t), nm);
+                }
+                _ => {
+                    return Err(Error::input(path, "$PhysicalNames", format!("malformed line '{l}'; delete the file and regenerate it")));
+                }
+            }
+        }
+        rest = &after[end + "$EndPhysicalNames".len()..];
+    }
+    out_text.push_str(rest);
+
+    let mut t = Tokens { it: out_text.split_whitespace().peekable(), path, section: "$MeshFormat" };
+    while let Some(tok) = t.it.next() {
+        match tok {
+            "$MeshFormat" => {
+                t.section = "$MeshFormat";
+                let version = t.next_str()?;
+                if version != "4.1" {
+                    return Err(t.err(format!("version {version} is not supported (need 4.1: run gmsh with -format msh41)")));
+                }
+                let file_type = t.usize()?;
+                if file_type != 0 {
+                    return Err(t.err("binary MSH is not supported (need ASCII: run gmsh with -bin 0)"));
+                }
+                let _data_size = t.usize()?;
+                t.expect("$EndMeshFormat")?;
+                have_format = true;
+            }
+            "$Entities" => {
+                t.section = "$Entities";
+                let np = t.usize()?;
+                let nc = t.usize()?;
+                let ns = t.usize()?;
+                let nv = t.usize()?;
+                for _ in 0..np {
+                    let tag = t.i32()?;
+                    for _ in 0..3 {
+                        t.f64()?;
+                    }
+                    let nphys = t.usize()?;
+                    check_count(&t, nphys, "physical tag")?;
+                    let mut tags = Vec::new();
+                    for _ in 0..nphys {
+                        tags.push(t.i32()?);
+                    }
+                    entity_phys.insert((0, tag), tags);
+                }
+                for (dim, n) in [(1usize, nc), (2, ns), (3, nv)] {
+                    for _ in 0..n {
+                        let tag = t.i32()?;
+                        for _ in 0..6 {
+                            t.f64()?;
+                        }
+                        let nphys = t.usize()?;
+                        check_count(&t, nphys, "physical tag")?;
+                        let mut tags = Vec::new();
+                        for _ in 0..nphys {
+                            tags.push(t.i32()?);
+                        }
+                        entity_phys.insert((dim, tag), tags);
+                        let nb = t.usize()?;
+                        check_count(&t, nb, "bounding entity")?;
+                        for _ in 0..nb {
+                            t.i32()?;
+                        }
+                    }
+                }
+                t.expect("$EndEntities")?;
+            }
+            "$Nodes" => {
+                t.section = "$Nodes";
+                let nblocks = t.usize()?;
+                let nnodes = t.usize()?;
+                check_count(&t, nnodes, "node")?;
+                let _min = t.usize()?;
+                let _max = t.usize()?;
+                mesh.nodes.reserve(nnodes);
+                for _ in 0..nblocks {
+                    let _dim = t.usize()?;
+                    let _etag = t.i32()?;
+                    let parametric = t.usize()?;
+                    let n = t.usize()?;
+                    check_count(&t, n, "node")?;
+                    let mut tags = Vec::with_capacity(n);
+                    for _ in 0..n {
+                        tags.push(t.usize()?);
+                    }
+                    for tag in tags {
+                        let x = t.f64()?;
+                        let y = t.f64()?;
+                        let _z = t.f64()?;
+                        if parametric != 0 {
+                            return Err(t.err("parametric node coordinates are not supported (Mesh.SaveParametric = 0)"));
+                        }
+                        if node_index.insert(tag, mesh.nodes.len()).is_some() {
+                            return Err(t.err(format!("node tag {tag} appears twice")));
+                        }
+                        mesh.nodes.push([x, y]);
+                    }
+                }
+                if mesh.nodes.len() != nnodes {
+                    return Err(t.err(format!("header announces {nnodes} nodes, blocks hold {}", mesh.nodes.len())));
+                }
+                t.expect("$EndNodes")?;
+                have_nodes = true;
+            }
+            "$Elements" => {
+                t.section = "$Elements";
+                let nblocks = t.usize()?;
+                let _nel = t.usize()?;
+                let _min = t.usize()?;
+                let _max = t.usize()?;
+                for _ in 0..nblocks {
+                    let dim = t.usize()?;
+                    let etag = t.i32()?;
+                    let etype = t.usize()?;
+                    let n = t.usize()?;
+                    check_count(&t, n, "element")?;
+                    let nper = match etype {
+                        15 => 1,
+                        1 => 2,
+                        2 => 3,
+                        other => {
+                            return Err(t.err(format!(
+                                "element type {other} is not supported (only points, 2-node lines and 3-node triangles: use first-order meshes)"
+                            )));
+                        }
+                    };
+                    let phys = entity_phys.get(&(dim, etag)).cloned().unwrap_or_default();
+                    for _ in 0..n {
+                        let _tag = t.usize()?;
+                        let mut ids = [0usize; 3];
+                        for id in ids.iter_mut().take(nper) {
+                            let tag = t.usize()?;
+                            *id = *node_index
+                                .get(&tag)
+                                .ok_or_else(|| t.err(format!("element refers to unknown node {tag}")))?;
+                        }
+                        for &p in &phys {
+                            match etype {
+                                1 => mesh.lines.push(([ids[0], ids[1]], p)),
+                                2 => mesh.triangles.push(([ids[0], ids[1], ids[2]], p)),
+                                _ => {}
+                            }
+                        }
+                    }
+                }
+                t.expect("$EndElements")?;
+                have_elements = true;
+            }
+            s if s.starts_with("$") && !s.starts_with("$End") => {
+                // Skip unknown sections ($Periodic, $NodeData, ...).
+                let end = format!("$End{}", &s[1..]);
+                loop {
+                    match t.it.next() {
+                        Some(x) if x == end => break,
+                        Some(_) => {}
+                        None => return Err(t.err(format!("section {s} is not closed"))),
+                    }
+                }
+            }
+            other => return Err(t.err(format!("unexpected token '{other}'"))),
+        }
+    }
+    if !have_format || !have_nodes || !have_elements {
+        return Err(Error::input(
+            path,
+            "file",
+            "missing $MeshFormat, $Nodes or $Elements (an empty or truncated mesh); delete it and regenerate it",
+        ));
+    }
+    if mesh.triangles.is_empty() {
+        return Err(Error::input(
+            path,
+            "$Elements",
+            "the mesh has no triangle in a physical surface (gmsh wrote an empty mesh); check the .geo's Physical Surface lines",
+        ));
+    }
+    Ok(mesh)
+}

@@ -1,0 +1,397 @@
+//! Scenes are data: a TOML file names the .geo and its gmsh parameters, the two bodies and
+//! their materials, the boundary parts by physical-curve name, loads as expressions in
+//! x, y, t, the contact lines, the time interval, and optionally an exact solution.
+
+use crate::error::{Error, Result};
+use crate::material::{Elasticity, Material, Viscoplasticity};
+use exmex::prelude::*;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// One body of a scene file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    /// Physical-surface name in the mesh.
+    pub surface: String,
+    /// Young's modulus E (> 0).
+    pub young: f64,
+    /// Poisson's ratio in (-1, 0.5).
+    pub poisson: f64,
+    /// Perzyna viscosity lambda (> 0); with `yield_stress`, makes the body viscoplastic.
+    pub lambda: Option<f64>,
+    /// Uniaxial yield stress sigma_Y (> 0); absent: the body is elastic.
+    pub yield_stress: Option<f64>,
+    /// Body force f = [f_x, f_y] as expressions in x, y, t (force per area).
+    pub body_force: Option<[String; 2]>,
+}
+
+/// A clamped curve (u = 0).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClampSpec {
+    /// Physical-curve name.
+    pub curve: String,
+}
+
+/// A roller (symmetry) curve: one displacement component held at zero.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RollerSpec {
+    /// Physical-curve name (axis-aligned).
+    pub curve: String,
+    /// The held component, "x" or "y".
+    pub component: String,
+}
+
+/// A traction on a curve, g = [g_x, g_y] (force per length) as expressions in x, y, t.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TractionSpec {
+    /// Physical-curve name.
+    pub curve: String,
+    /// The traction components.
+    pub g: [String; 2],
+}
+
+/// The contact lines.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// Surface name of the body that carries the constraint (body 1, the "slave").
+    pub slave_body: String,
+    /// Physical-curve name of Gamma_C on the slave body.
+    pub slave_curve: String,
+    /// Physical-curve name of Gamma_C on the other body (the "master").
+    pub master_curve: String,
+}
+
+/// Optional exact solution (used by tests and reports).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExactSpec {
+    /// Exact stress [s11, s22, s12] as expressions in x, y, t, the same in both bodies.
+    pub stress: Option<[String; 3]>,
+}
+
+/// The TOML layout of a scene file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// One line saying what the scene is.
+    pub description: String,
+    /// The .geo file, relative to the scene file.
+    pub geo: PathBuf,
+    /// gmsh parameters (`-setnumber NAME VALUE`).
+    #[serde(default)]
+    pub parameters: BTreeMap<String, f64>,
+    /// Final time T (> 0).
+    pub final_time: f64,
+    /// Default number of uniform time steps (> 0).
+    pub steps: usize,
+    /// The two bodies.
+    pub bodies: Vec<BodySpec>,
+    /// Clamped curves.
+    #[serde(default)]
+    pub clamp: Vec<ClampSpec>,
+    /// Roller curves.
+    #[serde(default)]
+    pub roller: Vec<RollerSpec>,
+    /// Traction curves.
+    #[serde(default)]
+    pub traction: Vec<TractionSpec>,
+    /// Contact lines.
+    pub contact: ContactSpec,
+    /// Exact solution, if known.
+    pub exact: Option<ExactSpec>,
+}
+
+/// A parsed expression in x, y, t (and the constant `pi`), evaluated without re-parsing.
+#[derive(Debug, Clone)]
+pub struct Expr {
+    /// The source text.
+    pub text: String,
+    flat: FlatEx<f64>,
+    /// For each variable of the expression (alphabetical order), which input it reads.
+    slots: Vec<u8>,
+}
+
+impl Expr {
+    /// Parse `text`; `file` and `field` name the place for error messages.
+    pub fn parse(text: &str, file: &Path, field: &str) -> Result<Self> {
+        let flat = FlatEx::<f64>::parse(text).map_err(|e| {
+            Error::input(file, field, format!("cannot parse expression '{text}' ({e}); use x, y, t, numbers, + - * / ^ and functions such as sin, cos, exp, sqrt, abs"))
+        })?;
+        let mut slots = Vec::new();
+        for v in flat.var_names() {
+            slots.push(match v.as_str() {
+                "x" => 0,
+                "y" => 1,
+                "t" => 2,
+                "pi" => 3,
+                other => {
+                    return Err(Error::input(file, field, format!("expression '{text}' uses unknown variable '{other}'; only x, y, t and pi are defined")));
+                }
+            });
+        }
+        Ok(Expr { text: text.to_string(), flat, slots })
+    }
+
+    /// Evaluate at (x, y, t). Non-finite values are returned as they are; callers check.
+    pub fn eval(&self, x: f64, y: f64, t: f64) -> f64 {
+        let inputs = [x, y, t, std::f64::consts::PI];
+        let mut vals = [0.0; 4];
+        for (k, &s) in self.slots.iter().enumerate() {
+            vals[k] = inputs[s as usize];
+        }
+        self.flat.eval(&vals[..self.slots.len()]).unwrap_or(f64::NAN)
+    }
+}
+
+/// A vector field given by two expressions.
+#[derive(Debug, Clone)]
+pub struct VectorExpr(pub [Expr; 2]);
+
+impl VectorExpr {
+    fn parse(e: &[String; 2], file: &Path, field: &str) -> Result<Self> {
+        Ok(VectorExpr([Expr::parse(&e[0], file, &format!("{field}[0]"))?, Expr::parse(&e[1], file, &format!("{field}[1]"))?]))
+    }
+    /// Evaluate both components; error naming the scene, field and expression if not finite.
+    pub fn eval(&self, x: f64, y: f64, t: f64, file: &Path, field: &str) -> Result<[f64; 2]> {
+        let v = [self.0[0].eval(x, y, t), self.0[1].eval(x, y, t)];
+        for (c, val) in v.iter().enumerate() {
+            if !val.is_finite() {
+                return Err(Error::input(
+                    file,
+                    format!("{field}[{c}]"),
+                    format!("expression '{}' is not finite at x = {x}, y = {y}, t = {t}; fix the expression", self.0[c].text),
+                ));
+            }
+        }
+        Ok(v)
+    }
+}
+
+/// A body of a validated scene.
+#[derive(Debug, Clone)]
+pub struct SceneBody {
+    /// Physical-surface name.
+    pub surface: String,
+    /// Its material.
+    pub material: Material,
+    /// Body force, if any.
+    pub body_force: Option<VectorExpr>,
+}
+
+/// A roller condition: curve and held component (0 = x, 1 = y).
+#[derive(Debug, Clone)]
+pub struct Roller {
+    /// Physical-curve name.
+    pub curve: String,
+    /// Held component.
+    pub component: usize,
+}
+
+/// A traction on a curve.
+#[derive(Debug, Clone)]
+pub struct Traction {
+    /// Physical-curve name.
+    pub curve: String,
+    /// g(x, y, t).
+    pub g: VectorExpr,
+}
+
+/// A validated scene, ready to be meshed and solved.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    /// Scene name (file stem).
+    pub name: String,
+    /// The scene file.
+    pub file: PathBuf,
+    /// One-line description.
+    pub description: String,
+    /// Absolute path of the .geo.
+    pub geo: PathBuf,
+    /// gmsh parameters.
+    pub parameters: BTreeMap<String, f64>,
+    /// Final time T.
+    pub final_time: f64,
+    /// Default number of time steps.
+    pub steps: usize,
+    /// Bodies; index 0 is the slave (body 1), index 1 the master (body 2).
+    pub bodies: [SceneBody; 2],
+    /// Clamped curves.
+    pub clamps: Vec<String>,
+    /// Roller curves.
+    pub rollers: Vec<Roller>,
+    /// Tractions.
+    pub tractions: Vec<Traction>,
+    /// Gamma_C on body 1.
+    pub slave_curve: String,
+    /// Gamma_C on body 2.
+    pub master_curve: String,
+    /// Exact stress, if known.
+    pub exact_stress: Option<[Expr; 3]>,
+}
+
+/// The folder of the built-in scenes.
+pub fn builtin_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
+}
+
+/// Names of the built-in scenes.
+pub fn builtin_names() -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(builtin_dir())
+        .map(|rd| {
+            rd.filter_map(|e| e.ok())
+                .filter_map(|e| {
+                    let p = e.path();
+                    (p.extension().is_some_and(|x| x == "toml")).then(|| p.file_stem().unwrap().to_string_lossy().to_string())
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+fn check_positive(file: &Path, field: &str, v: f64, what: &str) -> Result<()> {
+    if !(v > 0.0 && v.is_finite()) {
+        return Err(Error::input(file, field, format!("{what} must be a positive finite number, got {v}; fix the value")));
+    }
+    Ok(())
+}
+
+impl Scene {
+    /// Load a built-in scene by name, or a scene file by path.
+    pub fn load(name_or_path: &str) -> Result<Self> {
+        let p = Path::new(name_or_path);
+        let file = if p.extension().is_some_and(|e| e == "toml") || p.exists() {
+            p.to_path_buf()
+        } else {
+            let f = builtin_dir().join(format!("{name_or_path}.toml"));
+            if !f.exists() {
+                return Err(Error::input(
+                    name_or_path,
+                    "scene",
+                    format!("no built-in scene named '{name_or_path}' and no such file; built-in scenes: {}", builtin_names().join(", ")),
+                ));
+            }
+            f
+        };
+        let text = std::fs::read_to_string(&file).map_err(|e| Error::io(&file, e))?;
+        Self::from_toml(&text, &file)
+    }
+
+    /// Parse and validate scene TOML text; `file` locates the .geo and names errors.
+    pub fn from_toml(text: &str, file: &Path) -> Result<Self> {
+        let sf: SceneFile = toml::from_str(text).map_err(|e| {
+            let span = e.span().map(|s| format!(" (line {})", text[..s.start.min(text.len())].lines().count().max(1))).unwrap_or_default();
+            Error::input(file, format!("toml{span}"), format!("{}; fix the scene file", e.message()))
+        })?;
+        let name = file.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
+        let dir = file.parent().unwrap_or(Path::new("."));
+        let geo = dir.join(&sf.geo);
+        if !geo.exists() {
+            return Err(Error::input(file, "geo", format!("the .geo file {} does not exist; give its path relative to the scene file", geo.display())));
+        }
+        check_positive(file, "final_time", sf.final_time, "final_time")?;
+        if sf.steps == 0 {
+            return Err(Error::input(file, "steps", "steps must be at least 1; fix the value"));
+        }
+        if sf.bodies.len() != 2 {
+            return Err(Error::input(file, "bodies", format!("a scene has exactly two [[bodies]], found {}", sf.bodies.len())));
+        }
+        let mut bodies = Vec::new();
+        for (i, b) in sf.bodies.iter().enumerate() {
+            let f = |k: &str| format!("bodies[{i}].{k}");
+            check_positive(file, &f("young"), b.young, "Young's modulus")?;
+            if !(b.poisson > -1.0 && b.poisson < 0.5) {
+                return Err(Error::input(file, f("poisson"), format!("Poisson's ratio must lie in (-1, 0.5), got {}; fix the value", b.poisson)));
+            }
+            let viscoplastic = match (b.lambda, b.yield_stress) {
+                (None, None) => None,
+                (Some(l), Some(y)) => {
+                    check_positive(file, &f("lambda"), l, "the viscosity lambda")?;
+                    check_positive(file, &f("yield_stress"), y, "the yield stress")?;
+                    Some(Viscoplasticity { lambda: l, yield_stress: y })
+                }
+                (Some(_), None) => {
+                    return Err(Error::input(file, f("yield_stress"), "lambda is given without yield_stress; give both for a viscoplastic body or neither for an elastic one"));
+                }
+                (None, Some(_)) => {
+                    return Err(Error::input(file, f("lambda"), "yield_stress is given without lambda; give both for a viscoplastic body or neither for an elastic one"));
+                }
+            };
+            let body_force = b.body_force.as_ref().map(|e| VectorExpr::parse(e, file, &f("body_force"))).transpose()?;
+            bodies.push(SceneBody {
+                surface: b.surface.clone(),
+                material: Material { elastic: Elasticity { young: b.young, poisson: b.poisson }, viscoplastic },
+                body_force,
+            });
+        }
+        let slave = bodies.iter().position(|b| b.surface == sf.contact.slave_body).ok_or_else(|| {
+            Error::input(file, "contact.slave_body", format!("'{}' is not the surface of either body ({}, {})", sf.contact.slave_body, bodies[0].surface, bodies[1].surface))
+        })?;
+        if slave == 1 {
+            bodies.swap(0, 1);
+        }
+        let mut claimed: BTreeMap<String, &str> = BTreeMap::new();
+        let mut claim = |curve: &str, what: &'static str, field: String| -> Result<()> {
+            if let Some(prev) = claimed.insert(curve.to_string(), what) {
+                return Err(Error::input(
+                    file,
+                    field,
+                    format!("curve '{curve}' is claimed twice ({prev} and {what}); a boundary part takes one condition: split it into two physical curves or drop one"),
+                ));
+            }
+            Ok(())
+        };
+        for (i, c) in sf.clamp.iter().enumerate() {
+            claim(&c.curve, "clamp", format!("clamp[{i}].curve"))?;
+        }
+        let mut rollers = Vec::new();
+        for (i, r) in sf.roller.iter().enumerate() {
+            claim(&r.curve, "roller", format!("roller[{i}].curve"))?;
+            let component = match r.component.as_str() {
+                "x" => 0,
+                "y" => 1,
+                other => return Err(Error::input(file, format!("roller[{i}].component"), format!("'{other}' is not a component; use \"x\" or \"y\""))),
+            };
+            rollers.push(Roller { curve: r.curve.clone(), component });
+        }
+        let mut tractions = Vec::new();
+        for (i, t) in sf.traction.iter().enumerate() {
+            claim(&t.curve, "traction", format!("traction[{i}].curve"))?;
+            tractions.push(Traction { curve: t.curve.clone(), g: VectorExpr::parse(&t.g, file, &format!("traction[{i}].g"))? });
+        }
+        claim(&sf.contact.slave_curve, "contact", "contact.slave_curve".into())?;
+        claim(&sf.contact.master_curve, "contact", "contact.master_curve".into())?;
+        let exact_stress = match sf.exact.as_ref().and_then(|e| e.stress.as_ref()) {
+            Some(s) => Some([
+                Expr::parse(&s[0], file, "exact.stress[0]")?,
+                Expr::parse(&s[1], file, "exact.stress[1]")?,
+                Expr::parse(&s[2], file, "exact.stress[2]")?,
+            ]),
+            None => None,
+        };
+        let [b0, b1]: [SceneBody; 2] = bodies.try_into().expect("two bodies");
+        Ok(Scene {
+            name,
+            file: file.to_path_buf(),
+            description: sf.description,
+            geo,
+            parameters: sf.parameters,
+            final_time: sf.final_time,
+            steps: sf.steps,
+            bodies: [b0, b1],
+            clamps: sf.clamp.into_iter().map(|c| c.curve).collect(),
+            rollers,
+            tractions,
+            slave_curve: sf.contact.slave_curve,
+            master_curve: sf.contact.master_curve,
+            exact_stress,
+        })
+    }
+}

@@ -1,0 +1,269 @@
+//! The paper's algorithm (section 4): the fixed point (4.2)-(4.3) on
+//! `eta = G(sigma_eta)`, each contact subproblem (4.2) being an elastic variational
+//! inequality with the load shifted by `-k eta`. The subproblem is solved either by the
+//! penalty-duality iteration (4.4)-(4.5) on the matrix `A + omega C^T W C` (factorized once
+//! per mesh) or, as an independent cross-check, by Clarabel as a convex QP.
+//!
+//! Discretization choice: the L2(Gamma_C) products of (4.4)-(4.5) use the lumped trace mass
+//! W of body 1, so that the nodal clipping P_U is the exact projection and the limit solves
+//! exactly the same discrete problem as the other solvers (multipliers `lambda = W p`).
+
+use super::linear::SparseSystem;
+use super::{Problem, Settings, State, StepReport, StepSolver};
+use crate::contact;
+use crate::error::{Error, Result};
+use crate::fe::Pattern;
+use crate::material::Stress;
+
+/// How each contact subproblem is solved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Inner {
+    /// Penalty-duality (4.4)-(4.5), the paper's method.
+    PenaltyDuality,
+    /// Clarabel interior point on the QP.
+    Clarabel,
+}
+
+/// Fixed-point solver state for one problem.
+pub struct FixedPoint<'a> {
+    p: &'a Problem,
+    settings: Settings,
+    inner: Inner,
+    /// A + omega C^T W C (penalty-duality) or A (Clarabel), over free dofs.
+    system: SparseSystem,
+    pattern: Pattern,
+    omega: f64,
+    /// Multiplier iterate q of (4.5), kept as a warm start between steps.
+    q: Vec<f64>,
+    /// Stored eta of the last step (warm start).
+    eta: Option<Vec<Stress>>,
+    clarabel_s: f64,
+}
+
+fn inf_norm(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |a, x| a.max(x.abs()))
+}
+
+impl<'a> FixedPoint<'a> {
+    /// Assemble and factorize the constant matrix.
+    pub fn new(p: &'a Problem, settings: &Settings, inner: Inner) -> Result<Self> {
+        let model = &p.model;
+        let n = model.n_free;
+        let mut extra = Vec::new();
+        if inner == Inner::PenaltyDuality {
+            for r in &p.rows {
+                for &(d1, _) in &r.entries {
+                    for &(d2, _) in &r.entries {
+                        extra.push((model.equation[d1], model.equation[d2]));
+                    }
+                }
+            }
+        }
+        let (pattern, slots) = model.stiffness_pattern(&extra, n);
+        let mut system = SparseSystem::new(&pattern);
+        let tangents = model.elastic_tangents();
+        let vals = system.values_mut();
+        model.add_tangent(&tangents, &slots, vals);
+        let mean_diag = (0..n).map(|i| vals[pattern.slot(i, i)]).sum::<f64>() / n.max(1) as f64;
+        let mean_w = p.rows.iter().map(|r| r.weight).sum::<f64>() / p.rows.len().max(1) as f64;
+        // Default omega: the penalty term has the size of the stiffness diagonal.
+        let omega = settings.omega.unwrap_or(mean_diag / mean_w.max(f64::MIN_POSITIVE));
+        if !(omega > 0.0 && omega.is_finite()) {
+            return Err(Error::input(&p.model.scene.file, "omega", format!("omega must be positive and finite, got {omega}")));
+        }
+        if !(settings.rho > 0.0 && settings.rho <= 1.0) {
+            return Err(Error::input(&p.model.scene.file, "rho", format!("rho must lie in (0, 1], got {}", settings.rho)));
+        }
+        if inner == Inner::PenaltyDuality {
+            for r in &p.rows {
+                for &(d1, v1) in &r.entries {
+                    for &(d2, v2) in &r.entries {
+                        vals[pattern.slot(model.equation[d1], model.equation[d2])] += omega * r.weight * v1 * v2;
+                    }
+                }
+            }
+            system.factor_llt()?;
+        }
+        Ok(FixedPoint { p, settings: *settings, inner, system, pattern, omega, q: vec![0.0; p.rows.len()], eta: None, clarabel_s: 0.0 })
+    }
+
+    /// Solve the contact subproblem `A u = b - C^T lambda`, `C u <= 0`, complementarity.
+    /// Returns (u over global dofs, lambda, inner iterations).
+    fn contact_subproblem(&mut self, b: &[f64], u0: &[f64]) -> Result<(Vec<f64>, Vec<f64>, usize)> {
+        match self.inner {
+            Inner::PenaltyDuality => self.penalty_duality(b, u0),
+            Inner::Clarabel => self.clarabel(b),
+        }
+    }
+
+    fn penalty_duality(&mut self, b: &[f64], u0: &[f64]) -> Result<(Vec<f64>, Vec<f64>, usize)> {
+        let p = self.p;
+        let model = &p.model;
+        let (omega, rho) = (self.omega, self.settings.rho);
+        let w: Vec<f64> = p.rows.iter().map(|r| r.weight).collect();
+        let mut u_old = u0.to_vec();
+        let tol = 1e-3 * self.settings.tol;
+        for it in 1..=100_000 {
+            // (4.4): (A + omega C^T W C) u = b - C^T W q.
+            let wq: Vec<f64> = self.q.iter().zip(&w).map(|(q, w)| q * w).collect();
+            let mut rhs_g = vec![0.0; 2 * model.n_nodes];
+            contact::add_transpose(&p.rows, &wq, &mut rhs_g);
+            let mut rhs = model.restrict(&rhs_g);
+            for (r, bi) in rhs.iter_mut().zip(b) {
+                *r = bi - *r;
+            }
+            self.system.solve(&mut rhs);
+            let u = model.expand(&rhs);
+            let g = contact::apply_rows(&p.rows, &u);
+            // (4.5): q~ = 2 g + q/omega; q_half = omega (q~ - 2 P_U q~); relaxation rho.
+            let mut dq = 0.0f64;
+            for i in 0..self.q.len() {
+                let qt = 2.0 * g[i] + self.q[i] / omega;
+                let qh = omega * (qt - 2.0 * qt.min(0.0));
+                let qn = rho * qh + (1.0 - rho) * self.q[i];
+                dq = dq.max((qn - self.q[i]).abs());
+                self.q[i] = qn;
+            }
+            let du = u.iter().zip(&u_old).fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+            let un = inf_norm(&u).max(f64::MIN_POSITIVE);
+            let qn = inf_norm(&self.q).max(omega * un);
+            u_old = u;
+            if !du.is_finite() {
+                return Err(Error::NotConverged("penalty-duality iterate became non-finite".into()));
+            }
+            if du <= tol * un && dq <= tol * qn {
+                // Physical multiplier p = q + omega g, nodal force lambda = W p.
+                let g = contact::apply_rows(&p.rows, &u_old);
+                let lambda = (0..g.len()).map(|i| w[i] * (self.q[i] + omega * g[i]).max(0.0)).collect();
+                return Ok((u_old, lambda, it));
+            }
+        }
+        Err(Error::NotConverged(format!("penalty-duality (4.4)-(4.5) did not converge in 100000 iterations (omega = {omega:.3e}, rho = {rho})")))
+    }
+
+    fn clarabel(&mut self, b: &[f64]) -> Result<(Vec<f64>, Vec<f64>, usize)> {
+        use clarabel::algebra::CscMatrix;
+        use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+        let p = self.p;
+        let model = &p.model;
+        let n = model.n_free;
+        let t0 = std::time::Instant::now();
+        // P: upper triangle of A.
+        let vals = self.system.values_mut().to_vec();
+        let (mut cp, mut ri, mut nz) = (vec![0usize], Vec::new(), Vec::new());
+        for c in 0..n {
+            for s in self.pattern.col_ptr[c]..self.pattern.col_ptr[c + 1] {
+                let r = self.pattern.row_idx[s];
+                if r <= c {
+                    ri.push(r);
+                    nz.push(vals[s]);
+                }
+            }
+            cp.push(ri.len());
+        }
+        let pm = CscMatrix::new(n, n, cp, ri, nz);
+        // A: the constraint rows (m x n) in CSC.
+        let m = p.rows.len();
+        let mut cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
+        for (i, r) in p.rows.iter().enumerate() {
+            for &(d, v) in &r.entries {
+                cols[model.equation[d]].push((i, v));
+            }
+        }
+        let (mut cp, mut ri, mut nz) = (vec![0usize], Vec::new(), Vec::new());
+        for col in &mut cols {
+            col.sort_by_key(|e| e.0);
+            for &(i, v) in col.iter() {
+                ri.push(i);
+                nz.push(v);
+            }
+            cp.push(ri.len());
+        }
+        let am = CscMatrix::new(m, n, cp, ri, nz);
+        let q: Vec<f64> = b.iter().map(|v| -v).collect();
+        let cones = [SupportedConeT::NonnegativeConeT(m)];
+        let settings = DefaultSettingsBuilder::default()
+            .verbose(false)
+            .tol_gap_abs(1e-13)
+            .tol_gap_rel(1e-13)
+            .tol_feas(1e-13)
+            .tol_ktratio(1e-10)
+            .max_iter(200)
+            .build()
+            .expect("valid Clarabel settings");
+        let zeros = vec![0.0; m];
+        let mut solver = DefaultSolver::new(&pm, &q, &am, &zeros, &cones, settings).map_err(|e| Error::NotConverged(format!("Clarabel setup failed: {e}")))?;
+        solver.solve();
+        self.clarabel_s += t0.elapsed().as_secs_f64();
+        let sol = &solver.solution;
+        match sol.status {
+            SolverStatus::Solved | SolverStatus::AlmostSolved => {}
+            s => return Err(Error::NotConverged(format!("Clarabel stopped with status {s:?} after {} iterations", sol.iterations))),
+        }
+        Ok((model.expand(&sol.x), sol.z.clone(), sol.iterations as usize))
+    }
+}
+
+impl StepSolver for FixedPoint<'_> {
+    fn step(&mut self, prev: &State, guess: &State, t: f64, k: f64) -> Result<(State, StepReport)> {
+        let p = self.p;
+        let model = &p.model;
+        let f_ext = model.load(t)?;
+        // Shift of (4.2): E eps(u^{n-1}) - sigma^{n-1} per element.
+        let shift: Vec<Stress> = model
+            .elements
+            .iter()
+            .enumerate()
+            .map(|(i, e)| model.materials[e.body].elastic.apply(&e.strain(&prev.u)) - prev.sigma[i])
+            .collect();
+        let mut eta: Vec<Stress> = match &self.eta {
+            Some(e) => e.clone(),
+            None => model.elements.iter().zip(&prev.sigma).map(|(e, s)| model.materials[e.body].g(s)).collect(),
+        };
+        let mut u = guess.u.clone();
+        let mut inner_total = 0;
+        let mut first_change = None;
+        let mut last_change = f64::INFINITY;
+        for outer in 1..=self.settings.max_iterations.max(200) {
+            // b = F + sum |T| B^T (E eps(u^{n-1}) - sigma^{n-1} - k eta).
+            let loads: Vec<Stress> = shift.iter().zip(&eta).map(|(s, e)| s - k * e).collect();
+            let fb = model.internal_force(&loads);
+            let b: Vec<f64> = model.restrict(&f_ext.iter().zip(&fb).map(|(f, l)| f + l).collect::<Vec<_>>());
+            let (un, lambda, inner) = self.contact_subproblem(&b, &u)?;
+            inner_total += inner;
+            u = un;
+            // (4.3): sigma_eta = sigma^{n-1} + E eps(u) - E eps(u^{n-1}) + k eta; eta' = G(sigma_eta).
+            let sigma: Vec<Stress> = model
+                .elements
+                .iter()
+                .enumerate()
+                .map(|(i, e)| prev.sigma[i] + model.materials[e.body].elastic.apply(&(e.strain(&u) - e.strain(&prev.u))) + k * eta[i])
+                .collect();
+            let eta_new: Vec<Stress> = model.elements.iter().zip(&sigma).map(|(e, s)| model.materials[e.body].g(s)).collect();
+            let change = eta_new.iter().zip(&eta).map(|(a, b)| (a - b).amax()).fold(0.0f64, f64::max) * k;
+            let size = sigma.iter().map(|s| s.amax()).fold(0.0f64, f64::max).max(f64::MIN_POSITIVE);
+            let rel = change / size;
+            first_change.get_or_insert(rel);
+            eta = eta_new;
+            if rel <= 1e-2 * self.settings.tol || change == 0.0 {
+                self.eta = Some(eta.clone());
+                let state = State { time: t, u, sigma, lambda };
+                let residual = super::equilibrium_residual(p, &state, &f_ext);
+                return Ok((state, StepReport { iterations: inner_total, outer_iterations: outer, residual, active_set_changes: 0, reason: format!("fixed point converged: relative change of k*eta {rel:.2e}") }));
+            }
+            if !rel.is_finite() || (outer > 5 && rel > last_change && rel > first_change.unwrap()) {
+                let factor = if last_change.is_finite() { rel / last_change } else { f64::INFINITY };
+                return Err(Error::NotConverged(format!(
+                    "the fixed point (4.2)-(4.3) diverges after {outer} iterations (change ratio {factor:.3} > 1): k L is too large; take a smaller time step or use the newton solver"
+                )));
+            }
+            last_change = rel;
+        }
+        Err(Error::NotConverged(format!("the fixed point (4.2)-(4.3) did not converge in {} iterations (last relative change {last_change:.3e})", self.settings.max_iterations.max(200))))
+    }
+
+    fn factor_stats(&self) -> (f64, usize) {
+        (self.system.factor_s + self.clarabel_s, self.system.factorizations)
+    }
+}
+

@@ -1,0 +1,212 @@
+//! Solving the fully discrete problem (2.1) step by step with one of three solvers that
+//! solve the same equations: [`newton`] (default), the paper's fixed point with the
+//! penalty-duality iteration, and a Clarabel QP cross-check (both in [`fixed_point`]).
+
+pub mod fixed_point;
+pub mod linear;
+pub mod newton;
+
+use crate::contact::{self, Interface, Method, Row};
+use crate::error::{Error, Result};
+use crate::fe::Model;
+use crate::material::Stress;
+use std::time::Instant;
+
+/// Which solver.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum SolverKind {
+    /// Implicit return map + consistent tangent + semismooth Newton on the contact rows.
+    Newton,
+    /// The paper's fixed point (4.2)-(4.3) with penalty-duality (4.4)-(4.5).
+    Paper,
+    /// The paper's fixed point with each contact subproblem solved by Clarabel.
+    Qp,
+}
+
+impl SolverKind {
+    /// Name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            SolverKind::Newton => "newton",
+            SolverKind::Paper => "paper",
+            SolverKind::Qp => "qp",
+        }
+    }
+    /// Parse a name.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "newton" => Some(SolverKind::Newton),
+            "paper" => Some(SolverKind::Paper),
+            "qp" => Some(SolverKind::Qp),
+            _ => None,
+        }
+    }
+}
+
+/// Solver settings.
+#[derive(Debug, Clone, Copy)]
+pub struct Settings {
+    /// Which solver.
+    pub kind: SolverKind,
+    /// Relative tolerance on the equilibrium residual and complementarity.
+    pub tol: f64,
+    /// Iteration limit per step (Newton iterations, or outer fixed-point iterations).
+    pub max_iterations: usize,
+    /// Penalty parameter omega of the paper's solver (force / length^2); None: automatic.
+    pub omega: Option<f64>,
+    /// Relaxation rho in (0, 1] of the paper's solver.
+    pub rho: f64,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings { kind: SolverKind::Newton, tol: 1e-10, max_iterations: 60, omega: None, rho: 1.0 }
+    }
+}
+
+/// The discrete problem on one mesh with one cone.
+#[derive(Debug, Clone)]
+pub struct Problem {
+    /// Elements, dofs and loads.
+    pub model: Model,
+    /// Gamma_C.
+    pub interface: Interface,
+    /// The cone.
+    pub method: Method,
+    /// Constraint rows of the cone.
+    pub rows: Vec<Row>,
+}
+
+impl Problem {
+    /// Assemble the constraint rows of `method` for `model` and `interface`.
+    pub fn new(model: Model, interface: Interface, method: Method) -> Self {
+        let rows = contact::constraint_rows(&model, &interface, method);
+        Problem { model, interface, method, rows }
+    }
+}
+
+/// The discrete state at one time t_n.
+#[derive(Debug, Clone)]
+pub struct State {
+    /// Time t_n.
+    pub time: f64,
+    /// Nodal displacements over global dofs (x, y per node), length units.
+    pub u: Vec<f64>,
+    /// Stress per element (tensor components), stress units.
+    pub sigma: Vec<Stress>,
+    /// Contact multipliers per constraint row (nodal forces, force units, >= 0).
+    pub lambda: Vec<f64>,
+}
+
+/// What one time step cost and why it stopped.
+#[derive(Debug, Clone)]
+pub struct StepReport {
+    /// Iterations (Newton iterations; for the fixed-point solvers, inner solves).
+    pub iterations: usize,
+    /// Outer iterations (fixed point); equals `iterations` for Newton.
+    pub outer_iterations: usize,
+    /// Final relative equilibrium residual.
+    pub residual: f64,
+    /// Active-set changes during the step.
+    pub active_set_changes: usize,
+    /// Why the iteration stopped.
+    pub reason: String,
+}
+
+/// A solved history.
+#[derive(Debug, Clone)]
+pub struct Solution {
+    /// States t_0 .. t_N (all of them when `keep_history`, else t_0 and t_N).
+    pub states: Vec<State>,
+    /// One report per step.
+    pub reports: Vec<StepReport>,
+    /// Wall time of the time loop (s).
+    pub wall_s: f64,
+    /// Wall time spent in numeric factorizations (s).
+    pub factor_s: f64,
+    /// Number of numeric factorizations.
+    pub factorizations: usize,
+}
+
+impl Solution {
+    /// The final state.
+    pub fn last(&self) -> &State {
+        self.states.last().expect("at least the initial state")
+    }
+    /// Sum of iterations over the steps.
+    pub fn iterations(&self) -> usize {
+        self.reports.iter().map(|r| r.iterations).sum()
+    }
+    /// Largest iteration count of one step.
+    pub fn max_step_iterations(&self) -> usize {
+        self.reports.iter().map(|r| r.iterations).max().unwrap_or(0)
+    }
+}
+
+/// One solver's per-step interface.
+pub trait StepSolver {
+    /// Advance from `prev` to time `t` with step `k`, starting from `guess`.
+    fn step(&mut self, prev: &State, guess: &State, t: f64, k: f64) -> Result<(State, StepReport)>;
+    /// (seconds in numeric factorizations, count).
+    fn factor_stats(&self) -> (f64, usize);
+}
+
+/// Relative residual of (2.1) at a state: `|f_int(sigma) - F + C^T lambda|_inf / scale`
+/// over the free dofs, with scale the larger of |F| and |f_int|.
+pub fn equilibrium_residual(p: &Problem, state: &State, f_ext: &[f64]) -> f64 {
+    let mut r = p.model.internal_force(&state.sigma);
+    let scale = p.model.restrict(&r).iter().chain(p.model.restrict(f_ext).iter()).fold(0.0f64, |a, v| a.max(v.abs()));
+    for (ri, f) in r.iter_mut().zip(f_ext) {
+        *ri -= f;
+    }
+    contact::add_transpose(&p.rows, &state.lambda, &mut r);
+    let rf = p.model.restrict(&r);
+    rf.iter().fold(0.0f64, |a, v| a.max(v.abs())) / scale.max(f64::MIN_POSITIVE)
+}
+
+/// Solve the history on `steps` uniform steps over [0, T]; zero initial state.
+pub fn solve(p: &Problem, settings: &Settings, steps: usize, keep_history: bool) -> Result<Solution> {
+    if steps == 0 {
+        return Err(Error::input(&p.model.scene.file, "steps", "the number of time steps must be at least 1"));
+    }
+    let start = Instant::now();
+    let n_el = p.model.elements.len();
+    let initial = State { time: 0.0, u: vec![0.0; 2 * p.model.n_nodes], sigma: vec![Stress::zeros(); n_el], lambda: vec![0.0; p.rows.len()] };
+    let mut solver: Box<dyn StepSolver> = match settings.kind {
+        SolverKind::Newton => Box::new(newton::Newton::new(p, settings)?),
+        SolverKind::Paper => Box::new(fixed_point::FixedPoint::new(p, settings, fixed_point::Inner::PenaltyDuality)?),
+        SolverKind::Qp => Box::new(fixed_point::FixedPoint::new(p, settings, fixed_point::Inner::Clarabel)?),
+    };
+    let k = p.model.scene.final_time / steps as f64;
+    let mut states = vec![initial.clone()];
+    let mut reports = Vec::new();
+    let mut prev = initial;
+    let mut before: Option<State> = None;
+    for n in 1..=steps {
+        let t = n as f64 * k;
+        // Warm start: linear extrapolation of the last two states.
+        let guess = match &before {
+            Some(b) => State {
+                time: t,
+                u: prev.u.iter().zip(&b.u).map(|(a, c)| 2.0 * a - c).collect(),
+                sigma: prev.sigma.clone(),
+                lambda: prev.lambda.iter().zip(&b.lambda).map(|(a, c)| (2.0 * a - c).max(0.0)).collect(),
+            },
+            None => prev.clone(),
+        };
+        let (state, report) = solver.step(&prev, &guess, t, k).map_err(|e| match e {
+            Error::NotConverged(m) => Error::NotConverged(format!("{} solver, {} cone, step {n} of {steps} (t = {t}): {m}", settings.kind.name(), p.method.name())),
+            other => other,
+        })?;
+        reports.push(report);
+        if keep_history {
+            states.push(state.clone());
+        }
+        before = Some(std::mem::replace(&mut prev, state));
+    }
+    if !keep_history {
+        states.push(prev);
+    }
+    let (factor_s, factorizations) = solver.factor_stats();
+    Ok(Solution { states, reports, wall_s: start.elapsed().as_secs_f64(), factor_s, factorizations })
+}

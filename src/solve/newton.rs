@@ -1,0 +1,158 @@
+//! The default solver: exact implicit return map per triangle, consistent tangent, and a
+//! semismooth Newton (primal-dual active set) treatment of the contact rows, on the KKT
+//! system `[K C^T; C_A 0]` whose pattern (all rows present) and symbolic LU are fixed per
+//! mesh. The factorization is reused while the tangent is elastic and the active set is
+//! unchanged.
+
+use super::linear::SparseSystem;
+use super::{Problem, Settings, State, StepReport, StepSolver};
+use crate::contact;
+use crate::error::{Error, Result};
+use crate::fe::{FIXED, Pattern};
+
+/// Newton solver state (pattern, slots, factorization) for one problem.
+pub struct Newton<'a> {
+    p: &'a Problem,
+    settings: Settings,
+    n: usize,
+    slots: Vec<[usize; 36]>,
+    /// Per row: (slot in row n+i, slot in column n+i) for each free entry, and the free eq.
+    row_slots: Vec<Vec<(usize, usize, usize, f64)>>,
+    diag_slots: Vec<usize>,
+    system: SparseSystem,
+    /// Active set and "tangent was elastic everywhere" of the current factorization.
+    factored: Option<(Vec<bool>, bool)>,
+    /// Scale turning gaps into forces in the complementarity function (force/length).
+    c_scale: f64,
+}
+
+impl<'a> Newton<'a> {
+    /// Set up the KKT pattern and the symbolic analysis for `p`.
+    pub fn new(p: &'a Problem, settings: &Settings) -> Result<Self> {
+        let n = p.model.n_free;
+        let m = p.rows.len();
+        let mut extra = Vec::new();
+        for (i, r) in p.rows.iter().enumerate() {
+            for &(d, _) in &r.entries {
+                let eq = p.model.equation[d];
+                extra.push((n + i, eq));
+                extra.push((eq, n + i));
+            }
+            extra.push((n + i, n + i));
+        }
+        let (pattern, slots): (Pattern, _) = p.model.stiffness_pattern(&extra, n + m);
+        let row_slots = p
+            .rows
+            .iter()
+            .enumerate()
+            .map(|(i, r)| r.entries.iter().map(|&(d, v)| {
+                let eq = p.model.equation[d];
+                (pattern.slot(n + i, eq), pattern.slot(eq, n + i), eq, v)
+            }).collect())
+            .collect();
+        let diag_slots = (0..m).map(|i| pattern.slot(n + i, n + i)).collect();
+        // Stiffness scale: the mean diagonal of the elastic stiffness.
+        let mut diag = vec![0.0; n];
+        let tangents = p.model.elastic_tangents();
+        let mut vals = vec![0.0; pattern.nnz()];
+        p.model.add_tangent(&tangents, &slots, &mut vals);
+        for (i, d) in diag.iter_mut().enumerate() {
+            *d = vals[pattern.slot(i, i)];
+        }
+        let c_scale = diag.iter().sum::<f64>() / n.max(1) as f64;
+        Ok(Newton { p, settings: *settings, n, slots, row_slots, diag_slots, system: SparseSystem::new(&pattern), factored: None, c_scale })
+    }
+}
+
+fn inf_norm(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |a, x| a.max(x.abs()))
+}
+
+impl StepSolver for Newton<'_> {
+    fn step(&mut self, prev: &State, guess: &State, t: f64, k: f64) -> Result<(State, StepReport)> {
+        let p = self.p;
+        let model = &p.model;
+        let n = self.n;
+        let m = p.rows.len();
+        let f_ext = model.load(t)?;
+        let f_free = model.restrict(&f_ext);
+        let c = self.c_scale;
+        let mut u = guess.u.clone();
+        let mut lambda = guess.lambda.clone();
+        let mut last_active: Option<Vec<bool>> = None;
+        let mut changes = 0;
+        let mut iterations = 0;
+        loop {
+            let (sigma, tangents) = model.update_stresses(&u, &prev.u, &prev.sigma, k, true);
+            let elastic = model.elements.iter().zip(&sigma).all(|(e, s)| !model.materials[e.body].is_plastic(s));
+            let f_int = model.internal_force(&sigma);
+            let mut r = f_int.clone();
+            for (ri, f) in r.iter_mut().zip(&f_ext) {
+                *ri -= f;
+            }
+            contact::add_transpose(&p.rows, &lambda, &mut r);
+            let r_free = model.restrict(&r);
+            let scale = inf_norm(&f_free).max(inf_norm(&model.restrict(&f_int))).max(f64::MIN_POSITIVE);
+            let g = contact::apply_rows(&p.rows, &u);
+            let active: Vec<bool> = (0..m).map(|i| lambda[i] + c * g[i] >= 0.0).collect();
+            let ncp = (0..m).map(|i| lambda[i].min(-c * g[i]).abs()).fold(0.0f64, f64::max);
+            let res = inf_norm(&r_free) / scale;
+            let compl = ncp / scale;
+            let same_set = last_active.as_ref().is_some_and(|a| *a == active);
+            if let Some(a) = &last_active {
+                changes += a.iter().zip(&active).filter(|(x, y)| x != y).count();
+            }
+            if iterations > 0 && res <= self.settings.tol && compl <= self.settings.tol && same_set {
+                let state = State { time: t, u, sigma, lambda };
+                return Ok((state, StepReport { iterations, outer_iterations: iterations, residual: res, active_set_changes: changes, reason: format!("residual {res:.2e} and complementarity {compl:.2e} below {:.0e}, active set settled", self.settings.tol) }));
+            }
+            if !res.is_finite() {
+                return Err(Error::NotConverged(format!("Newton iterate became non-finite after {iterations} iterations")));
+            }
+            if iterations >= self.settings.max_iterations {
+                return Err(Error::NotConverged(format!(
+                    "Newton reached {iterations} iterations with residual {res:.3e}, complementarity {compl:.3e} (tolerance {:.0e})",
+                    self.settings.tol
+                )));
+            }
+            // Refactorize unless the matrix is the one already factored.
+            let reuse = matches!(&self.factored, Some((a, el)) if *el && elastic && *a == active);
+            if !reuse {
+                let vals = self.system.values_mut();
+                vals.iter_mut().for_each(|v| *v = 0.0);
+                model.add_tangent(&tangents, &self.slots, vals);
+                for i in 0..m {
+                    for &(rs, cs, _, v) in &self.row_slots[i] {
+                        vals[cs] = v;
+                        vals[rs] = if active[i] { c * v } else { 0.0 };
+                    }
+                    vals[self.diag_slots[i]] = if active[i] { 0.0 } else { c };
+                }
+                self.system.factor_lu()?;
+                self.factored = Some((active.clone(), elastic));
+            }
+            let mut rhs = vec![0.0; n + m];
+            for (i, v) in r_free.iter().enumerate() {
+                rhs[i] = -v;
+            }
+            for i in 0..m {
+                rhs[n + i] = if active[i] { -c * g[i] } else { -c * lambda[i] };
+            }
+            self.system.solve(&mut rhs);
+            for (d, &eq) in model.equation.iter().enumerate() {
+                if eq != FIXED {
+                    u[d] += rhs[eq];
+                }
+            }
+            for i in 0..m {
+                lambda[i] += rhs[n + i];
+            }
+            last_active = Some(active);
+            iterations += 1;
+        }
+    }
+
+    fn factor_stats(&self) -> (f64, usize) {
+        (self.system.factor_s, self.system.factorizations)
+    }
+}
