@@ -41,8 +41,8 @@ enum Command {
         /// Penalty parameter omega of the paper solver (default: automatic).
         #[arg(long)]
         omega: Option<f64>,
-        /// Relaxation rho of the paper solver, in (0, 1].
-        #[arg(long, default_value_t = 1.0)]
+        /// Relaxation rho of the paper solver, in (0, 1] (0.5: rho = 1 can cycle forever on a body held only by contact).
+        #[arg(long, default_value_t = 0.5)]
         rho: f64,
         /// Relative tolerance of the solvers.
         #[arg(long, default_value_t = 1e-10)]

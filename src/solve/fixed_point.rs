@@ -128,6 +128,9 @@ impl<'a> FixedPoint<'a> {
             let un = inf_norm(&u).max(f64::MIN_POSITIVE);
             let qn = inf_norm(&self.q).max(omega * un);
             u_old = u;
+            if std::env::var_os("CR_DEBUG").is_some() && (it < 20 || it % 1000 == 0) {
+                eprintln!("pd it {it}: du/u {:.3e} dq/q {:.3e}", du / un, dq / qn);
+            }
             if !du.is_finite() {
                 return Err(Error::NotConverged("penalty-duality iterate became non-finite".into()));
             }
@@ -148,15 +151,16 @@ impl<'a> FixedPoint<'a> {
         let model = &p.model;
         let n = model.n_free;
         let t0 = std::time::Instant::now();
-        // P: upper triangle of A.
+        // P: upper triangle of A, scaled to unit mean diagonal (x is unchanged, z scales).
         let vals = self.system.values_mut().to_vec();
+        let scale = (0..n).map(|i| vals[self.pattern.slot(i, i)]).sum::<f64>() / n.max(1) as f64;
         let (mut cp, mut ri, mut nz) = (vec![0usize], Vec::new(), Vec::new());
         for c in 0..n {
             for s in self.pattern.col_ptr[c]..self.pattern.col_ptr[c + 1] {
                 let r = self.pattern.row_idx[s];
                 if r <= c {
                     ri.push(r);
-                    nz.push(vals[s]);
+                    nz.push(vals[s] / scale);
                 }
             }
             cp.push(ri.len());
@@ -180,7 +184,7 @@ impl<'a> FixedPoint<'a> {
             cp.push(ri.len());
         }
         let am = CscMatrix::new(m, n, cp, ri, nz);
-        let q: Vec<f64> = b.iter().map(|v| -v).collect();
+        let q: Vec<f64> = b.iter().map(|v| -v / scale).collect();
         let cones = [SupportedConeT::NonnegativeConeT(m)];
         let settings = DefaultSettingsBuilder::default()
             .verbose(false)
@@ -200,7 +204,7 @@ impl<'a> FixedPoint<'a> {
             SolverStatus::Solved | SolverStatus::AlmostSolved => {}
             s => return Err(Error::NotConverged(format!("Clarabel stopped with status {s:?} after {} iterations", sol.iterations))),
         }
-        Ok((model.expand(&sol.x), sol.z.clone(), sol.iterations as usize))
+        Ok((model.expand(&sol.x), sol.z.iter().map(|z| z * scale).collect(), sol.iterations as usize))
     }
 }
 
@@ -245,7 +249,7 @@ impl StepSolver for FixedPoint<'_> {
             let rel = change / size;
             first_change.get_or_insert(rel);
             eta = eta_new;
-            if rel <= 1e-2 * self.settings.tol || change == 0.0 {
+            if rel <= self.settings.tol || change == 0.0 {
                 self.eta = Some(eta.clone());
                 let state = State { time: t, u, sigma, lambda };
                 let residual = super::equilibrium_residual(p, &state, &f_ext);

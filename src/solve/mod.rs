@@ -60,7 +60,7 @@ pub struct Settings {
 
 impl Default for Settings {
     fn default() -> Self {
-        Settings { kind: SolverKind::Newton, tol: 1e-10, max_iterations: 60, omega: None, rho: 1.0 }
+        Settings { kind: SolverKind::Newton, tol: 1e-10, max_iterations: 60, omega: None, rho: 0.5 }
     }
 }
 
@@ -169,6 +169,17 @@ pub fn solve(p: &Problem, settings: &Settings, steps: usize, keep_history: bool)
     if steps == 0 {
         return Err(Error::input(&p.model.scene.file, "steps", "the number of time steps must be at least 1"));
     }
+    let k = p.model.scene.final_time / steps as f64;
+    let times: Vec<f64> = (1..=steps).map(|n| n as f64 * k).collect();
+    solve_times(p, settings, &times, keep_history)
+}
+
+/// Solve the history on the time grid `times` (t_1 < ... < t_N, t_0 = 0).
+pub fn solve_times(p: &Problem, settings: &Settings, times: &[f64], keep_history: bool) -> Result<Solution> {
+    if times.is_empty() || times[0] <= 0.0 || times.windows(2).any(|w| w[1] <= w[0]) {
+        return Err(Error::input(&p.model.scene.file, "time steps", "time steps k must be positive: t_1 > 0 and the times increasing"));
+    }
+    let steps = times.len();
     let start = Instant::now();
     let n_el = p.model.elements.len();
     let initial = State { time: 0.0, u: vec![0.0; 2 * p.model.n_nodes], sigma: vec![Stress::zeros(); n_el], lambda: vec![0.0; p.rows.len()] };
@@ -177,21 +188,24 @@ pub fn solve(p: &Problem, settings: &Settings, steps: usize, keep_history: bool)
         SolverKind::Paper => Box::new(fixed_point::FixedPoint::new(p, settings, fixed_point::Inner::PenaltyDuality)?),
         SolverKind::Qp => Box::new(fixed_point::FixedPoint::new(p, settings, fixed_point::Inner::Clarabel)?),
     };
-    let k = p.model.scene.final_time / steps as f64;
     let mut states = vec![initial.clone()];
     let mut reports = Vec::new();
     let mut prev = initial;
     let mut before: Option<State> = None;
     for n in 1..=steps {
-        let t = n as f64 * k;
+        let t = times[n - 1];
+        let k = t - prev.time;
         // Warm start: linear extrapolation of the last two states.
         let guess = match &before {
-            Some(b) => State {
-                time: t,
-                u: prev.u.iter().zip(&b.u).map(|(a, c)| 2.0 * a - c).collect(),
-                sigma: prev.sigma.clone(),
-                lambda: prev.lambda.iter().zip(&b.lambda).map(|(a, c)| (2.0 * a - c).max(0.0)).collect(),
-            },
+            Some(b) => {
+                let r = k / (prev.time - b.time);
+                State {
+                    time: t,
+                    u: prev.u.iter().zip(&b.u).map(|(a, c)| a + r * (a - c)).collect(),
+                    sigma: prev.sigma.clone(),
+                    lambda: prev.lambda.iter().zip(&b.lambda).map(|(a, c)| (a + r * (a - c)).max(0.0)).collect(),
+                }
+            }
             None => prev.clone(),
         };
         let (state, report) = solver.step(&prev, &guess, t, k).map_err(|e| match e {
