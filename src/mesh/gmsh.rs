@@ -16,9 +16,9 @@ pub fn cache_dir() -> PathBuf {
     }
 }
 
-/// The name of the gmsh executable: `$CONTACT_RATES_GMSH` if set (tests use it), else `gmsh`.
+/// The gmsh executable, found on PATH.
 fn gmsh_command() -> String {
-    std::env::var("CONTACT_RATES_GMSH").unwrap_or_else(|_| "gmsh".to_string())
+    "gmsh".to_string()
 }
 
 fn missing_gmsh(cmd: &str) -> Error {

@@ -151,9 +151,13 @@ impl<'a> FixedPoint<'a> {
         let model = &p.model;
         let n = model.n_free;
         let t0 = std::time::Instant::now();
-        // P: upper triangle of A, scaled to unit mean diagonal (x is unchanged, z scales).
+        // Scaling: u = alpha x with alpha the size of b / diag(A), so that x is O(1) and the
+        // interior point's absolute complementarity floor is small against u; the
+        // objective is divided by alpha^2 mean diag(A). The QP's solution is unchanged.
         let vals = self.system.values_mut().to_vec();
-        let scale = (0..n).map(|i| vals[self.pattern.slot(i, i)]).sum::<f64>() / n.max(1) as f64;
+        let diag_mean = (0..n).map(|i| vals[self.pattern.slot(i, i)]).sum::<f64>() / n.max(1) as f64;
+        let alpha = (inf_norm(b) / diag_mean).max(f64::MIN_POSITIVE);
+        let scale = diag_mean;
         let (mut cp, mut ri, mut nz) = (vec![0usize], Vec::new(), Vec::new());
         for c in 0..n {
             for s in self.pattern.col_ptr[c]..self.pattern.col_ptr[c + 1] {
@@ -184,7 +188,7 @@ impl<'a> FixedPoint<'a> {
             cp.push(ri.len());
         }
         let am = CscMatrix::new(m, n, cp, ri, nz);
-        let q: Vec<f64> = b.iter().map(|v| -v / scale).collect();
+        let q: Vec<f64> = b.iter().map(|v| -v / (scale * alpha)).collect();
         let cones = [SupportedConeT::NonnegativeConeT(m)];
         let settings = DefaultSettingsBuilder::default()
             .verbose(false)
@@ -204,7 +208,8 @@ impl<'a> FixedPoint<'a> {
             SolverStatus::Solved | SolverStatus::AlmostSolved => {}
             s => return Err(Error::NotConverged(format!("Clarabel stopped with status {s:?} after {} iterations", sol.iterations))),
         }
-        Ok((model.expand(&sol.x), sol.z.iter().map(|z| z * scale).collect(), sol.iterations as usize))
+        let x: Vec<f64> = sol.x.iter().map(|x| x * alpha).collect();
+        Ok((model.expand(&x), sol.z.iter().map(|z| z * scale * alpha).collect(), sol.iterations as usize))
     }
 }
 
@@ -248,6 +253,9 @@ impl StepSolver for FixedPoint<'_> {
             let size = sigma.iter().map(|s| s.amax()).fold(0.0f64, f64::max).max(f64::MIN_POSITIVE);
             let rel = change / size;
             first_change.get_or_insert(rel);
+            if std::env::var_os("CR_DEBUG").is_some() {
+                eprintln!("fixed point {outer}: rel change {rel:.3e}, inner {inner}");
+            }
             eta = eta_new;
             if rel <= self.settings.tol || change == 0.0 {
                 self.eta = Some(eta.clone());

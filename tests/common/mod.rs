@@ -1,0 +1,24 @@
+//! Shared helpers for the integration tests.
+#![allow(dead_code)]
+
+use contact_rates::case::Case;
+use contact_rates::contact::Method;
+use contact_rates::scene::Scene;
+
+/// Build a built-in scene at `level` with `method` and gmsh parameter overrides.
+pub fn case(scene: &str, level: usize, method: Method, params: &[(&str, f64)]) -> Case {
+    contact_rates::init();
+    let scene = Scene::load(scene).expect("built-in scene loads");
+    let params: Vec<(String, f64)> = params.iter().map(|(k, v)| (k.to_string(), *v)).collect();
+    Case::build(&scene, level, method, &params).expect("case builds")
+}
+
+/// Largest absolute entry.
+pub fn amax(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |a, x| a.max(x.abs()))
+}
+
+/// max |a - b| / max |a|.
+pub fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / amax(a)
+}
