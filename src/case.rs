@@ -28,9 +28,18 @@ pub struct Case {
 impl Case {
     /// Mesh `scene` at `level` (gmsh parameters from the scene, overridden by `params`),
     /// and build the problem for `method`.
-    pub fn build(scene: &Scene, level: usize, method: Method, params: &[(String, f64)]) -> Result<Self> {
+    pub fn build(
+        scene: &Scene,
+        level: usize,
+        method: Method,
+        params: &[(String, f64)],
+    ) -> Result<Self> {
         let t0 = Instant::now();
-        let mut all: Vec<(String, f64)> = scene.parameters.iter().map(|(k, v)| (k.clone(), *v)).collect();
+        let mut all: Vec<(String, f64)> = scene
+            .parameters
+            .iter()
+            .map(|(k, v)| (k.clone(), *v))
+            .collect();
         for (k, v) in params {
             match all.iter_mut().find(|(kk, _)| kk == k) {
                 Some(e) => e.1 = *v,
@@ -45,6 +54,13 @@ impl Case {
         let interface = Interface::new(&model, &raw)?;
         let h = model.h();
         let problem = Problem::new(model, interface, method);
-        Ok(Case { problem, level, h, mesh: generated, mesh_s, setup_s: t1.elapsed().as_secs_f64() })
+        Ok(Case {
+            problem,
+            level,
+            h,
+            mesh: generated,
+            mesh_s,
+            setup_s: t1.elapsed().as_secs_f64(),
+        })
     }
 }

@@ -87,10 +87,18 @@ fn chains(edges: &[[usize; 2]], what: &str, file: &std::path::Path) -> Result<Ve
         adj.entry(e[1]).or_default().push(e[0]);
     }
     if adj.values().any(|v| v.len() > 2) {
-        return Err(Error::input(file, what, "the contact curve branches; Gamma_C must be a simple polyline"));
+        return Err(Error::input(
+            file,
+            what,
+            "the contact curve branches; Gamma_C must be a simple polyline",
+        ));
     }
     let mut seen = std::collections::HashSet::new();
-    let mut ends: Vec<usize> = adj.iter().filter(|(_, v)| v.len() == 1).map(|(k, _)| *k).collect();
+    let mut ends: Vec<usize> = adj
+        .iter()
+        .filter(|(_, v)| v.len() == 1)
+        .map(|(k, _)| *k)
+        .collect();
     ends.sort();
     let mut out = Vec::new();
     for s in ends {
@@ -114,7 +122,11 @@ fn chains(edges: &[[usize; 2]], what: &str, file: &std::path::Path) -> Result<Ve
         out.push(chain);
     }
     if seen.len() != adj.len() {
-        return Err(Error::input(file, what, "the contact curve is closed; Gamma_C must have two end points"));
+        return Err(Error::input(
+            file,
+            what,
+            "the contact curve is closed; Gamma_C must have two end points",
+        ));
     }
     Ok(out)
 }
@@ -129,18 +141,43 @@ impl Interface {
                 return Err(Error::input(
                     file,
                     c.as_str(),
-                    format!("the mesh has no physical curve named '{c}' (it has: {}); fix contact.*_curve in the scene or the .geo", raw.names_of_dim(1).join(", ")),
+                    format!(
+                        "the mesh has no physical curve named '{c}' (it has: {}); fix contact.*_curve in the scene or the .geo",
+                        raw.names_of_dim(1).join(", ")
+                    ),
                 ));
             }
         }
         let off = model.node_offset;
-        let slave_edges: Vec<[usize; 2]> = model.meshes[0].curve_edges(raw, &sc.slave_curve).iter().map(|e| [e[0] + off[0], e[1] + off[0]]).collect();
-        let master_edges: Vec<[usize; 2]> = model.meshes[1].curve_edges(raw, &sc.master_curve).iter().map(|e| [e[0] + off[1], e[1] + off[1]]).collect();
+        let slave_edges: Vec<[usize; 2]> = model.meshes[0]
+            .curve_edges(raw, &sc.slave_curve)
+            .iter()
+            .map(|e| [e[0] + off[0], e[1] + off[0]])
+            .collect();
+        let master_edges: Vec<[usize; 2]> = model.meshes[1]
+            .curve_edges(raw, &sc.master_curve)
+            .iter()
+            .map(|e| [e[0] + off[1], e[1] + off[1]])
+            .collect();
         if slave_edges.is_empty() {
-            return Err(Error::input(&sc.file, "contact.slave_curve", format!("curve '{}' has no edge on the slave body '{}'", sc.slave_curve, sc.bodies[0].surface)));
+            return Err(Error::input(
+                &sc.file,
+                "contact.slave_curve",
+                format!(
+                    "curve '{}' has no edge on the slave body '{}'",
+                    sc.slave_curve, sc.bodies[0].surface
+                ),
+            ));
         }
         if master_edges.is_empty() {
-            return Err(Error::input(&sc.file, "contact.master_curve", format!("curve '{}' has no edge on the master body '{}'", sc.master_curve, sc.bodies[1].surface)));
+            return Err(Error::input(
+                &sc.file,
+                "contact.master_curve",
+                format!(
+                    "curve '{}' has no edge on the master body '{}'",
+                    sc.master_curve, sc.bodies[1].surface
+                ),
+            ));
         }
         let pos = |g: usize| model.position(g);
         let mut pieces = Vec::new();
@@ -177,7 +214,12 @@ impl Interface {
         let tri = model.elements.iter().find(|e| e.body == 0 && e.nodes.contains(&n0) && e.nodes.contains(&n1)).ok_or_else(|| {
             Error::input(file, "contact.slave_curve", "a contact edge does not belong to a slave triangle; the curve must lie on the slave body's boundary")
         })?;
-        let third = tri.nodes.iter().copied().find(|&n| n != n0 && n != n1).unwrap();
+        let third = tri
+            .nodes
+            .iter()
+            .copied()
+            .find(|&n| n != n0 && n != n1)
+            .unwrap();
         let pt = model.position(third);
         if (pt[0] - a[0]) * normal[0] + (pt[1] - a[1]) * normal[1] > 0.0 {
             normal = [-normal[0], -normal[1]];
@@ -187,10 +229,15 @@ impl Interface {
         let offset = |p: [f64; 2]| ((p[0] - a[0]) * normal[0] + (p[1] - a[1]) * normal[1]).abs();
         let slave_s: Vec<f64> = slave.iter().map(|&n| abscissa(model.position(n))).collect();
         if slave_s.windows(2).any(|w| w[1] <= w[0]) {
-            return Err(Error::input(file, "contact.slave_curve", "slave nodes are not ordered along the piece"));
+            return Err(Error::input(
+                file,
+                "contact.slave_curve",
+                "slave nodes are not ordered along the piece",
+            ));
         }
         // Master nodes on this piece (both ends of an edge on the segment).
-        let on = |p: [f64; 2]| offset(p) <= tol && abscissa(p) >= -tol && abscissa(p) <= length + tol;
+        let on =
+            |p: [f64; 2]| offset(p) <= tol && abscissa(p) >= -tol && abscissa(p) <= length + tol;
         let mut mnodes: Vec<usize> = Vec::new();
         let mut medges = 0;
         for e in master_edges {
@@ -201,9 +248,17 @@ impl Interface {
         }
         mnodes.sort_unstable();
         mnodes.dedup();
-        mnodes.sort_by(|&p, &q| abscissa(model.position(p)).total_cmp(&abscissa(model.position(q))));
-        let master_s: Vec<f64> = mnodes.iter().map(|&n| abscissa(model.position(n))).collect();
-        if mnodes.len() < 2 || medges != mnodes.len() - 1 || master_s[0].abs() > tol || (master_s.last().unwrap() - length).abs() > tol {
+        mnodes
+            .sort_by(|&p, &q| abscissa(model.position(p)).total_cmp(&abscissa(model.position(q))));
+        let master_s: Vec<f64> = mnodes
+            .iter()
+            .map(|&n| abscissa(model.position(n)))
+            .collect();
+        if mnodes.len() < 2
+            || medges != mnodes.len() - 1
+            || master_s[0].abs() > tol
+            || (master_s.last().unwrap() - length).abs() > tol
+        {
             return Err(Error::input(
                 file,
                 "contact.master_curve",
@@ -218,7 +273,16 @@ impl Interface {
         let mut slave_s = slave_s;
         slave_s[0] = 0.0;
         *slave_s.last_mut().unwrap() = length;
-        Ok(Piece { a, tangent, length, normal, slave_nodes: slave.to_vec(), slave_s, master_nodes: mnodes, master_s })
+        Ok(Piece {
+            a,
+            tangent,
+            length,
+            normal,
+            slave_nodes: slave.to_vec(),
+            slave_s,
+            master_nodes: mnodes,
+            master_s,
+        })
     }
 
     /// Smallest distance between an interior body-1 node and any body-2 node on Gamma_C,
@@ -226,7 +290,12 @@ impl Interface {
     pub fn min_relative_separation(&self) -> f64 {
         let mut best = f64::INFINITY;
         for p in &self.pieces {
-            let hmax = p.slave_s.windows(2).chain(p.master_s.windows(2)).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+            let hmax = p
+                .slave_s
+                .windows(2)
+                .chain(p.master_s.windows(2))
+                .map(|w| w[1] - w[0])
+                .fold(0.0, f64::max);
             for &s in &p.slave_s[1..p.slave_s.len() - 1] {
                 let k = p.master_s.partition_point(|&m| m < s);
                 for j in [k.saturating_sub(1), k.min(p.master_s.len() - 1)] {
@@ -260,7 +329,8 @@ impl Piece {
             .map(|&s| {
                 let mut row = vec![0.0; nm];
                 let q = (self.master_s.partition_point(|&m| m <= s).max(1) - 1).min(nm - 2);
-                let theta = ((s - self.master_s[q]) / (self.master_s[q + 1] - self.master_s[q])).clamp(0.0, 1.0);
+                let theta = ((s - self.master_s[q]) / (self.master_s[q + 1] - self.master_s[q]))
+                    .clamp(0.0, 1.0);
                 row[q] += 1.0 - theta;
                 row[q + 1] += theta;
                 row
@@ -325,7 +395,11 @@ impl Piece {
         // end-value contributions int psi_j (lambda_0 phi(c_a) + lambda_m phi(c_b)).
         let n = m - 1;
         let get = |j: usize, k: usize| -> f64 {
-            if k + 1 < j || k > j + 1 { 0.0 } else { ss_int[j][k + 1 - j] }
+            if k + 1 < j || k > j + 1 {
+                0.0
+            } else {
+                ss_int[j][k + 1 - j]
+            }
         };
         let psi_lambda = |j: usize, k: usize| -> f64 {
             let mut v = get(j, k);
@@ -418,9 +492,22 @@ pub fn constraint_rows(model: &Model, interface: &Interface, method: Method) -> 
                     push(p.master_nodes[q], -v);
                 }
             }
-            let left = if i > 0 { p.slave_s[i] - p.slave_s[i - 1] } else { 0.0 };
-            let right = if i + 1 < p.slave_s.len() { p.slave_s[i + 1] - p.slave_s[i] } else { 0.0 };
-            rows.push(Row { piece: pi, i, entries, weight: 0.5 * (left + right) });
+            let left = if i > 0 {
+                p.slave_s[i] - p.slave_s[i - 1]
+            } else {
+                0.0
+            };
+            let right = if i + 1 < p.slave_s.len() {
+                p.slave_s[i + 1] - p.slave_s[i]
+            } else {
+                0.0
+            };
+            rows.push(Row {
+                piece: pi,
+                i,
+                entries,
+                weight: 0.5 * (left + right),
+            });
         }
     }
     rows
@@ -428,7 +515,9 @@ pub fn constraint_rows(model: &Model, interface: &Interface, method: Method) -> 
 
 /// Apply rows to a global displacement vector: `(C u)_i`.
 pub fn apply_rows(rows: &[Row], u: &[f64]) -> Vec<f64> {
-    rows.iter().map(|r| r.entries.iter().map(|&(d, v)| v * u[d]).sum()).collect()
+    rows.iter()
+        .map(|r| r.entries.iter().map(|&(d, v)| v * u[d]).sum())
+        .collect()
 }
 
 /// Add `C^T lambda` to a global-dof vector.
@@ -455,11 +544,19 @@ pub fn normal_jumps(interface: &Interface, u: &[f64]) -> Vec<(usize, f64, f64)> 
         let nu2 = [-nu1[0], -nu1[1]];
         for (i, &n) in p.slave_nodes.iter().enumerate() {
             let s = p.slave_s[i];
-            out.push((pi, s, un(n, nu1) + interp(&p.master_nodes, &p.master_s, s, nu2)));
+            out.push((
+                pi,
+                s,
+                un(n, nu1) + interp(&p.master_nodes, &p.master_s, s, nu2),
+            ));
         }
         for (q, &n) in p.master_nodes.iter().enumerate() {
             let s = p.master_s[q];
-            out.push((pi, s, interp(&p.slave_nodes, &p.slave_s, s, nu1) + un(n, nu2)));
+            out.push((
+                pi,
+                s,
+                interp(&p.slave_nodes, &p.slave_s, s, nu1) + un(n, nu2),
+            ));
         }
     }
     out

@@ -37,11 +37,22 @@ pub type Result<T> = std::result::Result<T, Error>;
 
 impl Error {
     /// Bad input in `file` at `field`, with a message that says the fix.
-    pub fn input(file: impl Into<PathBuf>, field: impl Into<String>, message: impl Into<String>) -> Self {
-        Error::Input { file: file.into(), field: field.into(), message: message.into() }
+    pub fn input(
+        file: impl Into<PathBuf>,
+        field: impl Into<String>,
+        message: impl Into<String>,
+    ) -> Self {
+        Error::Input {
+            file: file.into(),
+            field: field.into(),
+            message: message.into(),
+        }
     }
     /// I/O error on `path`.
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
-        Error::Io { path: path.into(), source }
+        Error::Io {
+            path: path.into(),
+            source,
+        }
     }
 }

@@ -54,7 +54,14 @@ impl Element {
     /// Global dof indices of the element (x, y per node).
     pub fn dofs(&self) -> [usize; 6] {
         let n = self.nodes;
-        [2 * n[0], 2 * n[0] + 1, 2 * n[1], 2 * n[1] + 1, 2 * n[2], 2 * n[2] + 1]
+        [
+            2 * n[0],
+            2 * n[0] + 1,
+            2 * n[1],
+            2 * n[1] + 1,
+            2 * n[2],
+            2 * n[2] + 1,
+        ]
     }
 }
 
@@ -64,7 +71,10 @@ pub fn p1_gradients(p: [[f64; 2]; 3]) -> (f64, [[f64; 2]; 3]) {
     let mut g = [[0.0; 2]; 3];
     for a in 0..3 {
         let (j, k) = ((a + 1) % 3, (a + 2) % 3);
-        g[a] = [(p[j][1] - p[k][1]) / (2.0 * area), (p[k][0] - p[j][0]) / (2.0 * area)];
+        g[a] = [
+            (p[j][1] - p[k][1]) / (2.0 * area),
+            (p[k][0] - p[j][0]) / (2.0 * area),
+        ];
     }
     (area, g)
 }
@@ -94,7 +104,11 @@ impl Pattern {
         for c in 0..n {
             col_ptr[c + 1] += col_ptr[c];
         }
-        Pattern { n, col_ptr, row_idx }
+        Pattern {
+            n,
+            col_ptr,
+            row_idx,
+        }
     }
     /// Slot of entry (row, col); panics if absent (a construction error).
     pub fn slot(&self, row: usize, col: usize) -> usize {
@@ -132,12 +146,21 @@ pub struct Model {
     pub mesh_file: std::path::PathBuf,
 }
 
-fn edges_of(raw: &RawMesh, meshes: &[BodyMesh; 2], offsets: [usize; 2], curve: &str, mesh_file: &Path) -> Result<Vec<(usize, [usize; 2])>> {
+fn edges_of(
+    raw: &RawMesh,
+    meshes: &[BodyMesh; 2],
+    offsets: [usize; 2],
+    curve: &str,
+    mesh_file: &Path,
+) -> Result<Vec<(usize, [usize; 2])>> {
     if raw.physical_tag(1, curve).is_none() {
         return Err(Error::input(
             mesh_file,
             curve,
-            format!("the mesh has no physical curve named '{curve}' (it has: {}); fix the scene's curve name or add `Physical Curve(\"{curve}\")` to the .geo", raw.names_of_dim(1).join(", ")),
+            format!(
+                "the mesh has no physical curve named '{curve}' (it has: {}); fix the scene's curve name or add `Physical Curve(\"{curve}\")` to the .geo",
+                raw.names_of_dim(1).join(", ")
+            ),
         ));
     }
     let mut out = Vec::new();
@@ -147,7 +170,11 @@ fn edges_of(raw: &RawMesh, meshes: &[BodyMesh; 2], offsets: [usize; 2], curve: &
         }
     }
     if out.is_empty() {
-        return Err(Error::input(mesh_file, curve, format!("physical curve '{curve}' has no edge on either body; check the .geo")));
+        return Err(Error::input(
+            mesh_file,
+            curve,
+            format!("physical curve '{curve}' has no edge on either body; check the .geo"),
+        ));
     }
     Ok(out)
 }
@@ -165,7 +192,12 @@ impl Model {
             for t in &meshes[b].triangles {
                 let p = t.map(|i| meshes[b].nodes[i]);
                 let (area, grads) = p1_gradients(p);
-                elements.push(Element { body: b, nodes: t.map(|i| i + node_offset[b]), area, grads });
+                elements.push(Element {
+                    body: b,
+                    nodes: t.map(|i| i + node_offset[b]),
+                    area,
+                    grads,
+                });
             }
         }
         let mut fixed = vec![false; 2 * n_nodes];
@@ -178,7 +210,11 @@ impl Model {
             }
         }
         let model_pos = |g: usize| -> [f64; 2] {
-            if g < node_offset[1] { meshes[0].nodes[g] } else { meshes[1].nodes[g - node_offset[1]] }
+            if g < node_offset[1] {
+                meshes[0].nodes[g]
+            } else {
+                meshes[1].nodes[g - node_offset[1]]
+            }
         };
         for r in &scene.rollers {
             for (_, e) in edges_of(raw, &meshes, node_offset, &r.curve, mesh_file)? {
@@ -190,7 +226,11 @@ impl Model {
                     return Err(Error::input(
                         &scene.file,
                         format!("roller '{}'", r.curve),
-                        format!("a roller holding u_{} needs a {} curve, but an edge runs from {a:?} to {b:?}; use a clamp or fix the geometry", ["x", "y"][r.component], ["vertical", "horizontal"][r.component]),
+                        format!(
+                            "a roller holding u_{} needs a {} curve, but an edge runs from {a:?} to {b:?}; use a clamp or fix the geometry",
+                            ["x", "y"][r.component],
+                            ["vertical", "horizontal"][r.component]
+                        ),
                     ));
                 }
                 for n in e {
@@ -228,7 +268,11 @@ impl Model {
 
     /// Coordinates of global node `g`.
     pub fn position(&self, g: usize) -> [f64; 2] {
-        if g < self.node_offset[1] { self.meshes[0].nodes[g] } else { self.meshes[1].nodes[g - self.node_offset[1]] }
+        if g < self.node_offset[1] {
+            self.meshes[0].nodes[g]
+        } else {
+            self.meshes[1].nodes[g - self.node_offset[1]]
+        }
     }
 
     /// Largest element diameter over both bodies.
@@ -238,7 +282,11 @@ impl Model {
 
     /// Pattern of the stiffness matrix over free dofs, and for every element its 36
     /// slots (row-major over the element dofs; `FIXED` where a dof is constrained).
-    pub fn stiffness_pattern(&self, extra: &[(usize, usize)], n_total: usize) -> (Pattern, Vec<[usize; 36]>) {
+    pub fn stiffness_pattern(
+        &self,
+        extra: &[(usize, usize)],
+        n_total: usize,
+    ) -> (Pattern, Vec<[usize; 36]>) {
         let mut entries = Vec::with_capacity(self.elements.len() * 36 + extra.len());
         for e in &self.elements {
             let eq = e.dofs().map(|d| self.equation[d]);
@@ -275,8 +323,18 @@ impl Model {
     /// body forces (6-point degree-4 rule per triangle).
     pub fn load(&self, t: f64) -> Result<Vec<f64>> {
         let mut f = vec![0.0; 2 * self.n_nodes];
-        const GX: [f64; 4] = [-0.861_136_311_594_052_6, -0.339_981_043_584_856_3, 0.339_981_043_584_856_3, 0.861_136_311_594_052_6];
-        const GW: [f64; 4] = [0.347_854_845_137_453_9, 0.652_145_154_862_546_1, 0.652_145_154_862_546_1, 0.347_854_845_137_453_9];
+        const GX: [f64; 4] = [
+            -0.861_136_311_594_052_6,
+            -0.339_981_043_584_856_3,
+            0.339_981_043_584_856_3,
+            0.861_136_311_594_052_6,
+        ];
+        const GW: [f64; 4] = [
+            0.347_854_845_137_453_9,
+            0.652_145_154_862_546_1,
+            0.652_145_154_862_546_1,
+            0.347_854_845_137_453_9,
+        ];
         for &(i, [a, b]) in &self.traction_edges {
             let (pa, pb) = (self.position(a), self.position(b));
             let len = (pb[0] - pa[0]).hypot(pb[1] - pa[1]);
@@ -284,7 +342,13 @@ impl Model {
                 let s = 0.5 * (1.0 + GX[q]);
                 let x = pa[0] + s * (pb[0] - pa[0]);
                 let y = pa[1] + s * (pb[1] - pa[1]);
-                let g = self.scene.tractions[i].g.eval(x, y, t, &self.scene.file, &format!("traction '{}'.g", self.scene.tractions[i].curve))?;
+                let g = self.scene.tractions[i].g.eval(
+                    x,
+                    y,
+                    t,
+                    &self.scene.file,
+                    &format!("traction '{}'.g", self.scene.tractions[i].curve),
+                )?;
                 let w = 0.5 * GW[q] * len;
                 for c in 0..2 {
                     f[2 * a + c] += w * (1.0 - s) * g[c];
@@ -294,21 +358,53 @@ impl Model {
         }
         // Dunavant degree-4 rule (6 points).
         const TRI: [(f64, f64, f64); 6] = [
-            (0.445_948_490_915_965, 0.445_948_490_915_965, 0.223_381_589_678_011),
-            (0.445_948_490_915_965, 0.108_103_018_168_070, 0.223_381_589_678_011),
-            (0.108_103_018_168_070, 0.445_948_490_915_965, 0.223_381_589_678_011),
-            (0.091_576_213_509_771, 0.091_576_213_509_771, 0.109_951_743_655_322),
-            (0.091_576_213_509_771, 0.816_847_572_980_459, 0.109_951_743_655_322),
-            (0.816_847_572_980_459, 0.091_576_213_509_771, 0.109_951_743_655_322),
+            (
+                0.445_948_490_915_965,
+                0.445_948_490_915_965,
+                0.223_381_589_678_011,
+            ),
+            (
+                0.445_948_490_915_965,
+                0.108_103_018_168_070,
+                0.223_381_589_678_011,
+            ),
+            (
+                0.108_103_018_168_070,
+                0.445_948_490_915_965,
+                0.223_381_589_678_011,
+            ),
+            (
+                0.091_576_213_509_771,
+                0.091_576_213_509_771,
+                0.109_951_743_655_322,
+            ),
+            (
+                0.091_576_213_509_771,
+                0.816_847_572_980_459,
+                0.109_951_743_655_322,
+            ),
+            (
+                0.816_847_572_980_459,
+                0.091_576_213_509_771,
+                0.109_951_743_655_322,
+            ),
         ];
         for e in &self.elements {
-            let Some(bf) = &self.scene.bodies[e.body].body_force else { continue };
+            let Some(bf) = &self.scene.bodies[e.body].body_force else {
+                continue;
+            };
             let p = e.nodes.map(|n| self.position(n));
             for &(l1, l2, w) in &TRI {
                 let lam = [1.0 - l1 - l2, l1, l2];
                 let x = lam[0] * p[0][0] + lam[1] * p[1][0] + lam[2] * p[2][0];
                 let y = lam[0] * p[0][1] + lam[1] * p[1][1] + lam[2] * p[2][1];
-                let v = bf.eval(x, y, t, &self.scene.file, &format!("bodies '{}'.body_force", self.scene.bodies[e.body].surface))?;
+                let v = bf.eval(
+                    x,
+                    y,
+                    t,
+                    &self.scene.file,
+                    &format!("bodies '{}'.body_force", self.scene.bodies[e.body].surface),
+                )?;
                 for a in 0..3 {
                     for c in 0..2 {
                         f[2 * e.nodes[a] + c] += w * e.area * lam[a] * v[c];
@@ -332,12 +428,22 @@ impl Model {
 
     /// Expand free-equation values to global dofs (constrained dofs are zero).
     pub fn expand(&self, v: &[f64]) -> Vec<f64> {
-        self.equation.iter().map(|&eq| if eq == FIXED { 0.0 } else { v[eq] }).collect()
+        self.equation
+            .iter()
+            .map(|&eq| if eq == FIXED { 0.0 } else { v[eq] })
+            .collect()
     }
 
     /// Constitutive update of every element: `sigma = sigma_prev + E (eps(u) - eps(u_prev))
     /// + k G(sigma)`. Returns the stresses and, if `tangent`, the consistent tangents.
-    pub fn update_stresses(&self, u: &[f64], u_prev: &[f64], sigma_prev: &[Stress], k: f64, tangent: bool) -> (Vec<Stress>, Vec<Matrix3<f64>>) {
+    pub fn update_stresses(
+        &self,
+        u: &[f64],
+        u_prev: &[f64],
+        sigma_prev: &[Stress],
+        k: f64,
+        tangent: bool,
+    ) -> (Vec<Stress>, Vec<Matrix3<f64>>) {
         let mut sig = Vec::with_capacity(self.elements.len());
         let mut tan = Vec::with_capacity(if tangent { self.elements.len() } else { 0 });
         for (i, e) in self.elements.iter().enumerate() {
@@ -367,7 +473,12 @@ impl Model {
 
     /// Add the element tangents `|T| B^T D S B` (S halves the engineering shear) into
     /// `values` using the slot map.
-    pub fn add_tangent(&self, tangents: &[Matrix3<f64>], slots: &[[usize; 36]], values: &mut [f64]) {
+    pub fn add_tangent(
+        &self,
+        tangents: &[Matrix3<f64>],
+        slots: &[[usize; 36]],
+        values: &mut [f64],
+    ) {
         let s = Matrix3::from_diagonal(&SVector::<f64, 3>::new(1.0, 1.0, 0.5));
         for ((e, d), sl) in self.elements.iter().zip(tangents).zip(slots) {
             let b = e.b_matrix();
@@ -385,6 +496,9 @@ impl Model {
 
     /// Elastic tangents of all elements (E of each body).
     pub fn elastic_tangents(&self) -> Vec<Matrix3<f64>> {
-        self.elements.iter().map(|e| self.materials[e.body].elastic.matrix()).collect()
+        self.elements
+            .iter()
+            .map(|e| self.materials[e.body].elastic.matrix())
+            .collect()
     }
 }

@@ -10,9 +10,16 @@ use std::path::Path;
 
 /// Write `contents` to `path` atomically (temp file in the same folder, then rename).
 pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    let tmp = dir.join(format!(".{}.{}.tmp", path.file_name().unwrap().to_string_lossy(), std::process::id()));
+    let tmp = dir.join(format!(
+        ".{}.{}.tmp",
+        path.file_name().unwrap().to_string_lossy(),
+        std::process::id()
+    ));
     std::fs::write(&tmp, contents).map_err(|e| Error::io(&tmp, e))?;
     std::fs::rename(&tmp, path).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
@@ -26,9 +33,14 @@ pub fn vtu(model: &Model, state: &State) -> String {
     let np = model.n_nodes;
     let nc = model.elements.len();
     let mut s = String::new();
-    let _ = writeln!(s, "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>");
+    let _ = writeln!(
+        s,
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>"
+    );
     let _ = writeln!(s, "<Piece NumberOfPoints=\"{np}\" NumberOfCells=\"{nc}\">");
-    s.push_str("<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+    s.push_str(
+        "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n",
+    );
     for g in 0..np {
         let p = model.position(g);
         let _ = writeln!(s, "{:e} {:e} 0", p[0], p[1]);
@@ -69,7 +81,9 @@ pub fn vtu(model: &Model, state: &State) -> String {
 pub fn csv_bytes<T: serde::Serialize>(records: &[T]) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
     for r in records {
-        w.serialize(r).map_err(|e| Error::io("csv", std::io::Error::other(e.to_string())))?;
+        w.serialize(r)
+            .map_err(|e| Error::io("csv", std::io::Error::other(e.to_string())))?;
     }
-    w.into_inner().map_err(|e| Error::io("csv", std::io::Error::other(e.to_string())))
+    w.into_inner()
+        .map_err(|e| Error::io("csv", std::io::Error::other(e.to_string())))
 }

@@ -5,16 +5,16 @@
 //! The modules follow the pipeline: [`mesh`] -> [`fe`] -> [`material`] -> [`contact`] ->
 //! [`solve`] -> [`case`] / [`metrics`] -> [`io`]. Scenes are data ([`scene`]).
 
-pub mod error;
-pub mod mesh;
-pub mod scene;
-pub mod material;
-pub mod fe;
-pub mod contact;
-pub mod solve;
 pub mod case;
-pub mod metrics;
+pub mod contact;
+pub mod error;
+pub mod fe;
 pub mod io;
+pub mod material;
+pub mod mesh;
+pub mod metrics;
+pub mod scene;
+pub mod solve;
 
 pub use error::{Error, Result};
 

@@ -10,7 +10,11 @@ use serde::Serialize;
 use std::path::PathBuf;
 
 #[derive(Parser)]
-#[command(name = "contact-rates", version, about = "Convergence rates of mortar and node-on-segment contact on non-matching meshes")]
+#[command(
+    name = "contact-rates",
+    version,
+    about = "Convergence rates of mortar and node-on-segment contact on non-matching meshes"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -75,8 +79,12 @@ struct Summary {
 fn parse_sets(set: &[String]) -> anyhow::Result<Vec<(String, f64)>> {
     set.iter()
         .map(|s| {
-            let (k, v) = s.split_once('=').with_context(|| format!("--set {s}: expected NAME=VALUE"))?;
-            let v: f64 = v.parse().with_context(|| format!("--set {s}: '{v}' is not a number"))?;
+            let (k, v) = s
+                .split_once('=')
+                .with_context(|| format!("--set {s}: expected NAME=VALUE"))?;
+            let v: f64 = v
+                .parse()
+                .with_context(|| format!("--set {s}: '{v}' is not a number"))?;
             Ok((k.to_string(), v))
         })
         .collect()
@@ -86,9 +94,24 @@ fn run() -> anyhow::Result<()> {
     contact_rates::init();
     let cli = Cli::parse();
     match cli.command {
-        Command::Solve { scene, method, solver, level, steps, out, omega, rho, tol, set } => {
-            let method = Method::parse(&method).with_context(|| format!("--method: unknown cone '{method}'; use mortar (K_h^pi) or nts (K_h^I)"))?;
-            let kind = SolverKind::parse(&solver).with_context(|| format!("--solver: unknown solver '{solver}'; use newton, paper or qp"))?;
+        Command::Solve {
+            scene,
+            method,
+            solver,
+            level,
+            steps,
+            out,
+            omega,
+            rho,
+            tol,
+            set,
+        } => {
+            let method = Method::parse(&method).with_context(|| {
+                format!("--method: unknown cone '{method}'; use mortar (K_h^pi) or nts (K_h^I)")
+            })?;
+            let kind = SolverKind::parse(&solver).with_context(|| {
+                format!("--solver: unknown solver '{solver}'; use newton, paper or qp")
+            })?;
             if !(tol > 0.0) {
                 anyhow::bail!("--tol: the tolerance must be positive, got {tol}");
             }
@@ -99,7 +122,13 @@ fn run() -> anyhow::Result<()> {
             }
             let t0 = std::time::Instant::now();
             let case = Case::build(&scene, level, method, &parse_sets(&set)?)?;
-            let settings = Settings { kind, tol, omega, rho, ..Settings::default() };
+            let settings = Settings {
+                kind,
+                tol,
+                omega,
+                rho,
+                ..Settings::default()
+            };
             let sol = solve::solve(&case.problem, &settings, steps, false)?;
             let last = sol.last();
             let p = &case.problem;
@@ -119,13 +148,30 @@ fn run() -> anyhow::Result<()> {
                 plastic_fraction: metrics::plastic_fraction(p, last),
                 converged: true,
             };
-            io::write_atomic(&out.join("solution.vtu"), io::vtu(&p.model, last).as_bytes())?;
+            io::write_atomic(
+                &out.join("solution.vtu"),
+                io::vtu(&p.model, last).as_bytes(),
+            )?;
             io::write_atomic(&out.join("summary.csv"), &io::csv_bytes(&[&summary])?)?;
             println!(
                 "{} {} {} level {level}: h = {:.4}, {} dofs, {steps} steps, {} iterations (max {} per step), {:.3} s; max penetration {:.3e}, contact fraction {:.3}, plastic fraction {:.3}",
-                summary.scene, summary.method, summary.solver, summary.h, summary.dofs, summary.iterations, summary.max_step_iterations, summary.wall_s, summary.max_penetration, summary.contact_fraction, summary.plastic_fraction
+                summary.scene,
+                summary.method,
+                summary.solver,
+                summary.h,
+                summary.dofs,
+                summary.iterations,
+                summary.max_step_iterations,
+                summary.wall_s,
+                summary.max_penetration,
+                summary.contact_fraction,
+                summary.plastic_fraction
             );
-            println!("wrote {} and {}", out.join("solution.vtu").display(), out.join("summary.csv").display());
+            println!(
+                "wrote {} and {}",
+                out.join("solution.vtu").display(),
+                out.join("summary.csv").display()
+            );
         }
     }
     Ok(())

@@ -45,7 +45,9 @@ pub struct Material {
 
 /// Von Mises norm `sqrt(t11^2 + t22^2 - t11 t22 + 3 t12^2)`.
 pub fn von_mises(s: &Stress) -> f64 {
-    (s[0] * s[0] + s[1] * s[1] - s[0] * s[1] + 3.0 * s[2] * s[2]).max(0.0).sqrt()
+    (s[0] * s[0] + s[1] * s[1] - s[0] * s[1] + 3.0 * s[2] * s[2])
+        .max(0.0)
+        .sqrt()
 }
 
 /// `(p, d, t)` coordinates of a tensor `[11, 22, 12]`.
@@ -111,7 +113,9 @@ impl Material {
     /// Projection `P_B sigma` onto `{|tau|_VM <= sigma_Y}` in the E-inner product.
     /// Identity for an elastic body.
     pub fn project(&self, s: &Stress) -> Stress {
-        let Some(vp) = self.viscoplastic else { return *s };
+        let Some(vp) = self.viscoplastic else {
+            return *s;
+        };
         let y2 = vp.yield_stress * vp.yield_stress;
         if von_mises(s) * von_mises(s) <= y2 {
             return *s;
@@ -124,7 +128,8 @@ impl Material {
             let fa = alpha / (alpha + mu);
             let fb = beta / (beta + 3.0 * mu);
             let val = p * p * fa * fa + 3.0 * r2 * fb * fb - y2;
-            let der = -2.0 * p * p * fa * fa / (alpha + mu) - 18.0 * r2 * fb * fb / (beta + 3.0 * mu);
+            let der =
+                -2.0 * p * p * fa * fa / (alpha + mu) - 18.0 * r2 * fb * fb / (beta + 3.0 * mu);
             (val, der)
         });
         let fa = alpha / (alpha + mu);
@@ -142,7 +147,8 @@ impl Material {
 
     /// Whether `s` lies outside the elastic set B (viscoplastic flow active).
     pub fn is_plastic(&self, s: &Stress) -> bool {
-        self.viscoplastic.is_some_and(|vp| von_mises(s) > vp.yield_stress * (1.0 + 1e-12))
+        self.viscoplastic
+            .is_some_and(|vp| von_mises(s) > vp.yield_stress * (1.0 + 1e-12))
     }
 
     /// Backward-Euler update of one triangle:
@@ -150,7 +156,9 @@ impl Material {
     /// Returns sigma and the consistent tangent `d sigma / d eps` (tensor components).
     pub fn update(&self, sigma_trial: &Stress, k: f64) -> (Stress, Matrix3<f64>) {
         let e = self.elastic.matrix();
-        let Some(vp) = self.viscoplastic else { return (*sigma_trial, e) };
+        let Some(vp) = self.viscoplastic else {
+            return (*sigma_trial, e);
+        };
         let y2 = vp.yield_stress * vp.yield_stress;
         let vm = von_mises(sigma_trial);
         if vm * vm <= y2 {
@@ -182,10 +190,15 @@ impl Material {
         let dphi = -0.5 * c / (a * a);
         let dpsi = -1.5 * c / (bq * bq);
         let h_mu = -2.0 * p * p * da / (a * a * a) - 6.0 * r2 * db / (bq * bq * bq);
-        let grad_h = Vector3::new(2.0 * v[0] / (a * a), 6.0 * v[1] / (bq * bq), 6.0 * v[2] / (bq * bq));
+        let grad_h = Vector3::new(
+            2.0 * v[0] / (a * a),
+            6.0 * v[1] / (bq * bq),
+            6.0 * v[2] / (bq * bq),
+        );
         let grad_mu = -grad_h / h_mu;
         let col = Vector3::new(v[0] * dphi, v[1] * dpsi, v[2] * dpsi);
-        let j_pdt = Matrix3::from_diagonal(&Vector3::new(phi, psi, psi)) + col * grad_mu.transpose();
+        let j_pdt =
+            Matrix3::from_diagonal(&Vector3::new(phi, psi, psi)) + col * grad_mu.transpose();
         // Chain rule: tensor -> (p, d, t) -> tensor.
         let to = Matrix3::new(0.5, 0.5, 0.0, 0.5, -0.5, 0.0, 0.0, 0.0, 1.0);
         let from = Matrix3::new(1.0, 1.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, 1.0);
@@ -194,6 +207,7 @@ impl Material {
 
     /// Lipschitz-type scale `|E| / (2 lambda)` of G (1/time); zero for elastic bodies.
     pub fn g_rate_scale(&self) -> f64 {
-        self.viscoplastic.map_or(0.0, |vp| self.elastic.matrix().norm() / (2.0 * vp.lambda))
+        self.viscoplastic
+            .map_or(0.0, |vp| self.elastic.matrix().norm() / (2.0 * vp.lambda))
     }
 }

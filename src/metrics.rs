@@ -5,7 +5,10 @@ use crate::solve::{Problem, State};
 
 /// Largest interpenetration [u.nu]^+ over all trace nodes of both bodies (length units).
 pub fn max_penetration(p: &Problem, s: &State) -> f64 {
-    contact::normal_jumps(&p.interface, &s.u).iter().map(|j| j.2).fold(0.0, f64::max)
+    contact::normal_jumps(&p.interface, &s.u)
+        .iter()
+        .map(|j| j.2)
+        .fold(0.0, f64::max)
 }
 
 /// Fraction of Gamma_C's length in contact: the lumped weights of the constraint rows that
@@ -13,7 +16,13 @@ pub fn max_penetration(p: &Problem, s: &State) -> f64 {
 pub fn contact_fraction(p: &Problem, s: &State) -> f64 {
     let total: f64 = p.rows.iter().map(|r| r.weight).sum();
     let scale = s.lambda.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    let on: f64 = p.rows.iter().zip(&s.lambda).filter(|(_, l)| **l > 1e-8 * scale && **l > 0.0).map(|(r, _)| r.weight).sum();
+    let on: f64 = p
+        .rows
+        .iter()
+        .zip(&s.lambda)
+        .filter(|(_, l)| **l > 1e-8 * scale && **l > 0.0)
+        .map(|(r, _)| r.weight)
+        .sum();
     if total > 0.0 { on / total } else { 0.0 }
 }
 
@@ -21,6 +30,12 @@ pub fn contact_fraction(p: &Problem, s: &State) -> f64 {
 pub fn plastic_fraction(p: &Problem, s: &State) -> f64 {
     let m = &p.model;
     let total: f64 = m.elements.iter().map(|e| e.area).sum();
-    let plastic: f64 = m.elements.iter().zip(&s.sigma).filter(|(e, sg)| m.materials[e.body].is_plastic(sg)).map(|(e, _)| e.area).sum();
+    let plastic: f64 = m
+        .elements
+        .iter()
+        .zip(&s.sigma)
+        .filter(|(e, sg)| m.materials[e.body].is_plastic(sg))
+        .map(|(e, _)| e.area)
+        .sum();
     plastic / total
 }

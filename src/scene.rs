@@ -135,7 +135,11 @@ impl Expr {
                 }
             });
         }
-        Ok(Expr { text: text.to_string(), flat, slots })
+        Ok(Expr {
+            text: text.to_string(),
+            flat,
+            slots,
+        })
     }
 
     /// Evaluate at (x, y, t). Non-finite values are returned as they are; callers check.
@@ -145,7 +149,9 @@ impl Expr {
         for (k, &s) in self.slots.iter().enumerate() {
             vals[k] = inputs[s as usize];
         }
-        self.flat.eval(&vals[..self.slots.len()]).unwrap_or(f64::NAN)
+        self.flat
+            .eval(&vals[..self.slots.len()])
+            .unwrap_or(f64::NAN)
     }
 }
 
@@ -155,7 +161,10 @@ pub struct VectorExpr(pub [Expr; 2]);
 
 impl VectorExpr {
     fn parse(e: &[String; 2], file: &Path, field: &str) -> Result<Self> {
-        Ok(VectorExpr([Expr::parse(&e[0], file, &format!("{field}[0]"))?, Expr::parse(&e[1], file, &format!("{field}[1]"))?]))
+        Ok(VectorExpr([
+            Expr::parse(&e[0], file, &format!("{field}[0]"))?,
+            Expr::parse(&e[1], file, &format!("{field}[1]"))?,
+        ]))
     }
     /// Evaluate both components; error naming the scene, field and expression if not finite.
     pub fn eval(&self, x: f64, y: f64, t: f64, file: &Path, field: &str) -> Result<[f64; 2]> {
@@ -165,7 +174,10 @@ impl VectorExpr {
                 return Err(Error::input(
                     file,
                     format!("{field}[{c}]"),
-                    format!("expression '{}' is not finite at x = {x}, y = {y}, t = {t}; fix the expression", self.0[c].text),
+                    format!(
+                        "expression '{}' is not finite at x = {x}, y = {y}, t = {t}; fix the expression",
+                        self.0[c].text
+                    ),
                 ));
             }
         }
@@ -247,7 +259,8 @@ pub fn builtin_names() -> Vec<String> {
             rd.filter_map(|e| e.ok())
                 .filter_map(|e| {
                     let p = e.path();
-                    (p.extension().is_some_and(|x| x == "toml")).then(|| p.file_stem().unwrap().to_string_lossy().to_string())
+                    (p.extension().is_some_and(|x| x == "toml"))
+                        .then(|| p.file_stem().unwrap().to_string_lossy().to_string())
                 })
                 .collect()
         })
@@ -258,7 +271,11 @@ pub fn builtin_names() -> Vec<String> {
 
 fn check_positive(file: &Path, field: &str, v: f64, what: &str) -> Result<()> {
     if !(v > 0.0 && v.is_finite()) {
-        return Err(Error::input(file, field, format!("{what} must be a positive finite number, got {v}; fix the value")));
+        return Err(Error::input(
+            file,
+            field,
+            format!("{what} must be a positive finite number, got {v}; fix the value"),
+        ));
     }
     Ok(())
 }
@@ -275,7 +292,10 @@ impl Scene {
                 return Err(Error::input(
                     name_or_path,
                     "scene",
-                    format!("no built-in scene named '{name_or_path}' and no such file; built-in scenes: {}", builtin_names().join(", ")),
+                    format!(
+                        "no built-in scene named '{name_or_path}' and no such file; built-in scenes: {}",
+                        builtin_names().join(", ")
+                    ),
                 ));
             }
             f
@@ -287,53 +307,124 @@ impl Scene {
     /// Parse and validate scene TOML text; `file` locates the .geo and names errors.
     pub fn from_toml(text: &str, file: &Path) -> Result<Self> {
         let sf: SceneFile = toml::from_str(text).map_err(|e| {
-            let span = e.span().map(|s| format!(" (line {})", text[..s.start.min(text.len())].lines().count().max(1))).unwrap_or_default();
-            Error::input(file, format!("toml{span}"), format!("{}; fix the scene file", e.message()))
+            let span = e
+                .span()
+                .map(|s| {
+                    format!(
+                        " (line {})",
+                        text[..s.start.min(text.len())].lines().count().max(1)
+                    )
+                })
+                .unwrap_or_default();
+            Error::input(
+                file,
+                format!("toml{span}"),
+                format!("{}; fix the scene file", e.message()),
+            )
         })?;
-        let name = file.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
+        let name = file
+            .file_stem()
+            .map(|s| s.to_string_lossy().to_string())
+            .unwrap_or_default();
         let dir = file.parent().unwrap_or(Path::new("."));
         let geo = dir.join(&sf.geo);
         if !geo.exists() {
-            return Err(Error::input(file, "geo", format!("the .geo file {} does not exist; give its path relative to the scene file", geo.display())));
+            return Err(Error::input(
+                file,
+                "geo",
+                format!(
+                    "the .geo file {} does not exist; give its path relative to the scene file",
+                    geo.display()
+                ),
+            ));
         }
         check_positive(file, "final_time", sf.final_time, "final_time")?;
         if sf.steps == 0 {
-            return Err(Error::input(file, "steps", "steps must be at least 1; fix the value"));
+            return Err(Error::input(
+                file,
+                "steps",
+                "steps must be at least 1; fix the value",
+            ));
         }
         if sf.bodies.len() != 2 {
-            return Err(Error::input(file, "bodies", format!("a scene has exactly two [[bodies]], found {}", sf.bodies.len())));
+            return Err(Error::input(
+                file,
+                "bodies",
+                format!(
+                    "a scene has exactly two [[bodies]], found {}",
+                    sf.bodies.len()
+                ),
+            ));
         }
         let mut bodies = Vec::new();
         for (i, b) in sf.bodies.iter().enumerate() {
             let f = |k: &str| format!("bodies[{i}].{k}");
             check_positive(file, &f("young"), b.young, "Young's modulus")?;
             if !(b.poisson > -1.0 && b.poisson < 0.5) {
-                return Err(Error::input(file, f("poisson"), format!("Poisson's ratio must lie in (-1, 0.5), got {}; fix the value", b.poisson)));
+                return Err(Error::input(
+                    file,
+                    f("poisson"),
+                    format!(
+                        "Poisson's ratio must lie in (-1, 0.5), got {}; fix the value",
+                        b.poisson
+                    ),
+                ));
             }
             let viscoplastic = match (b.lambda, b.yield_stress) {
                 (None, None) => None,
                 (Some(l), Some(y)) => {
                     check_positive(file, &f("lambda"), l, "the viscosity lambda")?;
                     check_positive(file, &f("yield_stress"), y, "the yield stress")?;
-                    Some(Viscoplasticity { lambda: l, yield_stress: y })
+                    Some(Viscoplasticity {
+                        lambda: l,
+                        yield_stress: y,
+                    })
                 }
                 (Some(_), None) => {
-                    return Err(Error::input(file, f("yield_stress"), "lambda is given without yield_stress; give both for a viscoplastic body or neither for an elastic one"));
+                    return Err(Error::input(
+                        file,
+                        f("yield_stress"),
+                        "lambda is given without yield_stress; give both for a viscoplastic body or neither for an elastic one",
+                    ));
                 }
                 (None, Some(_)) => {
-                    return Err(Error::input(file, f("lambda"), "yield_stress is given without lambda; give both for a viscoplastic body or neither for an elastic one"));
+                    return Err(Error::input(
+                        file,
+                        f("lambda"),
+                        "yield_stress is given without lambda; give both for a viscoplastic body or neither for an elastic one",
+                    ));
                 }
             };
-            let body_force = b.body_force.as_ref().map(|e| VectorExpr::parse(e, file, &f("body_force"))).transpose()?;
+            let body_force = b
+                .body_force
+                .as_ref()
+                .map(|e| VectorExpr::parse(e, file, &f("body_force")))
+                .transpose()?;
             bodies.push(SceneBody {
                 surface: b.surface.clone(),
-                material: Material { elastic: Elasticity { young: b.young, poisson: b.poisson }, viscoplastic },
+                material: Material {
+                    elastic: Elasticity {
+                        young: b.young,
+                        poisson: b.poisson,
+                    },
+                    viscoplastic,
+                },
                 body_force,
             });
         }
-        let slave = bodies.iter().position(|b| b.surface == sf.contact.slave_body).ok_or_else(|| {
-            Error::input(file, "contact.slave_body", format!("'{}' is not the surface of either body ({}, {})", sf.contact.slave_body, bodies[0].surface, bodies[1].surface))
-        })?;
+        let slave = bodies
+            .iter()
+            .position(|b| b.surface == sf.contact.slave_body)
+            .ok_or_else(|| {
+                Error::input(
+                    file,
+                    "contact.slave_body",
+                    format!(
+                        "'{}' is not the surface of either body ({}, {})",
+                        sf.contact.slave_body, bodies[0].surface, bodies[1].surface
+                    ),
+                )
+            })?;
         if slave == 1 {
             bodies.swap(0, 1);
         }
@@ -343,7 +434,9 @@ impl Scene {
                 return Err(Error::input(
                     file,
                     field,
-                    format!("curve '{curve}' is claimed twice ({prev} and {what}); a boundary part takes one condition: split it into two physical curves or drop one"),
+                    format!(
+                        "curve '{curve}' is claimed twice ({prev} and {what}); a boundary part takes one condition: split it into two physical curves or drop one"
+                    ),
                 ));
             }
             Ok(())
@@ -357,17 +450,37 @@ impl Scene {
             let component = match r.component.as_str() {
                 "x" => 0,
                 "y" => 1,
-                other => return Err(Error::input(file, format!("roller[{i}].component"), format!("'{other}' is not a component; use \"x\" or \"y\""))),
+                other => {
+                    return Err(Error::input(
+                        file,
+                        format!("roller[{i}].component"),
+                        format!("'{other}' is not a component; use \"x\" or \"y\""),
+                    ));
+                }
             };
-            rollers.push(Roller { curve: r.curve.clone(), component });
+            rollers.push(Roller {
+                curve: r.curve.clone(),
+                component,
+            });
         }
         let mut tractions = Vec::new();
         for (i, t) in sf.traction.iter().enumerate() {
             claim(&t.curve, "traction", format!("traction[{i}].curve"))?;
-            tractions.push(Traction { curve: t.curve.clone(), g: VectorExpr::parse(&t.g, file, &format!("traction[{i}].g"))? });
+            tractions.push(Traction {
+                curve: t.curve.clone(),
+                g: VectorExpr::parse(&t.g, file, &format!("traction[{i}].g"))?,
+            });
         }
-        claim(&sf.contact.slave_curve, "contact", "contact.slave_curve".into())?;
-        claim(&sf.contact.master_curve, "contact", "contact.master_curve".into())?;
+        claim(
+            &sf.contact.slave_curve,
+            "contact",
+            "contact.slave_curve".into(),
+        )?;
+        claim(
+            &sf.contact.master_curve,
+            "contact",
+            "contact.master_curve".into(),
+        )?;
         let exact_stress = match sf.exact.as_ref().and_then(|e| e.stress.as_ref()) {
             Some(s) => Some([
                 Expr::parse(&s[0], file, "exact.stress[0]")?,

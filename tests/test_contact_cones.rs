@@ -46,13 +46,21 @@ fn mortar_projection_reproduces_linear_functions_and_keeps_end_values() {
     let mut seed = 0x2545F4914F6CDD1D;
     for (ns, nm) in [(2, 3), (3, 2), (5, 7), (8, 5), (13, 29), (40, 17)] {
         let len = 1.7;
-        let p = piece(random_trace(ns, len, &mut seed), random_trace(nm, len, &mut seed), len);
+        let p = piece(
+            random_trace(ns, len, &mut seed),
+            random_trace(nm, len, &mut seed),
+            len,
+        );
         let tr = p.transfer(Method::Mortar);
         for (a, b) in [(1.0, 0.0), (0.0, 1.0), (-2.5, 0.75)] {
             let phi: Vec<f64> = p.master_s.iter().map(|s| a + b * s).collect();
             for (i, s) in p.slave_s.iter().enumerate() {
                 let v: f64 = tr[i].iter().zip(&phi).map(|(c, f)| c * f).sum();
-                assert!((v - (a + b * s)).abs() < 1e-12, "{ns}x{nm}: pi(linear) at s = {s}: {v} vs {}", a + b * s);
+                assert!(
+                    (v - (a + b * s)).abs() < 1e-12,
+                    "{ns}x{nm}: pi(linear) at s = {s}: {v} vs {}",
+                    a + b * s
+                );
             }
         }
         // End values are kept for any function.
@@ -62,10 +70,21 @@ fn mortar_projection_reproduces_linear_functions_and_keeps_end_values() {
         assert!((first - phi[0]).abs() < 1e-14 && (last - phi[nm]).abs() < 1e-14);
         // Orthogonality to M_h: the projected function has the same integral as phi against
         // the constant 1 (which lies in M_h when there are at least two elements).
-        let int = |s: &[f64], v: &[f64]| s.windows(2).zip(v.windows(2)).map(|(x, y)| 0.5 * (x[1] - x[0]) * (y[0] + y[1])).sum::<f64>();
-        let pv: Vec<f64> = tr.iter().map(|r| r.iter().zip(&phi).map(|(c, f)| c * f).sum()).collect();
+        let int = |s: &[f64], v: &[f64]| {
+            s.windows(2)
+                .zip(v.windows(2))
+                .map(|(x, y)| 0.5 * (x[1] - x[0]) * (y[0] + y[1]))
+                .sum::<f64>()
+        };
+        let pv: Vec<f64> = tr
+            .iter()
+            .map(|r| r.iter().zip(&phi).map(|(c, f)| c * f).sum())
+            .collect();
         if ns >= 2 {
-            assert!((int(&p.slave_s, &pv) - int(&p.master_s, &phi)).abs() < 1e-13, "{ns}x{nm}: mean not preserved");
+            assert!(
+                (int(&p.slave_s, &pv) - int(&p.master_s, &phi)).abs() < 1e-13,
+                "{ns}x{nm}: mean not preserved"
+            );
         }
     }
 }
@@ -73,10 +92,18 @@ fn mortar_projection_reproduces_linear_functions_and_keeps_end_values() {
 #[test]
 fn interpolation_reproduces_linear_functions() {
     let mut seed = 42;
-    let p = piece(random_trace(9, 1.0, &mut seed), random_trace(6, 1.0, &mut seed), 1.0);
+    let p = piece(
+        random_trace(9, 1.0, &mut seed),
+        random_trace(6, 1.0, &mut seed),
+        1.0,
+    );
     let tr = p.transfer(Method::Nts);
     for (i, s) in p.slave_s.iter().enumerate() {
-        let v: f64 = tr[i].iter().zip(&p.master_s).map(|(c, x)| c * (1.0 - 2.0 * x)).sum();
+        let v: f64 = tr[i]
+            .iter()
+            .zip(&p.master_s)
+            .map(|(c, x)| c * (1.0 - 2.0 * x))
+            .sum();
         assert!((v - (1.0 - 2.0 * s)).abs() < 1e-14);
     }
 }
@@ -87,7 +114,10 @@ fn cones_coincide_on_matching_meshes() {
     for level in 0..3 {
         let mortar = common::case("patch", level, Method::Mortar, &params);
         let nts = common::case("patch", level, Method::Nts, &params);
-        assert!(mortar.problem.interface.min_relative_separation() < 1e-12, "matching trace nodes");
+        assert!(
+            mortar.problem.interface.min_relative_separation() < 1e-12,
+            "matching trace nodes"
+        );
         let (a, b) = (&mortar.problem.rows, &nts.problem.rows);
         assert_eq!(a.len(), b.len());
         let mut worst = 0.0f64;
@@ -96,7 +126,10 @@ fn cones_coincide_on_matching_meshes() {
             let mut db = rb.entries.clone();
             da.retain(|e| e.1.abs() > 1e-12);
             db.retain(|e| e.1.abs() > 1e-12);
-            assert_eq!(da.iter().map(|e| e.0).collect::<Vec<_>>(), db.iter().map(|e| e.0).collect::<Vec<_>>());
+            assert_eq!(
+                da.iter().map(|e| e.0).collect::<Vec<_>>(),
+                db.iter().map(|e| e.0).collect::<Vec<_>>()
+            );
             for (x, y) in da.iter().zip(&db) {
                 worst = worst.max((x.1 - y.1).abs());
             }
@@ -118,7 +151,10 @@ fn nonmatching_meshes_stay_apart_under_refinement() {
             let c = common::case(scene, level, Method::Nts, &[]);
             let sep = c.problem.interface.min_relative_separation();
             println!("{scene} level {level}: min node separation {sep:.3} h");
-            assert!(sep > 1e-3, "{scene} level {level}: interface nodes {sep} h apart");
+            assert!(
+                sep > 1e-3,
+                "{scene} level {level}: interface nodes {sep} h apart"
+            );
         }
     }
     let _ = constraint_rows;

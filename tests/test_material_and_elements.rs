@@ -11,16 +11,32 @@ use contact_rates::material::{Elasticity, Material, Stress, Viscoplasticity, von
 use nalgebra::{Matrix3, Vector3};
 
 fn material(young: f64, lambda: f64) -> Material {
-    Material { elastic: Elasticity { young, poisson: 0.3 }, viscoplastic: Some(Viscoplasticity { lambda, yield_stress: 10f64.sqrt() }) }
+    Material {
+        elastic: Elasticity {
+            young,
+            poisson: 0.3,
+        },
+        viscoplastic: Some(Viscoplasticity {
+            lambda,
+            yield_stress: 10f64.sqrt(),
+        }),
+    }
 }
 
 #[test]
 fn p1_gradients_sum_to_zero_and_reproduce_linear_fields() {
-    let tris = [[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], [[0.3, -0.2], [2.0, 0.4], [-0.5, 1.7]], [[1e3, 1e3], [1e3 + 1e-3, 1e3], [1e3, 1e3 + 1e-6]]];
+    let tris = [
+        [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+        [[0.3, -0.2], [2.0, 0.4], [-0.5, 1.7]],
+        [[1e3, 1e3], [1e3 + 1e-3, 1e3], [1e3, 1e3 + 1e-6]],
+    ];
     for p in tris {
         let (area, g) = p1_gradients(p);
         assert!(area > 0.0);
-        let scale = g.iter().map(|v| v[0].abs().max(v[1].abs())).fold(0.0, f64::max);
+        let scale = g
+            .iter()
+            .map(|v| v[0].abs().max(v[1].abs()))
+            .fold(0.0, f64::max);
         for c in 0..2 {
             let s: f64 = g.iter().map(|v| v[c]).sum();
             assert!(s.abs() <= 1e-12 * scale, "sum of d/dx{c} = {s}");
@@ -48,7 +64,10 @@ fn stresses() -> Vec<Stress> {
 
 #[test]
 fn plane_stress_elasticity_and_compliance_are_inverse() {
-    let el = Elasticity { young: 100.0, poisson: 0.3 };
+    let el = Elasticity {
+        young: 100.0,
+        poisson: 0.3,
+    };
     // a = E nu / (1 - nu^2), b = E / (1 + nu)
     assert!((el.a() - 100.0 * 0.3 / 0.91).abs() < 1e-12);
     assert!((el.b() - 100.0 / 1.3).abs() < 1e-12);
@@ -95,7 +114,10 @@ fn backward_euler_update_solves_its_equation_for_every_k() {
             for s in stresses() {
                 let (sig, _) = m.update(&s, k);
                 let res = sig - s - k * m.g(&sig);
-                assert!(res.amax() <= 1e-12 * s.amax(), "E = {young}, k = {k}: residual {res:?}");
+                assert!(
+                    res.amax() <= 1e-12 * s.amax(),
+                    "E = {young}, k = {k}: residual {res:?}"
+                );
             }
         }
     }
@@ -119,14 +141,23 @@ fn consistent_tangent_matches_central_differences() {
                 fd.set_column(j, &((sp - sm) / (2.0 * h)));
             }
             let err = (fd - d).amax() / d.amax();
-            assert!(err < 1e-6, "k = {k}, sigma = {s0:?}: tangent error {err:e}\n{d}\n{fd}");
+            assert!(
+                err < 1e-6,
+                "k = {k}, sigma = {s0:?}: tangent error {err:e}\n{d}\n{fd}"
+            );
         }
     }
 }
 
 #[test]
 fn elastic_body_pays_nothing() {
-    let m = Material { elastic: Elasticity { young: 100.0, poisson: 0.3 }, viscoplastic: None };
+    let m = Material {
+        elastic: Elasticity {
+            young: 100.0,
+            poisson: 0.3,
+        },
+        viscoplastic: None,
+    };
     let s = Vector3::new(1e3, -2e3, 5e2);
     let (sig, d) = m.update(&s, 1.0);
     assert_eq!(sig, s);

@@ -36,14 +36,20 @@ fn project_independent(el: &Elasticity, s: &Stress, y: f64) -> Stress {
     let n = 20000;
     let mut best = 0;
     for i in 0..n {
-        if dist(i as f64 * std::f64::consts::TAU / n as f64) < dist(best as f64 * std::f64::consts::TAU / n as f64) {
+        if dist(i as f64 * std::f64::consts::TAU / n as f64)
+            < dist(best as f64 * std::f64::consts::TAU / n as f64)
+        {
             best = i;
         }
     }
     let h = std::f64::consts::TAU / n as f64;
     // d/dth of the distance: -2 (s - point)^T E point'(th); it changes sign at the minimum.
     let slope = |th: f64| {
-        let dp = Vector3::new(-y * th.sin() + y * th.cos() / 3f64.sqrt(), -y * th.sin() - y * th.cos() / 3f64.sqrt(), 0.0);
+        let dp = Vector3::new(
+            -y * th.sin() + y * th.cos() / 3f64.sqrt(),
+            -y * th.sin() - y * th.cos() / 3f64.sqrt(),
+            0.0,
+        );
         -(s - point(th)).dot(&el.apply(&dp))
     };
     let (mut a, mut b) = ((best as f64 - 1.0) * h, (best as f64 + 1.0) * h);
@@ -58,7 +64,10 @@ fn project_independent(el: &Elasticity, s: &Stress, y: f64) -> Stress {
 #[test]
 fn mortar_reproduces_the_homogeneous_solution_and_nts_does_not() {
     let steps = 10;
-    let el = Elasticity { young: 3e5, poisson: 0.3 };
+    let el = Elasticity {
+        young: 3e5,
+        poisson: 0.3,
+    };
     let (lambda, y) = (100.0, 10f64.sqrt());
     // Independent backward Euler: eps^n = eps^{n-1} + E^{-1}(sigma^n - sigma^{n-1} - k G(sigma^n)).
     let k = 1.0 / steps as f64;
@@ -69,25 +78,46 @@ fn mortar_reproduces_the_homogeneous_solution_and_nts_does_not() {
         let g = -(0.5 / lambda) * el.apply(&(s - project_independent(&el, &s, y)));
         eps.push(eps[n - 1] + el.compliance(&(s - sp - k * g)));
     }
-    assert!(eps[steps][1].abs() > 10.0 * 10.0 / 3e5, "the test must exercise viscoplastic flow");
+    assert!(
+        eps[steps][1].abs() > 10.0 * 10.0 / 3e5,
+        "the test must exercise viscoplastic flow"
+    );
 
     for level in 0..3 {
         let case = common::case("patch", level, Method::Mortar, &[]);
         let p = &case.problem;
-        assert!(p.interface.min_relative_separation() > 1e-3, "meshes must be non-matching");
+        assert!(
+            p.interface.min_relative_separation() > 1e-3,
+            "meshes must be non-matching"
+        );
         let sol = solve::solve(p, &Settings::default(), steps, true).unwrap();
         for (n, st) in sol.states.iter().enumerate().skip(1) {
             let exact = Vector3::new(0.0, -10.0 * st.time, 0.0);
-            let err = st.sigma.iter().map(|s| (s - exact).amax()).fold(0.0, f64::max) / exact.amax();
-            assert!(err < 1e-9, "level {level} step {n}: mortar stress error {err:e}");
+            let err = st
+                .sigma
+                .iter()
+                .map(|s| (s - exact).amax())
+                .fold(0.0, f64::max)
+                / exact.amax();
+            assert!(
+                err < 1e-9,
+                "level {level} step {n}: mortar stress error {err:e}"
+            );
             let pen = metrics::max_penetration(p, st) / common::amax(&st.u);
-            assert!(pen < 1e-12, "level {level} step {n}: mortar interpenetration {pen:e}");
+            assert!(
+                pen < 1e-12,
+                "level {level} step {n}: mortar interpenetration {pen:e}"
+            );
         }
         let last = sol.last();
         for (e, _) in p.model.elements.iter().zip(&last.sigma) {
             let strain = e.strain(&last.u);
             let err = (strain - eps[steps]).amax() / eps[steps].amax();
-            assert!(err < 1e-9, "level {level}: strain {strain:?} vs backward Euler {:?}", eps[steps]);
+            assert!(
+                err < 1e-9,
+                "level {level}: strain {strain:?} vs backward Euler {:?}",
+                eps[steps]
+            );
         }
 
         let case = common::case("patch", level, Method::Nts, &[]);
@@ -95,9 +125,16 @@ fn mortar_reproduces_the_homogeneous_solution_and_nts_does_not() {
         let sol = solve::solve(p, &Settings::default(), steps, false).unwrap();
         let last = sol.last();
         let exact = Vector3::new(0.0, -10.0, 0.0);
-        let err = last.sigma.iter().map(|s| (s - exact).amax()).fold(0.0, f64::max) / 10.0;
+        let err = last
+            .sigma
+            .iter()
+            .map(|s| (s - exact).amax())
+            .fold(0.0, f64::max)
+            / 10.0;
         let pen = metrics::max_penetration(p, last) / common::amax(&last.u);
-        println!("level {level}: nts max stress error {err:.3e} (relative), max interpenetration {pen:.3e} (relative to max |u|)");
+        println!(
+            "level {level}: nts max stress error {err:.3e} (relative), max interpenetration {pen:.3e} (relative to max |u|)"
+        );
         assert!(err > 1e-3, "nts must show spurious stresses, got {err:e}");
         assert!(pen > 1e-3, "nts must show interpenetration, got {pen:e}");
     }

@@ -19,20 +19,32 @@ fn rates_scene_has_contact_separation_and_partial_flow() {
         let last = sol.last();
         let cf = metrics::contact_fraction(p, last);
         let pf = metrics::plastic_fraction(p, last);
-        println!("{}: contact fraction {cf:.3}, plastic fraction {pf:.3}", method.name());
+        println!(
+            "{}: contact fraction {cf:.3}, plastic fraction {pf:.3}",
+            method.name()
+        );
         assert!(cf > 0.2 && cf < 0.8, "contact fraction {cf}");
         assert!(pf > 0.05 && pf < 0.95, "plastic fraction {pf}");
         // The active rows, ordered by x, form one block starting at x = 0: one transition
         // point, inside Gamma_C.
         let piece = &p.interface.pieces[0];
-        let mut by_x: Vec<(f64, bool)> = last.lambda.iter().zip(&piece.slave_s).map(|(&l, &s)| (piece.a[0] + s * piece.tangent[0], l > 0.0)).collect();
+        let mut by_x: Vec<(f64, bool)> = last
+            .lambda
+            .iter()
+            .zip(&piece.slave_s)
+            .map(|(&l, &s)| (piece.a[0] + s * piece.tangent[0], l > 0.0))
+            .collect();
         by_x.sort_by(|a, b| a.0.total_cmp(&b.0));
         let active: Vec<bool> = by_x.iter().map(|a| a.1).collect();
         let switches = active.windows(2).filter(|w| w[0] != w[1]).count();
         assert_eq!(switches, 1, "one contact/separation transition");
         assert!(active[0] && !active[active.len() - 1]);
         let x_t = by_x[active.iter().position(|a| !a).unwrap()].0;
-        println!("{}: transition between x = {:.3} and {x_t:.3}", method.name(), by_x[active.iter().position(|a| !a).unwrap() - 1].0);
+        println!(
+            "{}: transition between x = {:.3} and {x_t:.3}",
+            method.name(),
+            by_x[active.iter().position(|a| !a).unwrap() - 1].0
+        );
         assert!(x_t > 0.1 && x_t < 0.9, "transition at x = {x_t}");
         // Separation is real: the gap opens to a visible fraction of the displacement.
         let gap = contact::normal_jumps_min(p, last);
@@ -44,6 +56,9 @@ mod contact {
     use contact_rates::solve::{Problem, State};
     /// Most negative normal jump (the widest opening), length units.
     pub fn normal_jumps_min(p: &Problem, s: &State) -> f64 {
-        contact_rates::contact::normal_jumps(&p.interface, &s.u).iter().map(|j| j.2).fold(0.0, f64::min)
+        contact_rates::contact::normal_jumps(&p.interface, &s.u)
+            .iter()
+            .map(|j| j.2)
+            .fold(0.0, f64::min)
     }
 }

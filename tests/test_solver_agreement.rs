@@ -15,15 +15,33 @@ fn agree(scene: &str, times: &[f64]) {
     for method in [Method::Mortar, Method::Nts] {
         let case = common::case(scene, 1, method, &[]);
         let p = &case.problem;
-        let run = |kind| solve::solve_times(p, &Settings { kind, ..Settings::default() }, times, false).unwrap();
+        let run = |kind| {
+            solve::solve_times(
+                p,
+                &Settings {
+                    kind,
+                    ..Settings::default()
+                },
+                times,
+                false,
+            )
+            .unwrap()
+        };
         let newton = run(SolverKind::Newton);
         let last = newton.last();
         let plastic = metrics::plastic_fraction(p, last);
-        assert!(plastic > 0.0, "{scene}: the comparison must include viscoplastic flow");
+        assert!(
+            plastic > 0.0,
+            "{scene}: the comparison must include viscoplastic flow"
+        );
         for kind in [SolverKind::Paper, SolverKind::Qp] {
             let other = run(kind);
             let d = common::rel_diff(&last.u, &other.last().u);
-            println!("{scene} {} {}: max nodal difference to newton {d:.3e} (relative), plastic fraction {plastic:.3}", method.name(), kind.name());
+            println!(
+                "{scene} {} {}: max nodal difference to newton {d:.3e} (relative), plastic fraction {plastic:.3}",
+                method.name(),
+                kind.name()
+            );
             assert!(d < 1e-7, "{scene} {} {}: {d:e}", method.name(), kind.name());
         }
     }

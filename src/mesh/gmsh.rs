@@ -12,7 +12,9 @@ use std::sync::OnceLock;
 pub fn cache_dir() -> PathBuf {
     match std::env::var_os("CONTACT_RATES_CACHE") {
         Some(p) if !p.is_empty() => PathBuf::from(p),
-        _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("target").join("mesh-cache"),
+        _ => Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("target")
+            .join("mesh-cache"),
     }
 }
 
@@ -33,13 +35,15 @@ pub fn gmsh_version() -> Result<String> {
     let cmd = gmsh_command();
     let v = VERSION.get_or_init(|| match Command::new(&cmd).arg("--version").output() {
         Ok(out) if out.status.success() => {
-            let s = String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+            let s = String::from_utf8_lossy(&out.stdout).to_string()
+                + &String::from_utf8_lossy(&out.stderr);
             Ok(s.trim().to_string())
         }
         Ok(out) => Err(format!("`{cmd} --version` failed with {}", out.status)),
         Err(_) => Err(missing_gmsh(&cmd).to_string()),
     });
-    v.clone().map_err(|e| Error::Gmsh(e.trim_start_matches("gmsh: ").to_string()))
+    v.clone()
+        .map_err(|e| Error::Gmsh(e.trim_start_matches("gmsh: ").to_string()))
 }
 
 /// Hex SHA-256 of a byte string.
@@ -53,21 +57,37 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
 fn run_gmsh(args: &[String], out: &Path, what: &Path) -> Result<()> {
     let cmd = gmsh_command();
     let output = Command::new(&cmd).args(args).output().map_err(|e| {
-        if e.kind() == std::io::ErrorKind::NotFound { missing_gmsh(&cmd) } else { Error::Gmsh(format!("could not start `{cmd}`: {e}")) }
+        if e.kind() == std::io::ErrorKind::NotFound {
+            missing_gmsh(&cmd)
+        } else {
+            Error::Gmsh(format!("could not start `{cmd}`: {e}"))
+        }
     })?;
-    let text = String::from_utf8_lossy(&output.stdout).to_string() + &String::from_utf8_lossy(&output.stderr);
+    let text = String::from_utf8_lossy(&output.stdout).to_string()
+        + &String::from_utf8_lossy(&output.stderr);
     let errors: Vec<&str> = text.lines().filter(|l| l.starts_with("Error")).collect();
     if !output.status.success() || !errors.is_empty() {
         let _ = std::fs::remove_file(out);
-        let detail = if errors.is_empty() { text.lines().last().unwrap_or("").to_string() } else { errors.join(" | ") };
+        let detail = if errors.is_empty() {
+            text.lines().last().unwrap_or("").to_string()
+        } else {
+            errors.join(" | ")
+        };
         return Err(Error::Input {
             file: what.to_path_buf(),
             field: "gmsh".into(),
-            message: format!("gmsh failed ({}): {detail}; fix the geometry or its parameters", output.status),
+            message: format!(
+                "gmsh failed ({}): {detail}; fix the geometry or its parameters",
+                output.status
+            ),
         });
     }
     if !out.exists() {
-        return Err(Error::input(what, "gmsh", "gmsh exited 0 but wrote no mesh; check the .geo defines Physical Surface groups"));
+        return Err(Error::input(
+            what,
+            "gmsh",
+            "gmsh exited 0 but wrote no mesh; check the .geo defines Physical Surface groups",
+        ));
     }
     Ok(())
 }
@@ -107,7 +127,15 @@ pub fn generate(geo: &Path, params: &[(String, f64)], level: usize) -> Result<Ge
             break;
         }
     }
-    let tmp = |l: usize| dir.join(format!("{stem}-{hash}-L{l}.{}.tmp.msh", std::process::id()));
+    // Unique temporary names: several threads or processes may generate the same mesh.
+    static COUNTER: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let tmp = |l: usize| {
+        let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        dir.join(format!(
+            "{stem}-{hash}-L{l}.{}-{n}.tmp.msh",
+            std::process::id()
+        ))
+    };
     let start = match have {
         Some(l) => l + 1,
         None => {
@@ -122,7 +150,11 @@ pub fn generate(geo: &Path, params: &[(String, f64)], level: usize) -> Result<Ge
             // Validate before publishing: a failed gmsh run can leave a broken file.
             super::msh::read_msh(&t).map_err(|e| {
                 let _ = std::fs::remove_file(&t);
-                Error::input(geo, "gmsh", format!("gmsh wrote an unusable mesh ({e}); fix the .geo"))
+                Error::input(
+                    geo,
+                    "gmsh",
+                    format!("gmsh wrote an unusable mesh ({e}); fix the .geo"),
+                )
             })?;
             std::fs::rename(&t, path_of(0)).map_err(|e| Error::io(path_of(0), e))?;
             1
@@ -141,9 +173,17 @@ pub fn generate(geo: &Path, params: &[(String, f64)], level: usize) -> Result<Ge
         run_gmsh(&args, &t, geo)?;
         super::msh::read_msh(&t).map_err(|e| {
             let _ = std::fs::remove_file(&t);
-            Error::input(geo, "gmsh", format!("gmsh -refine wrote an unusable mesh ({e})"))
+            Error::input(
+                geo,
+                "gmsh",
+                format!("gmsh -refine wrote an unusable mesh ({e})"),
+            )
         })?;
         std::fs::rename(&t, path_of(l)).map_err(|e| Error::io(path_of(l), e))?;
     }
-    Ok(GeneratedMesh { path: path_of(level), geo_hash, gmsh_version: version })
+    Ok(GeneratedMesh {
+        path: path_of(level),
+        geo_hash,
+        gmsh_version: version,
+    })
 }

@@ -62,21 +62,40 @@ impl BodyMesh {
                 t[k] = local_of_raw[r];
             }
             let area = signed_area(nodes[t[0]], nodes[t[1]], nodes[t[2]]);
-            if area.abs() <= 1e-14 * dist(nodes[t[0]], nodes[t[1]]).powi(2).max(f64::MIN_POSITIVE) {
-                return Err(Error::input(file, surface, format!("degenerate triangle with nodes at {:?}; fix the mesh sizes in the .geo", t.map(|i| nodes[i]))));
+            if area.abs()
+                <= 1e-14
+                    * dist(nodes[t[0]], nodes[t[1]])
+                        .powi(2)
+                        .max(f64::MIN_POSITIVE)
+            {
+                return Err(Error::input(
+                    file,
+                    surface,
+                    format!(
+                        "degenerate triangle with nodes at {:?}; fix the mesh sizes in the .geo",
+                        t.map(|i| nodes[i])
+                    ),
+                ));
             }
             if area < 0.0 {
                 t.swap(1, 2);
             }
             triangles.push(t);
         }
-        Ok(BodyMesh { name: surface.to_string(), nodes, triangles, local_of_raw })
+        Ok(BodyMesh {
+            name: surface.to_string(),
+            nodes,
+            triangles,
+            local_of_raw,
+        })
     }
 
     /// Edges (pairs of body node indices) of the physical curve `curve` that lie on this
     /// body; empty when the curve belongs to the other body.
     pub fn curve_edges(&self, raw: &RawMesh, curve: &str) -> Vec<[usize; 2]> {
-        let Some(tag) = raw.physical_tag(1, curve) else { return Vec::new() };
+        let Some(tag) = raw.physical_tag(1, curve) else {
+            return Vec::new();
+        };
         raw.lines
             .iter()
             .filter(|(_, p)| *p == tag)

@@ -32,8 +32,12 @@ impl RawMesh {
 
     /// Sorted names of the physical groups of dimension `dim`.
     pub fn names_of_dim(&self, dim: usize) -> Vec<String> {
-        let mut v: Vec<String> =
-            self.physical_names.iter().filter(|((d, _), _)| *d == dim).map(|(_, n)| n.clone()).collect();
+        let mut v: Vec<String> = self
+            .physical_names
+            .iter()
+            .filter(|((d, _), _)| *d == dim)
+            .map(|(_, n)| n.clone())
+            .collect();
         v.sort();
         v
     }
@@ -50,23 +54,32 @@ impl<'a> Tokens<'a> {
         Error::input(
             self.path,
             self.section,
-            format!("{}; the file is not a valid gmsh MSH 4.1 ASCII mesh: delete it and let the program regenerate it", msg.into()),
+            format!(
+                "{}; the file is not a valid gmsh MSH 4.1 ASCII mesh: delete it and let the program regenerate it",
+                msg.into()
+            ),
         )
     }
     fn next_str(&mut self) -> Result<&'a str> {
-        self.it.next().ok_or_else(|| self.err("unexpected end of file"))
+        self.it
+            .next()
+            .ok_or_else(|| self.err("unexpected end of file"))
     }
     fn usize(&mut self) -> Result<usize> {
         let s = self.next_str()?;
-        s.parse().map_err(|_| self.err(format!("expected a non-negative integer, found '{s}'")))
+        s.parse()
+            .map_err(|_| self.err(format!("expected a non-negative integer, found '{s}'")))
     }
     fn i32(&mut self) -> Result<i32> {
         let s = self.next_str()?;
-        s.parse().map_err(|_| self.err(format!("expected an integer, found '{s}'")))
+        s.parse()
+            .map_err(|_| self.err(format!("expected an integer, found '{s}'")))
     }
     fn f64(&mut self) -> Result<f64> {
         let s = self.next_str()?;
-        let v: f64 = s.parse().map_err(|_| self.err(format!("expected a number, found '{s}'")))?;
+        let v: f64 = s
+            .parse()
+            .map_err(|_| self.err(format!("expected a number, found '{s}'")))?;
         if !v.is_finite() {
             return Err(self.err(format!("non-finite coordinate '{s}'")));
         }
@@ -111,18 +124,29 @@ pub fn parse_msh(text: &str, path: &Path) -> Result<RawMesh> {
         out_text.push_str(&rest[..start]);
         let after = &rest[start + "$PhysicalNames".len()..];
         let end = after.find("$EndPhysicalNames").ok_or_else(|| {
-            Error::input(path, "$PhysicalNames", "section is not closed by $EndPhysicalNames; delete the file and regenerate it")
+            Error::input(
+                path,
+                "$PhysicalNames",
+                "section is not closed by $EndPhysicalNames; delete the file and regenerate it",
+            )
         })?;
         let block = &after[..end];
         let mut lines = block.lines().map(str::trim).filter(|l| !l.is_empty());
-        let n: usize = lines
-            .next()
-            .and_then(|l| l.parse().ok())
-            .ok_or_else(|| Error::input(path, "$PhysicalNames", "missing count; delete the file and regenerate it"))?;
+        let n: usize = lines.next().and_then(|l| l.parse().ok()).ok_or_else(|| {
+            Error::input(
+                path,
+                "$PhysicalNames",
+                "missing count; delete the file and regenerate it",
+            )
+        })?;
         for _ in 0..n {
-            let l = lines
-                .next()
-                .ok_or_else(|| Error::input(path, "$PhysicalNames", "fewer names than announced; delete the file and regenerate it"))?;
+            let l = lines.next().ok_or_else(|| {
+                Error::input(
+                    path,
+                    "$PhysicalNames",
+                    "fewer names than announced; delete the file and regenerate it",
+                )
+            })?;
             let mut parts = l.splitn(3, char::is_whitespace);
             let dim: Option<usize> = parts.next().and_then(|s| s.parse().ok());
             let tag: Option<i32> = parts.next().and_then(|s| s.parse().ok());
@@ -132,7 +156,11 @@ pub fn parse_msh(text: &str, path: &Path) -> Result<RawMesh> {
                     mesh.physical_names.insert((d, t), nm);
                 }
                 _ => {
-                    return Err(Error::input(path, "$PhysicalNames", format!("malformed line '{l}'; delete the file and regenerate it")));
+                    return Err(Error::input(
+                        path,
+                        "$PhysicalNames",
+                        format!("malformed line '{l}'; delete the file and regenerate it"),
+                    ));
                 }
             }
         }
@@ -140,18 +168,26 @@ pub fn parse_msh(text: &str, path: &Path) -> Result<RawMesh> {
     }
     out_text.push_str(rest);
 
-    let mut t = Tokens { it: out_text.split_whitespace().peekable(), path, section: "$MeshFormat" };
+    let mut t = Tokens {
+        it: out_text.split_whitespace().peekable(),
+        path,
+        section: "$MeshFormat",
+    };
     while let Some(tok) = t.it.next() {
         match tok {
             "$MeshFormat" => {
                 t.section = "$MeshFormat";
                 let version = t.next_str()?;
                 if version != "4.1" {
-                    return Err(t.err(format!("version {version} is not supported (need 4.1: run gmsh with -format msh41)")));
+                    return Err(t.err(format!(
+                        "version {version} is not supported (need 4.1: run gmsh with -format msh41)"
+                    )));
                 }
                 let file_type = t.usize()?;
                 if file_type != 0 {
-                    return Err(t.err("binary MSH is not supported (need ASCII: run gmsh with -bin 0)"));
+                    return Err(
+                        t.err("binary MSH is not supported (need ASCII: run gmsh with -bin 0)")
+                    );
                 }
                 let _data_size = t.usize()?;
                 t.expect("$EndMeshFormat")?;
@@ -230,7 +266,10 @@ pub fn parse_msh(text: &str, path: &Path) -> Result<RawMesh> {
                     }
                 }
                 if mesh.nodes.len() != nnodes {
-                    return Err(t.err(format!("header announces {nnodes} nodes, blocks hold {}", mesh.nodes.len())));
+                    return Err(t.err(format!(
+                        "header announces {nnodes} nodes, blocks hold {}",
+                        mesh.nodes.len()
+                    )));
                 }
                 t.expect("$EndNodes")?;
                 have_nodes = true;
@@ -263,9 +302,9 @@ pub fn parse_msh(text: &str, path: &Path) -> Result<RawMesh> {
                         let mut ids = [0usize; 3];
                         for id in ids.iter_mut().take(nper) {
                             let tag = t.usize()?;
-                            *id = *node_index
-                                .get(&tag)
-                                .ok_or_else(|| t.err(format!("element refers to unknown node {tag}")))?;
+                            *id = *node_index.get(&tag).ok_or_else(|| {
+                                t.err(format!("element refers to unknown node {tag}"))
+                            })?;
                         }
                         for &p in &phys {
                             match etype {

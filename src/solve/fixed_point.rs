@@ -67,24 +67,45 @@ impl<'a> FixedPoint<'a> {
         let mean_diag = (0..n).map(|i| vals[pattern.slot(i, i)]).sum::<f64>() / n.max(1) as f64;
         let mean_w = p.rows.iter().map(|r| r.weight).sum::<f64>() / p.rows.len().max(1) as f64;
         // Default omega: the penalty term has the size of the stiffness diagonal.
-        let omega = settings.omega.unwrap_or(mean_diag / mean_w.max(f64::MIN_POSITIVE));
+        let omega = settings
+            .omega
+            .unwrap_or(mean_diag / mean_w.max(f64::MIN_POSITIVE));
         if !(omega > 0.0 && omega.is_finite()) {
-            return Err(Error::input(&p.model.scene.file, "omega", format!("omega must be positive and finite, got {omega}")));
+            return Err(Error::input(
+                &p.model.scene.file,
+                "omega",
+                format!("omega must be positive and finite, got {omega}"),
+            ));
         }
         if !(settings.rho > 0.0 && settings.rho <= 1.0) {
-            return Err(Error::input(&p.model.scene.file, "rho", format!("rho must lie in (0, 1], got {}", settings.rho)));
+            return Err(Error::input(
+                &p.model.scene.file,
+                "rho",
+                format!("rho must lie in (0, 1], got {}", settings.rho),
+            ));
         }
         if inner == Inner::PenaltyDuality {
             for r in &p.rows {
                 for &(d1, v1) in &r.entries {
                     for &(d2, v2) in &r.entries {
-                        vals[pattern.slot(model.equation[d1], model.equation[d2])] += omega * r.weight * v1 * v2;
+                        vals[pattern.slot(model.equation[d1], model.equation[d2])] +=
+                            omega * r.weight * v1 * v2;
                     }
                 }
             }
             system.factor_llt()?;
         }
-        Ok(FixedPoint { p, settings: *settings, inner, system, pattern, omega, q: vec![0.0; p.rows.len()], eta: None, clarabel_s: 0.0 })
+        Ok(FixedPoint {
+            p,
+            settings: *settings,
+            inner,
+            system,
+            pattern,
+            omega,
+            q: vec![0.0; p.rows.len()],
+            eta: None,
+            clarabel_s: 0.0,
+        })
     }
 
     /// Solve the contact subproblem `A u = b - C^T lambda`, `C u <= 0`, complementarity.
@@ -124,7 +145,10 @@ impl<'a> FixedPoint<'a> {
                 dq = dq.max((qn - self.q[i]).abs());
                 self.q[i] = qn;
             }
-            let du = u.iter().zip(&u_old).fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+            let du = u
+                .iter()
+                .zip(&u_old)
+                .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
             let un = inf_norm(&u).max(f64::MIN_POSITIVE);
             let qn = inf_norm(&self.q).max(omega * un);
             u_old = u;
@@ -132,21 +156,29 @@ impl<'a> FixedPoint<'a> {
                 eprintln!("pd it {it}: du/u {:.3e} dq/q {:.3e}", du / un, dq / qn);
             }
             if !du.is_finite() {
-                return Err(Error::NotConverged("penalty-duality iterate became non-finite".into()));
+                return Err(Error::NotConverged(
+                    "penalty-duality iterate became non-finite".into(),
+                ));
             }
             if du <= tol * un && dq <= tol * qn {
                 // Physical multiplier p = q + omega g, nodal force lambda = W p.
                 let g = contact::apply_rows(&p.rows, &u_old);
-                let lambda = (0..g.len()).map(|i| w[i] * (self.q[i] + omega * g[i]).max(0.0)).collect();
+                let lambda = (0..g.len())
+                    .map(|i| w[i] * (self.q[i] + omega * g[i]).max(0.0))
+                    .collect();
                 return Ok((u_old, lambda, it));
             }
         }
-        Err(Error::NotConverged(format!("penalty-duality (4.4)-(4.5) did not converge in 100000 iterations (omega = {omega:.3e}, rho = {rho})")))
+        Err(Error::NotConverged(format!(
+            "penalty-duality (4.4)-(4.5) did not converge in 100000 iterations (omega = {omega:.3e}, rho = {rho})"
+        )))
     }
 
     fn clarabel(&mut self, b: &[f64]) -> Result<(Vec<f64>, Vec<f64>, usize)> {
         use clarabel::algebra::CscMatrix;
-        use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+        use clarabel::solver::{
+            DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+        };
         let p = self.p;
         let model = &p.model;
         let n = model.n_free;
@@ -155,7 +187,8 @@ impl<'a> FixedPoint<'a> {
         // interior point's absolute complementarity floor is small against u; the
         // objective is divided by alpha^2 mean diag(A). The QP's solution is unchanged.
         let vals = self.system.values_mut().to_vec();
-        let diag_mean = (0..n).map(|i| vals[self.pattern.slot(i, i)]).sum::<f64>() / n.max(1) as f64;
+        let diag_mean =
+            (0..n).map(|i| vals[self.pattern.slot(i, i)]).sum::<f64>() / n.max(1) as f64;
         let alpha = (inf_norm(b) / diag_mean).max(f64::MIN_POSITIVE);
         let scale = diag_mean;
         let (mut cp, mut ri, mut nz) = (vec![0usize], Vec::new(), Vec::new());
@@ -200,16 +233,26 @@ impl<'a> FixedPoint<'a> {
             .build()
             .expect("valid Clarabel settings");
         let zeros = vec![0.0; m];
-        let mut solver = DefaultSolver::new(&pm, &q, &am, &zeros, &cones, settings).map_err(|e| Error::NotConverged(format!("Clarabel setup failed: {e}")))?;
+        let mut solver = DefaultSolver::new(&pm, &q, &am, &zeros, &cones, settings)
+            .map_err(|e| Error::NotConverged(format!("Clarabel setup failed: {e}")))?;
         solver.solve();
         self.clarabel_s += t0.elapsed().as_secs_f64();
         let sol = &solver.solution;
         match sol.status {
             SolverStatus::Solved | SolverStatus::AlmostSolved => {}
-            s => return Err(Error::NotConverged(format!("Clarabel stopped with status {s:?} after {} iterations", sol.iterations))),
+            s => {
+                return Err(Error::NotConverged(format!(
+                    "Clarabel stopped with status {s:?} after {} iterations",
+                    sol.iterations
+                )));
+            }
         }
         let x: Vec<f64> = sol.x.iter().map(|x| x * alpha).collect();
-        Ok((model.expand(&x), sol.z.iter().map(|z| z * scale * alpha).collect(), sol.iterations as usize))
+        Ok((
+            model.expand(&x),
+            sol.z.iter().map(|z| z * scale * alpha).collect(),
+            sol.iterations as usize,
+        ))
     }
 }
 
@@ -227,7 +270,12 @@ impl StepSolver for FixedPoint<'_> {
             .collect();
         let mut eta: Vec<Stress> = match &self.eta {
             Some(e) => e.clone(),
-            None => model.elements.iter().zip(&prev.sigma).map(|(e, s)| model.materials[e.body].g(s)).collect(),
+            None => model
+                .elements
+                .iter()
+                .zip(&prev.sigma)
+                .map(|(e, s)| model.materials[e.body].g(s))
+                .collect(),
         };
         let mut u = guess.u.clone();
         let mut inner_total = 0;
@@ -237,7 +285,13 @@ impl StepSolver for FixedPoint<'_> {
             // b = F + sum |T| B^T (E eps(u^{n-1}) - sigma^{n-1} - k eta).
             let loads: Vec<Stress> = shift.iter().zip(&eta).map(|(s, e)| s - k * e).collect();
             let fb = model.internal_force(&loads);
-            let b: Vec<f64> = model.restrict(&f_ext.iter().zip(&fb).map(|(f, l)| f + l).collect::<Vec<_>>());
+            let b: Vec<f64> = model.restrict(
+                &f_ext
+                    .iter()
+                    .zip(&fb)
+                    .map(|(f, l)| f + l)
+                    .collect::<Vec<_>>(),
+            );
             let (un, lambda, inner) = self.contact_subproblem(&b, &u)?;
             inner_total += inner;
             u = un;
@@ -246,11 +300,31 @@ impl StepSolver for FixedPoint<'_> {
                 .elements
                 .iter()
                 .enumerate()
-                .map(|(i, e)| prev.sigma[i] + model.materials[e.body].elastic.apply(&(e.strain(&u) - e.strain(&prev.u))) + k * eta[i])
+                .map(|(i, e)| {
+                    prev.sigma[i]
+                        + model.materials[e.body]
+                            .elastic
+                            .apply(&(e.strain(&u) - e.strain(&prev.u)))
+                        + k * eta[i]
+                })
                 .collect();
-            let eta_new: Vec<Stress> = model.elements.iter().zip(&sigma).map(|(e, s)| model.materials[e.body].g(s)).collect();
-            let change = eta_new.iter().zip(&eta).map(|(a, b)| (a - b).amax()).fold(0.0f64, f64::max) * k;
-            let size = sigma.iter().map(|s| s.amax()).fold(0.0f64, f64::max).max(f64::MIN_POSITIVE);
+            let eta_new: Vec<Stress> = model
+                .elements
+                .iter()
+                .zip(&sigma)
+                .map(|(e, s)| model.materials[e.body].g(s))
+                .collect();
+            let change = eta_new
+                .iter()
+                .zip(&eta)
+                .map(|(a, b)| (a - b).amax())
+                .fold(0.0f64, f64::max)
+                * k;
+            let size = sigma
+                .iter()
+                .map(|s| s.amax())
+                .fold(0.0f64, f64::max)
+                .max(f64::MIN_POSITIVE);
             let rel = change / size;
             first_change.get_or_insert(rel);
             if std::env::var_os("CR_DEBUG").is_some() {
@@ -259,23 +333,48 @@ impl StepSolver for FixedPoint<'_> {
             eta = eta_new;
             if rel <= self.settings.tol || change == 0.0 {
                 self.eta = Some(eta.clone());
-                let state = State { time: t, u, sigma, lambda };
+                let state = State {
+                    time: t,
+                    u,
+                    sigma,
+                    lambda,
+                };
                 let residual = super::equilibrium_residual(p, &state, &f_ext);
-                return Ok((state, StepReport { iterations: inner_total, outer_iterations: outer, residual, active_set_changes: 0, reason: format!("fixed point converged: relative change of k*eta {rel:.2e}") }));
+                return Ok((
+                    state,
+                    StepReport {
+                        iterations: inner_total,
+                        outer_iterations: outer,
+                        residual,
+                        active_set_changes: 0,
+                        reason: format!(
+                            "fixed point converged: relative change of k*eta {rel:.2e}"
+                        ),
+                    },
+                ));
             }
             if !rel.is_finite() || (outer > 5 && rel > last_change && rel > first_change.unwrap()) {
-                let factor = if last_change.is_finite() { rel / last_change } else { f64::INFINITY };
+                let factor = if last_change.is_finite() {
+                    rel / last_change
+                } else {
+                    f64::INFINITY
+                };
                 return Err(Error::NotConverged(format!(
                     "the fixed point (4.2)-(4.3) diverges after {outer} iterations (change ratio {factor:.3} > 1): k L is too large; take a smaller time step or use the newton solver"
                 )));
             }
             last_change = rel;
         }
-        Err(Error::NotConverged(format!("the fixed point (4.2)-(4.3) did not converge in {} iterations (last relative change {last_change:.3e})", self.settings.max_iterations.max(200))))
+        Err(Error::NotConverged(format!(
+            "the fixed point (4.2)-(4.3) did not converge in {} iterations (last relative change {last_change:.3e})",
+            self.settings.max_iterations.max(200)
+        )))
     }
 
     fn factor_stats(&self) -> (f64, usize) {
-        (self.system.factor_s + self.clarabel_s, self.system.factorizations)
+        (
+            self.system.factor_s + self.clarabel_s,
+            self.system.factorizations,
+        )
     }
 }
-

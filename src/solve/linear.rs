@@ -25,9 +25,23 @@ pub struct SparseSystem {
 impl SparseSystem {
     /// A zero matrix with `pattern`.
     pub fn new(pattern: &Pattern) -> Self {
-        let sym = SymbolicSparseColMat::new_checked(pattern.n, pattern.n, pattern.col_ptr.clone(), None, pattern.row_idx.clone());
+        let sym = SymbolicSparseColMat::new_checked(
+            pattern.n,
+            pattern.n,
+            pattern.col_ptr.clone(),
+            None,
+            pattern.row_idx.clone(),
+        );
         let mat = SparseColMat::new(sym, vec![0.0; pattern.nnz()]);
-        SparseSystem { mat, symbolic_lu: None, symbolic_llt: None, lu: None, llt: None, factor_s: 0.0, factorizations: 0 }
+        SparseSystem {
+            mat,
+            symbolic_lu: None,
+            symbolic_llt: None,
+            lu: None,
+            llt: None,
+            factor_s: 0.0,
+            factorizations: 0,
+        }
     }
 
     /// Values in pattern order (CSC slots).
@@ -38,11 +52,18 @@ impl SparseSystem {
     /// LU factorization with partial pivoting (any invertible matrix).
     pub fn factor_lu(&mut self) -> Result<()> {
         if self.symbolic_lu.is_none() {
-            self.symbolic_lu = Some(SymbolicLu::try_new(self.mat.symbolic()).map_err(|e| Error::NotConverged(format!("symbolic LU failed: {e:?}")))?);
+            self.symbolic_lu = Some(
+                SymbolicLu::try_new(self.mat.symbolic())
+                    .map_err(|e| Error::NotConverged(format!("symbolic LU failed: {e:?}")))?,
+            );
         }
         let t = Instant::now();
         let lu = Lu::try_new_with_symbolic(self.symbolic_lu.clone().unwrap(), self.mat.as_ref())
-            .map_err(|e| Error::NotConverged(format!("the linearized system is singular ({e:?}): is a body free to move?")))?;
+            .map_err(|e| {
+                Error::NotConverged(format!(
+                    "the linearized system is singular ({e:?}): is a body free to move?"
+                ))
+            })?;
         self.factor_s += t.elapsed().as_secs_f64();
         self.factorizations += 1;
         self.lu = Some(lu);
@@ -54,12 +75,21 @@ impl SparseSystem {
     pub fn factor_llt(&mut self) -> Result<()> {
         if self.symbolic_llt.is_none() {
             self.symbolic_llt = Some(
-                SymbolicLlt::try_new(self.mat.symbolic(), Side::Lower).map_err(|e| Error::NotConverged(format!("symbolic Cholesky failed: {e:?}")))?,
+                SymbolicLlt::try_new(self.mat.symbolic(), Side::Lower)
+                    .map_err(|e| Error::NotConverged(format!("symbolic Cholesky failed: {e:?}")))?,
             );
         }
         let t = Instant::now();
-        let llt = Llt::try_new_with_symbolic(self.symbolic_llt.clone().unwrap(), self.mat.as_ref(), Side::Lower)
-            .map_err(|e| Error::NotConverged(format!("the matrix is not positive definite ({e:?}): is a body free to move?")))?;
+        let llt = Llt::try_new_with_symbolic(
+            self.symbolic_llt.clone().unwrap(),
+            self.mat.as_ref(),
+            Side::Lower,
+        )
+        .map_err(|e| {
+            Error::NotConverged(format!(
+                "the matrix is not positive definite ({e:?}): is a body free to move?"
+            ))
+        })?;
         self.factor_s += t.elapsed().as_secs_f64();
         self.factorizations += 1;
         self.llt = Some(llt);

@@ -60,7 +60,13 @@ pub struct Settings {
 
 impl Default for Settings {
     fn default() -> Self {
-        Settings { kind: SolverKind::Newton, tol: 1e-10, max_iterations: 60, omega: None, rho: 0.5 }
+        Settings {
+            kind: SolverKind::Newton,
+            tol: 1e-10,
+            max_iterations: 60,
+            omega: None,
+            rho: 0.5,
+        }
     }
 }
 
@@ -81,7 +87,12 @@ impl Problem {
     /// Assemble the constraint rows of `method` for `model` and `interface`.
     pub fn new(model: Model, interface: Interface, method: Method) -> Self {
         let rows = contact::constraint_rows(&model, &interface, method);
-        Problem { model, interface, method, rows }
+        Problem {
+            model,
+            interface,
+            method,
+            rows,
+        }
     }
 }
 
@@ -155,7 +166,12 @@ pub trait StepSolver {
 /// over the free dofs, with scale the larger of |F| and |f_int|.
 pub fn equilibrium_residual(p: &Problem, state: &State, f_ext: &[f64]) -> f64 {
     let mut r = p.model.internal_force(&state.sigma);
-    let scale = p.model.restrict(&r).iter().chain(p.model.restrict(f_ext).iter()).fold(0.0f64, |a, v| a.max(v.abs()));
+    let scale = p
+        .model
+        .restrict(&r)
+        .iter()
+        .chain(p.model.restrict(f_ext).iter())
+        .fold(0.0f64, |a, v| a.max(v.abs()));
     for (ri, f) in r.iter_mut().zip(f_ext) {
         *ri -= f;
     }
@@ -165,9 +181,18 @@ pub fn equilibrium_residual(p: &Problem, state: &State, f_ext: &[f64]) -> f64 {
 }
 
 /// Solve the history on `steps` uniform steps over [0, T]; zero initial state.
-pub fn solve(p: &Problem, settings: &Settings, steps: usize, keep_history: bool) -> Result<Solution> {
+pub fn solve(
+    p: &Problem,
+    settings: &Settings,
+    steps: usize,
+    keep_history: bool,
+) -> Result<Solution> {
     if steps == 0 {
-        return Err(Error::input(&p.model.scene.file, "steps", "the number of time steps must be at least 1"));
+        return Err(Error::input(
+            &p.model.scene.file,
+            "steps",
+            "the number of time steps must be at least 1",
+        ));
     }
     let k = p.model.scene.final_time / steps as f64;
     let times: Vec<f64> = (1..=steps).map(|n| n as f64 * k).collect();
@@ -175,18 +200,40 @@ pub fn solve(p: &Problem, settings: &Settings, steps: usize, keep_history: bool)
 }
 
 /// Solve the history on the time grid `times` (t_1 < ... < t_N, t_0 = 0).
-pub fn solve_times(p: &Problem, settings: &Settings, times: &[f64], keep_history: bool) -> Result<Solution> {
+pub fn solve_times(
+    p: &Problem,
+    settings: &Settings,
+    times: &[f64],
+    keep_history: bool,
+) -> Result<Solution> {
     if times.is_empty() || times[0] <= 0.0 || times.windows(2).any(|w| w[1] <= w[0]) {
-        return Err(Error::input(&p.model.scene.file, "time steps", "time steps k must be positive: t_1 > 0 and the times increasing"));
+        return Err(Error::input(
+            &p.model.scene.file,
+            "time steps",
+            "time steps k must be positive: t_1 > 0 and the times increasing",
+        ));
     }
     let steps = times.len();
     let start = Instant::now();
     let n_el = p.model.elements.len();
-    let initial = State { time: 0.0, u: vec![0.0; 2 * p.model.n_nodes], sigma: vec![Stress::zeros(); n_el], lambda: vec![0.0; p.rows.len()] };
+    let initial = State {
+        time: 0.0,
+        u: vec![0.0; 2 * p.model.n_nodes],
+        sigma: vec![Stress::zeros(); n_el],
+        lambda: vec![0.0; p.rows.len()],
+    };
     let mut solver: Box<dyn StepSolver> = match settings.kind {
         SolverKind::Newton => Box::new(newton::Newton::new(p, settings)?),
-        SolverKind::Paper => Box::new(fixed_point::FixedPoint::new(p, settings, fixed_point::Inner::PenaltyDuality)?),
-        SolverKind::Qp => Box::new(fixed_point::FixedPoint::new(p, settings, fixed_point::Inner::Clarabel)?),
+        SolverKind::Paper => Box::new(fixed_point::FixedPoint::new(
+            p,
+            settings,
+            fixed_point::Inner::PenaltyDuality,
+        )?),
+        SolverKind::Qp => Box::new(fixed_point::FixedPoint::new(
+            p,
+            settings,
+            fixed_point::Inner::Clarabel,
+        )?),
     };
     let mut states = vec![initial.clone()];
     let mut reports = Vec::new();
@@ -201,15 +248,29 @@ pub fn solve_times(p: &Problem, settings: &Settings, times: &[f64], keep_history
                 let r = k / (prev.time - b.time);
                 State {
                     time: t,
-                    u: prev.u.iter().zip(&b.u).map(|(a, c)| a + r * (a - c)).collect(),
+                    u: prev
+                        .u
+                        .iter()
+                        .zip(&b.u)
+                        .map(|(a, c)| a + r * (a - c))
+                        .collect(),
                     sigma: prev.sigma.clone(),
-                    lambda: prev.lambda.iter().zip(&b.lambda).map(|(a, c)| (a + r * (a - c)).max(0.0)).collect(),
+                    lambda: prev
+                        .lambda
+                        .iter()
+                        .zip(&b.lambda)
+                        .map(|(a, c)| (a + r * (a - c)).max(0.0))
+                        .collect(),
                 }
             }
             None => prev.clone(),
         };
         let (state, report) = solver.step(&prev, &guess, t, k).map_err(|e| match e {
-            Error::NotConverged(m) => Error::NotConverged(format!("{} solver, {} cone, step {n} of {steps} (t = {t}): {m}", settings.kind.name(), p.method.name())),
+            Error::NotConverged(m) => Error::NotConverged(format!(
+                "{} solver, {} cone, step {n} of {steps} (t = {t}): {m}",
+                settings.kind.name(),
+                p.method.name()
+            )),
             other => other,
         })?;
         reports.push(report);
@@ -222,5 +283,11 @@ pub fn solve_times(p: &Problem, settings: &Settings, times: &[f64], keep_history
         states.push(prev);
     }
     let (factor_s, factorizations) = solver.factor_stats();
-    Ok(Solution { states, reports, wall_s: start.elapsed().as_secs_f64(), factor_s, factorizations })
+    Ok(Solution {
+        states,
+        reports,
+        wall_s: start.elapsed().as_secs_f64(),
+        factor_s,
+        factorizations,
+    })
 }

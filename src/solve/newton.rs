@@ -45,10 +45,15 @@ impl<'a> Newton<'a> {
             .rows
             .iter()
             .enumerate()
-            .map(|(i, r)| r.entries.iter().map(|&(d, v)| {
-                let eq = p.model.equation[d];
-                (pattern.slot(n + i, eq), pattern.slot(eq, n + i), eq, v)
-            }).collect())
+            .map(|(i, r)| {
+                r.entries
+                    .iter()
+                    .map(|&(d, v)| {
+                        let eq = p.model.equation[d];
+                        (pattern.slot(n + i, eq), pattern.slot(eq, n + i), eq, v)
+                    })
+                    .collect()
+            })
             .collect();
         let diag_slots = (0..m).map(|i| pattern.slot(n + i, n + i)).collect();
         // Stiffness scale: the mean diagonal of the elastic stiffness.
@@ -60,7 +65,17 @@ impl<'a> Newton<'a> {
             *d = vals[pattern.slot(i, i)];
         }
         let c_scale = diag.iter().sum::<f64>() / n.max(1) as f64;
-        Ok(Newton { p, settings: *settings, n, slots, row_slots, diag_slots, system: SparseSystem::new(&pattern), factored: None, c_scale })
+        Ok(Newton {
+            p,
+            settings: *settings,
+            n,
+            slots,
+            row_slots,
+            diag_slots,
+            system: SparseSystem::new(&pattern),
+            factored: None,
+            c_scale,
+        })
     }
 }
 
@@ -84,7 +99,11 @@ impl StepSolver for Newton<'_> {
         let mut iterations = 0;
         loop {
             let (sigma, tangents) = model.update_stresses(&u, &prev.u, &prev.sigma, k, true);
-            let elastic = model.elements.iter().zip(&sigma).all(|(e, s)| !model.materials[e.body].is_plastic(s));
+            let elastic = model
+                .elements
+                .iter()
+                .zip(&sigma)
+                .all(|(e, s)| !model.materials[e.body].is_plastic(s));
             let f_int = model.internal_force(&sigma);
             let mut r = f_int.clone();
             for (ri, f) in r.iter_mut().zip(&f_ext) {
@@ -92,22 +111,46 @@ impl StepSolver for Newton<'_> {
             }
             contact::add_transpose(&p.rows, &lambda, &mut r);
             let r_free = model.restrict(&r);
-            let scale = inf_norm(&f_free).max(inf_norm(&model.restrict(&f_int))).max(f64::MIN_POSITIVE);
+            let scale = inf_norm(&f_free)
+                .max(inf_norm(&model.restrict(&f_int)))
+                .max(f64::MIN_POSITIVE);
             let g = contact::apply_rows(&p.rows, &u);
             let active: Vec<bool> = (0..m).map(|i| lambda[i] + c * g[i] >= 0.0).collect();
-            let ncp = (0..m).map(|i| lambda[i].min(-c * g[i]).abs()).fold(0.0f64, f64::max);
+            let ncp = (0..m)
+                .map(|i| lambda[i].min(-c * g[i]).abs())
+                .fold(0.0f64, f64::max);
             let res = inf_norm(&r_free) / scale;
             let compl = ncp / scale;
             let same_set = last_active.as_ref().is_some_and(|a| *a == active);
             if let Some(a) = &last_active {
                 changes += a.iter().zip(&active).filter(|(x, y)| x != y).count();
             }
-            if iterations > 0 && res <= self.settings.tol && compl <= self.settings.tol && same_set {
-                let state = State { time: t, u, sigma, lambda };
-                return Ok((state, StepReport { iterations, outer_iterations: iterations, residual: res, active_set_changes: changes, reason: format!("residual {res:.2e} and complementarity {compl:.2e} below {:.0e}, active set settled", self.settings.tol) }));
+            if iterations > 0 && res <= self.settings.tol && compl <= self.settings.tol && same_set
+            {
+                let state = State {
+                    time: t,
+                    u,
+                    sigma,
+                    lambda,
+                };
+                return Ok((
+                    state,
+                    StepReport {
+                        iterations,
+                        outer_iterations: iterations,
+                        residual: res,
+                        active_set_changes: changes,
+                        reason: format!(
+                            "residual {res:.2e} and complementarity {compl:.2e} below {:.0e}, active set settled",
+                            self.settings.tol
+                        ),
+                    },
+                ));
             }
             if !res.is_finite() {
-                return Err(Error::NotConverged(format!("Newton iterate became non-finite after {iterations} iterations")));
+                return Err(Error::NotConverged(format!(
+                    "Newton iterate became non-finite after {iterations} iterations"
+                )));
             }
             if iterations >= self.settings.max_iterations {
                 return Err(Error::NotConverged(format!(

@@ -20,5 +20,8 @@ pub fn amax(v: &[f64]) -> f64 {
 
 /// max |a - b| / max |a|.
 pub fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / amax(a)
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+        / amax(a)
 }

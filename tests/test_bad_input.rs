@@ -1,0 +1,303 @@
+//! Reference: SPEC section 8 (bad input).
+//! Goal: every bad input of the core solver's path (scene data, .geo, .msh, gmsh missing
+//! or failing) stops the binary with one clear message naming the file, the field and the
+//! fix, a non-zero exit, no panic, and no half-written output.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_contact-rates");
+
+fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The built-in rates scene with `edit` applied, written into `dir`.
+fn scene_file(dir: &Path, edit: impl Fn(String) -> String) -> PathBuf {
+    let text = std::fs::read_to_string(repo().join("scenes/rates.toml")).unwrap();
+    let geo = repo().join("meshes/two_blocks.geo");
+    let text = text.replace(
+        "\"../meshes/two_blocks.geo\"",
+        &format!("{:?}", geo.display().to_string()),
+    );
+    let f = dir.join("scene.toml");
+    std::fs::write(&f, edit(text)).unwrap();
+    f
+}
+
+fn run(args: &[&str], envs: &[(&str, &str)]) -> Output {
+    let mut c = Command::new(BIN);
+    c.args(args);
+    for (k, v) in envs {
+        c.env(k, v);
+    }
+    c.output().unwrap()
+}
+
+/// Assert a clean failure whose message contains every one of `needles`.
+fn fails_with(out: &Output, needles: &[&str]) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "exit code; stderr: {err}");
+    assert!(!err.contains("panicked"), "panic: {err}");
+    assert_eq!(
+        err.lines().filter(|l| l.starts_with("error")).count(),
+        1,
+        "one error line: {err}"
+    );
+    for n in needles {
+        assert!(err.contains(n), "message lacks '{n}': {err}");
+    }
+}
+
+fn solve_scene(scene: &Path, out: &Path, envs: &[(&str, &str)]) -> Output {
+    run(
+        &[
+            "solve",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        envs,
+    )
+}
+
+#[test]
+fn scene_data_errors_name_file_field_and_fix() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let cases: Vec<(Box<dyn Fn(String) -> String>, Vec<&str>)> = vec![
+        (
+            Box::new(|t| t.replace("final_time = 1.0", "final_time = [")),
+            vec!["scene.toml", "toml (line", "fix the scene file"],
+        ),
+        (
+            Box::new(|t| t.replace("steps = 10", "steps = 10\ncolour = 3")),
+            vec!["scene.toml", "unknown field `colour`"],
+        ),
+        (
+            Box::new(|t| t.replace("final_time = 1.0\n", "")),
+            vec!["scene.toml", "missing field `final_time`"],
+        ),
+        (
+            Box::new(|t| t.replacen("young = 100.0", "young = -1.0", 1)),
+            vec!["scene.toml", "bodies[0].young", "positive"],
+        ),
+        (
+            Box::new(|t| t.replacen("poisson = 0.3", "poisson = 0.5", 1)),
+            vec!["bodies[0].poisson", "(-1, 0.5)"],
+        ),
+        (
+            Box::new(|t| t.replacen("lambda = 100.0", "lambda = 0.0", 1)),
+            vec!["bodies[0].lambda", "positive"],
+        ),
+        (
+            Box::new(|t| t.replacen("yield_stress = 3.1622776601683795", "yield_stress = -2", 1)),
+            vec!["bodies[0].yield_stress", "positive"],
+        ),
+        (
+            Box::new(|t| t.replace("final_time = 1.0", "final_time = 0.0")),
+            vec!["final_time", "positive"],
+        ),
+        (
+            Box::new(|t| t.replace("steps = 10", "steps = 0")),
+            vec!["steps", "at least 1"],
+        ),
+        (
+            Box::new(|t| t.replace("-10*t*(0.1 + cos(pi*x))", "-10*t*(")),
+            vec!["traction[0].g[1]", "cannot parse expression"],
+        ),
+        (
+            Box::new(|t| t.replace("-10*t*(0.1 + cos(pi*x))", "-10*z")),
+            vec!["traction[0].g[1]", "unknown variable 'z'"],
+        ),
+        (
+            Box::new(|t| t.replace("curve = \"left_upper\"", "curve = \"bottom\"")),
+            vec!["roller[0].curve", "claimed twice"],
+        ),
+        (
+            Box::new(|t| t.replace("component = \"x\"", "component = \"z\"")),
+            vec!["roller[0].component", "\"x\" or \"y\""],
+        ),
+        (
+            Box::new(|t| t.replace("slave_body = \"upper\"", "slave_body = \"top\"")),
+            vec!["contact.slave_body", "upper"],
+        ),
+    ];
+    for (edit, needles) in cases {
+        let f = scene_file(dir.path(), edit);
+        fails_with(&solve_scene(&f, &out, &[]), &needles);
+        assert!(!out.exists(), "no output after a failure");
+    }
+}
+
+#[test]
+fn expression_that_is_not_finite_is_reported_with_its_place() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = scene_file(dir.path(), |t| {
+        t.replace("-10*t*(0.1 + cos(pi*x))", "1/(x-x)")
+    });
+    fails_with(
+        &solve_scene(&f, &dir.path().join("o"), &[]),
+        &["traction 'top'.g[1]", "1/(x-x)", "not finite"],
+    );
+}
+
+#[test]
+fn mesh_lacking_a_physical_group_lists_what_it_has() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = scene_file(dir.path(), |t| {
+        t.replace(
+            "master_curve = \"contact_lower\"",
+            "master_curve = \"interface\"",
+        )
+    });
+    fails_with(
+        &solve_scene(&f, &dir.path().join("o"), &[]),
+        &[
+            "interface",
+            "no physical curve named 'interface'",
+            "contact_lower",
+        ],
+    );
+    let f = scene_file(dir.path(), |t| {
+        t.replace("surface = \"lower\"", "surface = \"base\"")
+    });
+    fails_with(
+        &solve_scene(&f, &dir.path().join("o"), &[]),
+        &["no physical surface named 'base'", "lower, upper"],
+    );
+}
+
+#[test]
+fn unknown_scene_method_solver_and_steps() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = dir.path().join("o");
+    let o = o.to_str().unwrap();
+    fails_with(
+        &run(&["solve", "--scene", "nosuch", "--out", o], &[]),
+        &["no built-in scene named 'nosuch'", "patch", "rates"],
+    );
+    fails_with(
+        &run(
+            &[
+                "solve", "--scene", "rates", "--method", "penalty", "--out", o,
+            ],
+            &[],
+        ),
+        &["--method", "mortar", "nts"],
+    );
+    fails_with(
+        &run(
+            &["solve", "--scene", "rates", "--solver", "cg", "--out", o],
+            &[],
+        ),
+        &["--solver", "newton, paper or qp"],
+    );
+    fails_with(
+        &run(
+            &["solve", "--scene", "rates", "--steps", "0", "--out", o],
+            &[],
+        ),
+        &["--steps", "at least 1"],
+    );
+}
+
+#[test]
+fn geo_with_a_syntax_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let geo = dir.path().join("broken.geo");
+    std::fs::write(&geo, "Point(1) = {0, 0, 0, 0.1;\nLine(1) = {1, 2};\n").unwrap();
+    let f = scene_file(dir.path(), |t| {
+        t.replace(
+            &format!(
+                "{:?}",
+                repo().join("meshes/two_blocks.geo").display().to_string()
+            ),
+            "\"broken.geo\"",
+        )
+    });
+    let cache = dir.path().join("cache");
+    fails_with(
+        &solve_scene(
+            &f,
+            &dir.path().join("o"),
+            &[("CONTACT_RATES_CACHE", cache.to_str().unwrap())],
+        ),
+        &["broken.geo", "gmsh failed", "fix the geometry"],
+    );
+    let left: Vec<_> = std::fs::read_dir(&cache)
+        .map(|r| r.flatten().collect())
+        .unwrap_or_default();
+    assert!(
+        left.is_empty(),
+        "nothing half-written in the cache: {left:?}"
+    );
+}
+
+#[test]
+fn gmsh_missing_from_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = dir.path().join("cache");
+    let f = scene_file(dir.path(), |t| t);
+    fails_with(
+        &solve_scene(
+            &f,
+            &dir.path().join("o"),
+            &[
+                ("PATH", "/nonexistent"),
+                ("CONTACT_RATES_CACHE", cache.to_str().unwrap()),
+            ],
+        ),
+        &["gmsh", "not found on PATH", "apt-get install -y gmsh"],
+    );
+}
+
+/// A fake gmsh on PATH: answers --version, writes `body` to the -o file, exits with `code`.
+fn fake_gmsh(dir: &Path, body: &str, code: i32) -> String {
+    let bin = dir.join("bin");
+    std::fs::create_dir_all(&bin).unwrap();
+    let script = format!(
+        "#!/bin/sh\nif [ \"$1\" = --version ]; then echo 4.8.4; exit 0; fi\nout=\nwhile [ $# -gt 0 ]; do if [ \"$1\" = -o ]; then out=$2; fi; shift; done\nprintf '%s' '{body}' > \"$out\"\nexit {code}\n"
+    );
+    let p = bin.join("gmsh");
+    std::fs::write(&p, script).unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o755)).unwrap();
+    format!("{}:/usr/bin:/bin", bin.display())
+}
+
+#[test]
+fn gmsh_failing_after_writing_a_broken_mesh() {
+    for (code, needles) in [
+        (1, vec!["gmsh failed", "exit status: 1"]),
+        (0, vec!["unusable mesh", "$Nodes"]),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let path = fake_gmsh(
+            dir.path(),
+            "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 5 1 5\n",
+            code,
+        );
+        let cache = dir.path().join("cache");
+        let f = scene_file(dir.path(), |t| t);
+        fails_with(
+            &solve_scene(
+                &f,
+                &dir.path().join("o"),
+                &[
+                    ("PATH", &path),
+                    ("CONTACT_RATES_CACHE", cache.to_str().unwrap()),
+                ],
+            ),
+            &needles,
+        );
+        let left: Vec<_> = std::fs::read_dir(&cache)
+            .map(|r| r.flatten().collect())
+            .unwrap_or_default();
+        assert!(
+            left.is_empty(),
+            "the broken mesh is not left in the cache: {left:?}"
+        );
+    }
+}
