@@ -168,6 +168,10 @@ fn run() -> anyhow::Result<()> {
                 summary.plastic_fraction
             );
             println!(
+                "  mesh {:.3} s, setup {:.3} s, time loop {:.3} s, of which {} numeric factorizations {:.3} s",
+                case.mesh_s, case.setup_s, sol.wall_s, sol.factorizations, sol.factor_s
+            );
+            println!(
                 "wrote {} and {}",
                 out.join("solution.vtu").display(),
                 out.join("summary.csv").display()
