@@ -10,6 +10,8 @@ pub mod contact;
 pub mod error;
 pub mod fe;
 pub mod io;
+pub mod study;
+pub mod report;
 pub mod material;
 pub mod mesh;
 pub mod metrics;

@@ -22,6 +22,11 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Run a convergence study (`study list` lists them) and write reports/NAME/.
+    Study {
+        /// Study name (studies/NAME.toml), a path to a study file, or `list`.
+        name: String,
+    },
     /// Solve one scene on one mesh level and write solution.vtu and summary.csv.
     Solve {
         /// Built-in scene name or path to a scene .toml.
@@ -94,6 +99,39 @@ fn run() -> anyhow::Result<()> {
     contact_rates::init();
     let cli = Cli::parse();
     match cli.command {
+        Command::Study { name } => {
+            if name == "list" {
+                for (n, d) in contact_rates::study::file::list() {
+                    println!("{n:12} {d}");
+                }
+                return Ok(());
+            }
+            let result = contact_rates::study::run(&name)?;
+            let dir = contact_rates::report::reports_dir().join(&result.name);
+            contact_rates::report::write_study(&result, &dir)?;
+            for r in &result.rates {
+                println!(
+                    "{:7} {:16} rate {:6.3} +- {:.3} (levels {}){}",
+                    r.method,
+                    r.quantity,
+                    r.rate,
+                    r.stderr,
+                    r.levels_used,
+                    r.threshold.map(|t| format!(" threshold {t:.3}: {}", if r.pass == Some(true) { "pass" } else { "FAIL" })).unwrap_or_default()
+                );
+            }
+            for e in &result.errors {
+                if e.quantity == "theorem" {
+                    println!("{} level {} h {:.4} dofs {} error {:.4e} ({:.2} s)", e.method, e.level, e.h, e.dofs, e.error, e.wall_s);
+                }
+            }
+            println!("reference level {} ({} dofs, {:.1} s), estimated error {:.3e} (rate {:.2}); study {:.1} s", result.reference.0, result.reference.2, result.reference.3, result.reference_error.0, result.reference_error.1, result.wall_s);
+            println!("wrote {}", dir.display());
+            let failed: Vec<String> = result.rates.iter().filter(|r| r.pass == Some(false)).map(|r| format!("{} {} rate {:.3} < {:.3} (levels {})", r.method, r.quantity, r.rate, r.threshold.unwrap(), r.levels_used)).collect();
+            if !failed.is_empty() {
+                anyhow::bail!("rate below threshold: {}", failed.join("; "));
+            }
+        }
         Command::Solve {
             scene,
             method,

@@ -1,0 +1,218 @@
+//! The TOML layout of a study file (studies/NAME.toml).
+
+use crate::error::{Error, Result};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// The mesh family: gmsh size parameters of the two bodies at level 0 and the levels.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSpec {
+    /// Name of the .geo parameter sizing body 1 (the slave).
+    pub size_parameter_1: String,
+    /// Name of the .geo parameter sizing body 2 (the master).
+    pub size_parameter_2: String,
+    /// Coarsest mesh size of body 1 (level 0), length units.
+    pub coarsest: f64,
+    /// Ratio h1/h2 of the two bodies' sizes (not a ratio of small integers).
+    pub ratio: f64,
+    /// Refinement levels of the study (each splits every triangle in four).
+    pub levels: Vec<usize>,
+    /// Other gmsh parameters.
+    #[serde(default)]
+    pub parameters: BTreeMap<String, f64>,
+}
+
+/// The reference solution.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReferenceSpec {
+    /// Reference level minus the finest study level (at least 2).
+    pub levels_above: usize,
+    /// gmsh parameter overrides that make the meshes match on Gamma_C.
+    #[serde(default)]
+    pub parameters: BTreeMap<String, f64>,
+}
+
+/// Rate thresholds of Theorem 3.1 for the `theorem` quantity.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ThresholdSpec {
+    /// Required rate for mortar (K_h^pi).
+    pub mortar: f64,
+    /// Required rate for nts (K_h^I).
+    pub nts: f64,
+    /// Allowed shortfall below each rate (at most 0.05).
+    pub tolerance: f64,
+}
+
+/// A time-convergence study on a fixed mesh.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeSpec {
+    /// Mesh level.
+    pub level: usize,
+    /// Numbers of steps (each doubling halves k).
+    pub steps: Vec<usize>,
+    /// Steps of the reference in time.
+    pub reference_steps: usize,
+}
+
+/// A study file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StudyFile {
+    /// One line saying what the study measures.
+    pub description: String,
+    /// Built-in scene name or a scene file path relative to the study file.
+    pub scene: String,
+    /// Cones to compare: "mortar", "nts".
+    pub methods: Vec<String>,
+    /// Solver: "newton", "paper" or "qp".
+    #[serde(default = "default_solver")]
+    pub solver: String,
+    /// Uniform time steps over [0, T].
+    pub steps: usize,
+    /// Quantities to report (subset of theorem, h1_u, l2_u, l2_stress, l2_pressure,
+    /// max_penetration).
+    pub quantities: Vec<String>,
+    /// The mesh family.
+    pub mesh: MeshSpec,
+    /// The reference.
+    pub reference: ReferenceSpec,
+    /// Rate thresholds.
+    pub thresholds: ThresholdSpec,
+    /// Optional time study.
+    pub time: Option<TimeSpec>,
+}
+
+fn default_solver() -> String {
+    "newton".into()
+}
+
+/// The quantities a study can report.
+pub const QUANTITIES: [&str; 6] = ["theorem", "h1_u", "l2_u", "l2_stress", "l2_pressure", "max_penetration"];
+
+/// The folder of the built-in studies.
+pub fn builtin_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("studies")
+}
+
+/// Names and descriptions of the built-in studies.
+pub fn list() -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    if let Ok(rd) = std::fs::read_dir(builtin_dir()) {
+        for e in rd.flatten() {
+            let p = e.path();
+            if p.extension().is_some_and(|x| x == "toml") {
+                let name = p.file_stem().unwrap().to_string_lossy().to_string();
+                let desc = StudyFile::load(&p).map(|s| s.description).unwrap_or_else(|e| format!("(invalid: {e})"));
+                out.push((name, desc));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// Resolve a study name or path to its file.
+pub fn resolve(name_or_path: &str) -> Result<PathBuf> {
+    let p = Path::new(name_or_path);
+    if p.extension().is_some_and(|e| e == "toml") || p.exists() {
+        return Ok(p.to_path_buf());
+    }
+    let f = builtin_dir().join(format!("{name_or_path}.toml"));
+    if f.exists() {
+        Ok(f)
+    } else {
+        let names: Vec<String> = list().into_iter().map(|(n, _)| n).collect();
+        Err(Error::input(name_or_path, "study", format!("no built-in study named '{name_or_path}' and no such file; built-in studies: {}", names.join(", "))))
+    }
+}
+
+impl StudyFile {
+    /// Read and validate a study file.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let s: StudyFile = toml::from_str(&text).map_err(|e| {
+            let span = e.span().map(|s| format!(" (line {})", text[..s.start.min(text.len())].lines().count().max(1))).unwrap_or_default();
+            Error::input(path, format!("toml{span}"), format!("{}; fix the study file", e.message()))
+        })?;
+        let bad = |field: &str, msg: String| Err(Error::input(path, field, msg));
+        for m in &s.methods {
+            if crate::contact::Method::parse(m).is_none() {
+                return bad("methods", format!("unknown method '{m}'; use \"mortar\" or \"nts\""));
+            }
+        }
+        if s.methods.is_empty() {
+            return bad("methods", "list at least one method".into());
+        }
+        if crate::solve::SolverKind::parse(&s.solver).is_none() {
+            return bad("solver", format!("unknown solver '{}'; use newton, paper or qp", s.solver));
+        }
+        for q in &s.quantities {
+            if !QUANTITIES.contains(&q.as_str()) {
+                return bad("quantities", format!("unknown quantity '{q}'; use any of {}", QUANTITIES.join(", ")));
+            }
+        }
+        if !s.quantities.iter().any(|q| q == "theorem") {
+            return bad("quantities", "the thresholds apply to 'theorem': include it".into());
+        }
+        if s.steps == 0 {
+            return bad("steps", "steps must be at least 1 (the time step k must be positive)".into());
+        }
+        if s.mesh.levels.len() < 3 {
+            return bad("mesh.levels", format!("a rate needs at least 3 levels, got {}", s.mesh.levels.len()));
+        }
+        if s.mesh.levels.windows(2).any(|w| w[1] <= w[0]) {
+            return bad("mesh.levels", "levels must increase".into());
+        }
+        if !(s.mesh.coarsest > 0.0 && s.mesh.coarsest.is_finite()) {
+            return bad("mesh.coarsest", format!("the mesh size must be positive, got {}", s.mesh.coarsest));
+        }
+        if !(s.mesh.ratio > 0.0 && s.mesh.ratio.is_finite()) {
+            return bad("mesh.ratio", format!("the ratio h1/h2 must be positive, got {}", s.mesh.ratio));
+        }
+        for q in 1..=6u32 {
+            for p in 1..=12u32 {
+                if (s.mesh.ratio - p as f64 / q as f64).abs() < 1e-9 {
+                    return bad("mesh.ratio", format!("h1/h2 = {} = {p}/{q} is a ratio of small integers: the meshes would match at many nodes; use e.g. 1.4142", s.mesh.ratio));
+                }
+            }
+        }
+        if s.reference.levels_above < 2 {
+            return bad("reference.levels_above", "the reference must be at least 2 levels finer than the finest study level".into());
+        }
+        let t = &s.thresholds;
+        if !(t.tolerance >= 0.0 && t.tolerance <= 0.05) {
+            return bad("thresholds.tolerance", format!("the tolerance must lie in [0, 0.05], got {}", t.tolerance));
+        }
+        if let Some(ts) = &s.time {
+            if ts.steps.len() < 3 || ts.steps.iter().any(|&n| n == 0) || ts.reference_steps <= *ts.steps.iter().max().unwrap() {
+                return bad("time", "give at least 3 positive step counts and reference_steps larger than all of them".into());
+            }
+        }
+        Ok(s)
+    }
+
+    /// gmsh parameters of the study family.
+    pub fn family_parameters(&self) -> Vec<(String, f64)> {
+        let mut v: Vec<(String, f64)> = self.mesh.parameters.iter().map(|(k, v)| (k.clone(), *v)).collect();
+        v.push((self.mesh.size_parameter_1.clone(), self.mesh.coarsest));
+        v.push((self.mesh.size_parameter_2.clone(), self.mesh.coarsest / self.mesh.ratio));
+        v
+    }
+
+    /// gmsh parameters of the reference family.
+    pub fn reference_parameters(&self) -> Vec<(String, f64)> {
+        let mut v = self.family_parameters();
+        for (k, val) in &self.reference.parameters {
+            match v.iter_mut().find(|(kk, _)| kk == k) {
+                Some(e) => e.1 = *val,
+                None => v.push((k.clone(), *val)),
+            }
+        }
+        v
+    }
+}
