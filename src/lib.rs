@@ -10,13 +10,13 @@ pub mod contact;
 pub mod error;
 pub mod fe;
 pub mod io;
-pub mod study;
-pub mod report;
 pub mod material;
 pub mod mesh;
 pub mod metrics;
+pub mod report;
 pub mod scene;
 pub mod solve;
+pub mod study;
 
 pub use error::{Error, Result};
 

@@ -117,17 +117,61 @@ fn run() -> anyhow::Result<()> {
                     r.rate,
                     r.stderr,
                     r.levels_used,
-                    r.threshold.map(|t| format!(" threshold {t:.3}: {}", if r.pass == Some(true) { "pass" } else { "FAIL" })).unwrap_or_default()
+                    r.threshold
+                        .map(|t| format!(
+                            " threshold {}: {}",
+                            if t < 0.01 {
+                                format!("error <= {t:.0e}")
+                            } else {
+                                format!("rate >= {t:.3}")
+                            },
+                            if r.pass == Some(true) { "pass" } else { "FAIL" }
+                        ))
+                        .unwrap_or_default()
                 );
             }
             for e in &result.errors {
                 if e.quantity == "theorem" {
-                    println!("{} level {} h {:.4} dofs {} error {:.4e} ({:.2} s)", e.method, e.level, e.h, e.dofs, e.error, e.wall_s);
+                    println!(
+                        "{} level {} h {:.4} dofs {} error {:.4e} ({:.2} s)",
+                        e.method, e.level, e.h, e.dofs, e.error, e.wall_s
+                    );
                 }
             }
-            println!("reference level {} ({} dofs, {:.1} s), estimated error {:.3e} (rate {:.2}); study {:.1} s", result.reference.0, result.reference.2, result.reference.3, result.reference_error.0, result.reference_error.1, result.wall_s);
+            println!(
+                "reference level {} ({} dofs, {:.1} s), estimated error {:.3e} (rate {:.2}); study {:.1} s",
+                result.reference.0,
+                result.reference.2,
+                result.reference.3,
+                result.reference_error.0,
+                result.reference_error.1,
+                result.wall_s
+            );
             println!("wrote {}", dir.display());
-            let failed: Vec<String> = result.rates.iter().filter(|r| r.pass == Some(false)).map(|r| format!("{} {} rate {:.3} < {:.3} (levels {})", r.method, r.quantity, r.rate, r.threshold.unwrap(), r.levels_used)).collect();
+            let failed: Vec<String> = result
+                .rates
+                .iter()
+                .filter(|r| r.pass == Some(false))
+                .map(|r| {
+                    if result.file.thresholds.exact.contains(&r.method) {
+                        format!(
+                            "{} {} error above the exactness tolerance {:.1e}",
+                            r.method,
+                            r.quantity,
+                            r.threshold.unwrap()
+                        )
+                    } else {
+                        format!(
+                            "{} {} rate {:.3} < {:.3} (levels {})",
+                            r.method,
+                            r.quantity,
+                            r.rate,
+                            r.threshold.unwrap(),
+                            r.levels_used
+                        )
+                    }
+                })
+                .collect();
             if !failed.is_empty() {
                 anyhow::bail!("rate below threshold: {}", failed.join("; "));
             }

@@ -20,7 +20,12 @@ fn err<E: std::fmt::Display>(path: &Path) -> impl Fn(E) -> Error + '_ {
 }
 
 /// Colours of the series (colour-blind friendly).
-pub const COLORS: [RGBColor; 4] = [RGBColor(0, 114, 178), RGBColor(213, 94, 0), RGBColor(0, 0, 0), RGBColor(0, 158, 115)];
+pub const COLORS: [RGBColor; 4] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 0, 0),
+    RGBColor(0, 158, 115),
+];
 
 /// One series of a plot.
 pub struct Series {
@@ -56,12 +61,25 @@ fn range(points: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
 }
 
 /// A log-log plot with optional reference slope triangles (slopes given with labels).
-pub fn loglog(path: &Path, title: &str, xlabel: &str, ylabel: &str, series: &[Series], slopes: &[(f64, &str)]) -> Result<()> {
+pub fn loglog(
+    path: &Path,
+    title: &str,
+    xlabel: &str,
+    ylabel: &str,
+    series: &[Series],
+    slopes: &[(f64, &str)],
+) -> Result<()> {
     register();
     let root = BitMapBackend::new(path, (900, 650)).into_drawing_area();
     root.fill(&WHITE).map_err(err(path))?;
-    let (x0, x1) = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)), true);
-    let (y0, y1) = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)), true);
+    let (x0, x1) = range(
+        series.iter().flat_map(|s| s.points.iter().map(|p| p.0)),
+        true,
+    );
+    let (y0, y1) = range(
+        series.iter().flat_map(|s| s.points.iter().map(|p| p.1)),
+        true,
+    );
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 22))
         .margin(15)
@@ -80,7 +98,11 @@ pub fn loglog(path: &Path, title: &str, xlabel: &str, ylabel: &str, series: &[Se
         .map_err(err(path))?;
     for s in series {
         let c = COLORS[s.color % COLORS.len()];
-        let style = if s.thin { c.stroke_width(1) } else { c.stroke_width(2) };
+        let style = if s.thin {
+            c.stroke_width(1)
+        } else {
+            c.stroke_width(2)
+        };
         if s.line {
             chart
                 .draw_series(LineSeries::new(s.points.iter().copied(), style))
@@ -89,9 +111,12 @@ pub fn loglog(path: &Path, title: &str, xlabel: &str, ylabel: &str, series: &[Se
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
         }
         if s.markers {
-            let a = chart.draw_series(s.points.iter().map(|&p| Circle::new(p, 5, c.filled()))).map_err(err(path))?;
+            let a = chart
+                .draw_series(s.points.iter().map(|&p| Circle::new(p, 5, c.filled())))
+                .map_err(err(path))?;
             if !s.line {
-                a.label(s.label.clone()).legend(move |(x, y)| Circle::new((x + 10, y), 5, c.filled()));
+                a.label(s.label.clone())
+                    .legend(move |(x, y)| Circle::new((x + 10, y), 5, c.filled()));
             }
         }
     }
@@ -102,23 +127,51 @@ pub fn loglog(path: &Path, title: &str, xlabel: &str, ylabel: &str, series: &[Se
         let base = y0 * 1.15 * (y1 / y0).powf(0.09 * i as f64);
         let top = base * (lx1 / lx0).powf(*slope);
         let tri = vec![(lx0, base), (lx1, base), (lx1, top), (lx0, base)];
-        chart.draw_series(std::iter::once(PathElement::new(tri, BLACK.stroke_width(1)))).map_err(err(path))?;
         chart
-            .draw_series(std::iter::once(Text::new(format!("slope {label}"), (lx1 * 1.05, (base * top).sqrt()), ("sans-serif", 14))))
+            .draw_series(std::iter::once(PathElement::new(
+                tri,
+                BLACK.stroke_width(1),
+            )))
+            .map_err(err(path))?;
+        chart
+            .draw_series(std::iter::once(Text::new(
+                format!("slope {label}"),
+                (lx1 * 1.05, (base * top).sqrt()),
+                ("sans-serif", 14),
+            )))
             .map_err(err(path))?;
     }
-    chart.configure_series_labels().background_style(WHITE.mix(0.85)).border_style(BLACK).label_font(("sans-serif", 15)).position(SeriesLabelPosition::UpperLeft).draw().map_err(err(path))?;
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 15))
+        .position(SeriesLabelPosition::UpperLeft)
+        .draw()
+        .map_err(err(path))?;
     root.present().map_err(err(path))?;
     Ok(())
 }
 
 /// A linear x-y plot of lines.
-pub fn lines(path: &Path, title: &str, xlabel: &str, ylabel: &str, series: &[Series]) -> Result<()> {
+pub fn lines(
+    path: &Path,
+    title: &str,
+    xlabel: &str,
+    ylabel: &str,
+    series: &[Series],
+) -> Result<()> {
     register();
     let root = BitMapBackend::new(path, (900, 550)).into_drawing_area();
     root.fill(&WHITE).map_err(err(path))?;
-    let (x0, x1) = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)), false);
-    let (y0, y1) = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)), false);
+    let (x0, x1) = range(
+        series.iter().flat_map(|s| s.points.iter().map(|p| p.0)),
+        false,
+    );
+    let (y0, y1) = range(
+        series.iter().flat_map(|s| s.points.iter().map(|p| p.1)),
+        false,
+    );
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 20))
         .margin(15)
@@ -126,28 +179,57 @@ pub fn lines(path: &Path, title: &str, xlabel: &str, ylabel: &str, series: &[Ser
         .y_label_area_size(90)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(err(path))?;
-    chart.configure_mesh().x_desc(xlabel).y_desc(ylabel).label_style(("sans-serif", 15)).y_label_formatter(&|v| format!("{v:.2e}")).draw().map_err(err(path))?;
+    chart
+        .configure_mesh()
+        .x_desc(xlabel)
+        .y_desc(ylabel)
+        .label_style(("sans-serif", 15))
+        .y_label_formatter(&|v| format!("{v:.2e}"))
+        .draw()
+        .map_err(err(path))?;
     for s in series {
         let c = COLORS[s.color % COLORS.len()];
-        let style = if s.thin { c.stroke_width(1) } else { c.stroke_width(2) };
+        let style = if s.thin {
+            c.stroke_width(1)
+        } else {
+            c.stroke_width(2)
+        };
         chart
             .draw_series(LineSeries::new(s.points.iter().copied(), style))
             .map_err(err(path))?
             .label(s.label.clone())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
         if s.markers {
-            chart.draw_series(s.points.iter().map(|&p| Circle::new(p, 3, c.filled()))).map_err(err(path))?;
+            chart
+                .draw_series(s.points.iter().map(|&p| Circle::new(p, 3, c.filled())))
+                .map_err(err(path))?;
         }
     }
-    chart.configure_series_labels().background_style(WHITE.mix(0.85)).border_style(BLACK).label_font(("sans-serif", 15)).draw().map_err(err(path))?;
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 15))
+        .draw()
+        .map_err(err(path))?;
     root.present().map_err(err(path))?;
     Ok(())
 }
 
 /// Viridis-like colour map on [0, 1].
 pub fn colormap(t: f64) -> RGBColor {
-    const STOPS: [(f64, [f64; 3]); 5] = [(0.0, [68.0, 1.0, 84.0]), (0.25, [59.0, 82.0, 139.0]), (0.5, [33.0, 145.0, 140.0]), (0.75, [94.0, 201.0, 98.0]), (1.0, [253.0, 231.0, 37.0])];
-    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
+    const STOPS: [(f64, [f64; 3]); 5] = [
+        (0.0, [68.0, 1.0, 84.0]),
+        (0.25, [59.0, 82.0, 139.0]),
+        (0.5, [33.0, 145.0, 140.0]),
+        (0.75, [94.0, 201.0, 98.0]),
+        (1.0, [253.0, 231.0, 37.0]),
+    ];
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     let k = STOPS.iter().position(|s| s.0 >= t).unwrap_or(4).max(1);
     let (a, b) = (STOPS[k - 1], STOPS[k]);
     let w = (t - a.0) / (b.0 - a.0);
@@ -180,8 +262,14 @@ pub fn field_panels(path: &Path, title: &str, bar_label: &str, panels: &[Panel])
     let (main, bar) = root.split_horizontally(w - 140);
     let areas = main.split_evenly((1, panels.len()));
     for (p, area) in panels.iter().zip(areas.iter()) {
-        let (x0, x1) = range(p.triangles.iter().flat_map(|t| t.iter().map(|v| v[0])), false);
-        let (y0, y1) = range(p.triangles.iter().flat_map(|t| t.iter().map(|v| v[1])), false);
+        let (x0, x1) = range(
+            p.triangles.iter().flat_map(|t| t.iter().map(|v| v[0])),
+            false,
+        );
+        let (y0, y1) = range(
+            p.triangles.iter().flat_map(|t| t.iter().map(|v| v[1])),
+            false,
+        );
         // Equal aspect: pad the shorter range.
         let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
         let half = 0.5 * (x1 - x0).max(y1 - y0);
@@ -192,28 +280,67 @@ pub fn field_panels(path: &Path, title: &str, bar_label: &str, panels: &[Panel])
             .y_label_area_size(40)
             .build_cartesian_2d(cx - half..cx + half, cy - half..cy + half)
             .map_err(err(path))?;
-        chart.configure_mesh().disable_mesh().label_style(("sans-serif", 12)).draw().map_err(err(path))?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .label_style(("sans-serif", 12))
+            .draw()
+            .map_err(err(path))?;
         for (i, t) in p.triangles.iter().enumerate() {
             let c = colormap((p.values[i] - vmin) / (vmax - vmin).max(f64::MIN_POSITIVE));
             let pts: Vec<(f64, f64)> = t.iter().map(|v| (v[0], v[1])).collect();
-            chart.draw_series(std::iter::once(Polygon::new(pts.clone(), c.filled()))).map_err(err(path))?;
-            let edge = if p.body[i] == 1 { BLACK.mix(0.35) } else { RGBColor(90, 90, 90).mix(0.35) };
+            chart
+                .draw_series(std::iter::once(Polygon::new(pts.clone(), c.filled())))
+                .map_err(err(path))?;
+            let edge = if p.body[i] == 1 {
+                BLACK.mix(0.35)
+            } else {
+                RGBColor(90, 90, 90).mix(0.35)
+            };
             let mut closed = pts;
             closed.push(closed[0]);
-            chart.draw_series(std::iter::once(PathElement::new(closed, edge.stroke_width(1)))).map_err(err(path))?;
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    closed,
+                    edge.stroke_width(1),
+                )))
+                .map_err(err(path))?;
         }
         for s in &p.highlight {
-            chart.draw_series(std::iter::once(PathElement::new(vec![(s[0][0], s[0][1]), (s[1][0], s[1][1])], RED.stroke_width(3)))).map_err(err(path))?;
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(s[0][0], s[0][1]), (s[1][0], s[1][1])],
+                    RED.stroke_width(3),
+                )))
+                .map_err(err(path))?;
         }
     }
     // Colour bar.
-    let mut cb = ChartBuilder::on(&bar).margin_top(60).margin_bottom(60).margin_right(70).y_label_area_size(0).right_y_label_area_size(60).build_cartesian_2d(0.0..1.0, vmin..vmax).map_err(err(path))?;
-    cb.configure_mesh().disable_mesh().disable_x_axis().y_desc(bar_label).label_style(("sans-serif", 13)).y_label_formatter(&|v| format!("{v:.2}")).draw().map_err(err(path))?;
+    let mut cb = ChartBuilder::on(&bar)
+        .margin_top(60)
+        .margin_bottom(60)
+        .margin_right(70)
+        .y_label_area_size(0)
+        .right_y_label_area_size(60)
+        .build_cartesian_2d(0.0..1.0, vmin..vmax)
+        .map_err(err(path))?;
+    cb.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_desc(bar_label)
+        .label_style(("sans-serif", 13))
+        .y_label_formatter(&|v| format!("{v:.2}"))
+        .draw()
+        .map_err(err(path))?;
     let n = 100;
     for k in 0..n {
         let a = vmin + (vmax - vmin) * k as f64 / n as f64;
         let b = vmin + (vmax - vmin) * (k + 1) as f64 / n as f64;
-        cb.draw_series(std::iter::once(Rectangle::new([(0.0, a), (1.0, b)], colormap((k as f64 + 0.5) / n as f64).filled()))).map_err(err(path))?;
+        cb.draw_series(std::iter::once(Rectangle::new(
+            [(0.0, a), (1.0, b)],
+            colormap((k as f64 + 0.5) / n as f64).filled(),
+        )))
+        .map_err(err(path))?;
     }
     root.present().map_err(err(path))?;
     Ok(())

@@ -182,14 +182,50 @@ impl StepSolver for Newton<'_> {
                 rhs[n + i] = if active[i] { -c * g[i] } else { -c * lambda[i] };
             }
             self.system.solve(&mut rhs);
-            for (d, &eq) in model.equation.iter().enumerate() {
-                if eq != FIXED {
-                    u[d] += rhs[eq];
+            // Backtracking on the merit |r|^2 + |min(lambda, -c g)|^2: full steps near the
+            // solution, shorter ones when a large step flips many triangles between
+            // elastic and viscoplastic (stiff k E / lambda) or many contact rows.
+            let merit = |u: &[f64], lambda: &[f64]| -> f64 {
+                let (sig, _) = model.update_stresses(u, &prev.u, &prev.sigma, k, false);
+                let mut r = model.internal_force(&sig);
+                for (ri, f) in r.iter_mut().zip(&f_ext) {
+                    *ri -= f;
                 }
+                contact::add_transpose(&p.rows, lambda, &mut r);
+                let g = contact::apply_rows(&p.rows, u);
+                let rr: f64 = model.restrict(&r).iter().map(|v| v * v).sum();
+                let cc: f64 = (0..m).map(|i| lambda[i].min(-c * g[i]).powi(2)).sum();
+                rr + cc
+            };
+            let merit0 = r_free.iter().map(|v| v * v).sum::<f64>()
+                + (0..m)
+                    .map(|i| lambda[i].min(-c * g[i]).powi(2))
+                    .sum::<f64>();
+            let trial = |alpha: f64| -> (Vec<f64>, Vec<f64>) {
+                let mut ut = u.clone();
+                for (d, &eq) in model.equation.iter().enumerate() {
+                    if eq != FIXED {
+                        ut[d] += alpha * rhs[eq];
+                    }
+                }
+                let lt: Vec<f64> = (0..m).map(|i| lambda[i] + alpha * rhs[n + i]).collect();
+                (ut, lt)
+            };
+            let mut alpha = 1.0;
+            let (mut best, mut best_merit) = (trial(1.0), f64::INFINITY);
+            for _ in 0..12 {
+                let t = trial(alpha);
+                let mv = merit(&t.0, &t.1);
+                if mv < best_merit {
+                    best_merit = mv;
+                    best = t;
+                }
+                if mv <= (1.0 - 1e-4 * alpha) * merit0 {
+                    break;
+                }
+                alpha *= 0.5;
             }
-            for i in 0..m {
-                lambda[i] += rhs[n + i];
-            }
+            (u, lambda) = best;
             last_active = Some(active);
             iterations += 1;
         }

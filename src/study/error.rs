@@ -103,17 +103,31 @@ impl Comparison {
     }
 
     /// Squared norms of the difference (study - reference) at one time step.
-    pub fn difference(&self, study: &Model, s: &State, reference: &Model, r: &State) -> SquaredNorms {
-        let gs: Vec<Matrix2<f64>> = (0..study.elements.len()).map(|e| grad(study, e, &s.u)).collect();
-        let gr: Vec<Matrix2<f64>> = (0..reference.elements.len()).map(|e| grad(reference, e, &r.u)).collect();
+    pub fn difference(
+        &self,
+        study: &Model,
+        s: &State,
+        reference: &Model,
+        r: &State,
+    ) -> SquaredNorms {
+        let gs: Vec<Matrix2<f64>> = (0..study.elements.len())
+            .map(|e| grad(study, e, &s.u))
+            .collect();
+        let gr: Vec<Matrix2<f64>> = (0..reference.elements.len())
+            .map(|e| grad(reference, e, &r.u))
+            .collect();
         let mut n = SquaredNorms::default();
         for o in &self.overlaps {
             let (ea, eb) = (&study.elements[o.a], &reference.elements[o.b]);
             let mut l2 = 0.0;
             for m in 0..3 {
                 for c in 0..2 {
-                    let ua: f64 = (0..3).map(|k| o.bary_a[m][k] * s.u[2 * ea.nodes[k] + c]).sum();
-                    let ub: f64 = (0..3).map(|k| o.bary_b[m][k] * r.u[2 * eb.nodes[k] + c]).sum();
+                    let ua: f64 = (0..3)
+                        .map(|k| o.bary_a[m][k] * s.u[2 * ea.nodes[k] + c])
+                        .sum();
+                    let ub: f64 = (0..3)
+                        .map(|k| o.bary_b[m][k] * r.u[2 * eb.nodes[k] + c])
+                        .sum();
                     l2 += (ua - ub).powi(2);
                 }
             }
@@ -134,7 +148,8 @@ impl Comparison {
                 let p = el.nodes.map(|n| study.position(n));
                 let sum: f64 = (0..3)
                     .map(|m| {
-                        let x = [0, 1].map(|c| (0..3).map(|k| o.bary_a[m][k] * p[k][c]).sum::<f64>());
+                        let x =
+                            [0, 1].map(|c| (0..3).map(|k| o.bary_a[m][k] * p[k][c]).sum::<f64>());
                         f(x)
                     })
                     .sum();
@@ -151,15 +166,33 @@ pub fn pressure_profile(p: &Problem, s: &State) -> Vec<Vec<([f64; 2], f64)>> {
     for (row, l) in p.rows.iter().zip(&s.lambda) {
         let piece = &p.interface.pieces[row.piece];
         let x = piece.slave_s[row.i];
-        let pos = [piece.a[0] + x * piece.tangent[0], piece.a[1] + x * piece.tangent[1]];
-        out[row.piece].push((pos, if row.weight > 0.0 { l / row.weight } else { 0.0 }));
+        let pos = [
+            piece.a[0] + x * piece.tangent[0],
+            piece.a[1] + x * piece.tangent[1],
+        ];
+        out[row.piece].push((
+            pos,
+            if row.weight > 0.0 {
+                l / row.weight
+            } else {
+                0.0
+            },
+        ));
     }
     out
 }
 
 fn profile_on(interface: &Interface, piece: usize, profile: &[([f64; 2], f64)]) -> Vec<(f64, f64)> {
     let pc = &interface.pieces[piece];
-    let mut v: Vec<(f64, f64)> = profile.iter().map(|(x, p)| ((x[0] - pc.a[0]) * pc.tangent[0] + (x[1] - pc.a[1]) * pc.tangent[1], *p)).collect();
+    let mut v: Vec<(f64, f64)> = profile
+        .iter()
+        .map(|(x, p)| {
+            (
+                (x[0] - pc.a[0]) * pc.tangent[0] + (x[1] - pc.a[1]) * pc.tangent[1],
+                *p,
+            )
+        })
+        .collect();
     v.sort_by(|a, b| a.0.total_cmp(&b.0));
     v
 }
@@ -167,13 +200,22 @@ fn profile_on(interface: &Interface, piece: usize, profile: &[([f64; 2], f64)]) 
 fn eval_pl(f: &[(f64, f64)], x: f64) -> f64 {
     let k = f.partition_point(|p| p.0 <= x).clamp(1, f.len() - 1);
     let (a, b) = (f[k - 1], f[k]);
-    let t = if b.0 > a.0 { ((x - a.0) / (b.0 - a.0)).clamp(0.0, 1.0) } else { 0.0 };
+    let t = if b.0 > a.0 {
+        ((x - a.0) / (b.0 - a.0)).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     a.1 + t * (b.1 - a.1)
 }
 
 /// (||p - p_ref||^2, ||p_ref||^2) in L2(Gamma_C), exact for the piecewise-linear profiles.
 /// Pieces of the reference are matched to the study's by their geometry.
-pub fn pressure_difference(study: &Problem, s: &State, reference: &Problem, r: &State) -> (f64, f64) {
+pub fn pressure_difference(
+    study: &Problem,
+    s: &State,
+    reference: &Problem,
+    r: &State,
+) -> (f64, f64) {
     let ps = pressure_profile(study, s);
     let pr = pressure_profile(reference, r);
     let (mut diff, mut norm) = (0.0, 0.0);
@@ -183,9 +225,15 @@ pub fn pressure_difference(study: &Problem, s: &State, reference: &Problem, r: &
         let mut fr: Vec<(f64, f64)> = Vec::new();
         for prof in &pr {
             for (x, p) in prof {
-                let s_ = (x[0] - piece.a[0]) * piece.tangent[0] + (x[1] - piece.a[1]) * piece.tangent[1];
-                let off = ((x[0] - piece.a[0]) * piece.normal[0] + (x[1] - piece.a[1]) * piece.normal[1]).abs();
-                if off <= 1e-9 * piece.length && s_ >= -1e-9 * piece.length && s_ <= piece.length * (1.0 + 1e-9) {
+                let s_ =
+                    (x[0] - piece.a[0]) * piece.tangent[0] + (x[1] - piece.a[1]) * piece.tangent[1];
+                let off = ((x[0] - piece.a[0]) * piece.normal[0]
+                    + (x[1] - piece.a[1]) * piece.normal[1])
+                    .abs();
+                if off <= 1e-9 * piece.length
+                    && s_ >= -1e-9 * piece.length
+                    && s_ <= piece.length * (1.0 + 1e-9)
+                {
                     fr.push((s_.clamp(0.0, piece.length), *p));
                 }
             }

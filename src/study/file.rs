@@ -45,6 +45,17 @@ pub struct ThresholdSpec {
     pub nts: f64,
     /// Allowed shortfall below each rate (at most 0.05).
     pub tolerance: f64,
+    /// Methods that must reproduce the reference exactly (e.g. mortar on the patch scene):
+    /// their `theorem` error must stay below `exact_tolerance` instead of meeting a rate.
+    #[serde(default)]
+    pub exact: Vec<String>,
+    /// Largest relative `theorem` error allowed for the `exact` methods.
+    #[serde(default = "default_exact_tolerance")]
+    pub exact_tolerance: f64,
+}
+
+fn default_exact_tolerance() -> f64 {
+    1e-9
 }
 
 /// A time-convergence study on a fixed mesh.
@@ -92,7 +103,14 @@ fn default_solver() -> String {
 }
 
 /// The quantities a study can report.
-pub const QUANTITIES: [&str; 6] = ["theorem", "h1_u", "l2_u", "l2_stress", "l2_pressure", "max_penetration"];
+pub const QUANTITIES: [&str; 6] = [
+    "theorem",
+    "h1_u",
+    "l2_u",
+    "l2_stress",
+    "l2_pressure",
+    "max_penetration",
+];
 
 /// The folder of the built-in studies.
 pub fn builtin_dir() -> PathBuf {
@@ -107,7 +125,9 @@ pub fn list() -> Vec<(String, String)> {
             let p = e.path();
             if p.extension().is_some_and(|x| x == "toml") {
                 let name = p.file_stem().unwrap().to_string_lossy().to_string();
-                let desc = StudyFile::load(&p).map(|s| s.description).unwrap_or_else(|e| format!("(invalid: {e})"));
+                let desc = StudyFile::load(&p)
+                    .map(|s| s.description)
+                    .unwrap_or_else(|e| format!("(invalid: {e})"));
                 out.push((name, desc));
             }
         }
@@ -127,7 +147,14 @@ pub fn resolve(name_or_path: &str) -> Result<PathBuf> {
         Ok(f)
     } else {
         let names: Vec<String> = list().into_iter().map(|(n, _)| n).collect();
-        Err(Error::input(name_or_path, "study", format!("no built-in study named '{name_or_path}' and no such file; built-in studies: {}", names.join(", "))))
+        Err(Error::input(
+            name_or_path,
+            "study",
+            format!(
+                "no built-in study named '{name_or_path}' and no such file; built-in studies: {}",
+                names.join(", ")
+            ),
+        ))
     }
 }
 
@@ -136,60 +163,117 @@ impl StudyFile {
     pub fn load(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
         let s: StudyFile = toml::from_str(&text).map_err(|e| {
-            let span = e.span().map(|s| format!(" (line {})", text[..s.start.min(text.len())].lines().count().max(1))).unwrap_or_default();
-            Error::input(path, format!("toml{span}"), format!("{}; fix the study file", e.message()))
+            let span = e
+                .span()
+                .map(|s| {
+                    format!(
+                        " (line {})",
+                        text[..s.start.min(text.len())].lines().count().max(1)
+                    )
+                })
+                .unwrap_or_default();
+            Error::input(
+                path,
+                format!("toml{span}"),
+                format!("{}; fix the study file", e.message()),
+            )
         })?;
         let bad = |field: &str, msg: String| Err(Error::input(path, field, msg));
         for m in &s.methods {
             if crate::contact::Method::parse(m).is_none() {
-                return bad("methods", format!("unknown method '{m}'; use \"mortar\" or \"nts\""));
+                return bad(
+                    "methods",
+                    format!("unknown method '{m}'; use \"mortar\" or \"nts\""),
+                );
             }
         }
         if s.methods.is_empty() {
             return bad("methods", "list at least one method".into());
         }
         if crate::solve::SolverKind::parse(&s.solver).is_none() {
-            return bad("solver", format!("unknown solver '{}'; use newton, paper or qp", s.solver));
+            return bad(
+                "solver",
+                format!("unknown solver '{}'; use newton, paper or qp", s.solver),
+            );
         }
         for q in &s.quantities {
             if !QUANTITIES.contains(&q.as_str()) {
-                return bad("quantities", format!("unknown quantity '{q}'; use any of {}", QUANTITIES.join(", ")));
+                return bad(
+                    "quantities",
+                    format!(
+                        "unknown quantity '{q}'; use any of {}",
+                        QUANTITIES.join(", ")
+                    ),
+                );
             }
         }
         if !s.quantities.iter().any(|q| q == "theorem") {
-            return bad("quantities", "the thresholds apply to 'theorem': include it".into());
+            return bad(
+                "quantities",
+                "the thresholds apply to 'theorem': include it".into(),
+            );
         }
         if s.steps == 0 {
-            return bad("steps", "steps must be at least 1 (the time step k must be positive)".into());
+            return bad(
+                "steps",
+                "steps must be at least 1 (the time step k must be positive)".into(),
+            );
         }
         if s.mesh.levels.len() < 3 {
-            return bad("mesh.levels", format!("a rate needs at least 3 levels, got {}", s.mesh.levels.len()));
+            return bad(
+                "mesh.levels",
+                format!(
+                    "a rate needs at least 3 levels, got {}",
+                    s.mesh.levels.len()
+                ),
+            );
         }
         if s.mesh.levels.windows(2).any(|w| w[1] <= w[0]) {
             return bad("mesh.levels", "levels must increase".into());
         }
         if !(s.mesh.coarsest > 0.0 && s.mesh.coarsest.is_finite()) {
-            return bad("mesh.coarsest", format!("the mesh size must be positive, got {}", s.mesh.coarsest));
+            return bad(
+                "mesh.coarsest",
+                format!("the mesh size must be positive, got {}", s.mesh.coarsest),
+            );
         }
         if !(s.mesh.ratio > 0.0 && s.mesh.ratio.is_finite()) {
-            return bad("mesh.ratio", format!("the ratio h1/h2 must be positive, got {}", s.mesh.ratio));
+            return bad(
+                "mesh.ratio",
+                format!("the ratio h1/h2 must be positive, got {}", s.mesh.ratio),
+            );
         }
         for q in 1..=6u32 {
             for p in 1..=12u32 {
                 if (s.mesh.ratio - p as f64 / q as f64).abs() < 1e-9 {
-                    return bad("mesh.ratio", format!("h1/h2 = {} = {p}/{q} is a ratio of small integers: the meshes would match at many nodes; use e.g. 1.4142", s.mesh.ratio));
+                    return bad(
+                        "mesh.ratio",
+                        format!(
+                            "h1/h2 = {} = {p}/{q} is a ratio of small integers: the meshes would match at many nodes; use e.g. 1.4142",
+                            s.mesh.ratio
+                        ),
+                    );
                 }
             }
         }
         if s.reference.levels_above < 2 {
-            return bad("reference.levels_above", "the reference must be at least 2 levels finer than the finest study level".into());
+            return bad(
+                "reference.levels_above",
+                "the reference must be at least 2 levels finer than the finest study level".into(),
+            );
         }
         let t = &s.thresholds;
         if !(t.tolerance >= 0.0 && t.tolerance <= 0.05) {
-            return bad("thresholds.tolerance", format!("the tolerance must lie in [0, 0.05], got {}", t.tolerance));
+            return bad(
+                "thresholds.tolerance",
+                format!("the tolerance must lie in [0, 0.05], got {}", t.tolerance),
+            );
         }
         if let Some(ts) = &s.time {
-            if ts.steps.len() < 3 || ts.steps.iter().any(|&n| n == 0) || ts.reference_steps <= *ts.steps.iter().max().unwrap() {
+            if ts.steps.len() < 3
+                || ts.steps.iter().any(|&n| n == 0)
+                || ts.reference_steps <= *ts.steps.iter().max().unwrap()
+            {
                 return bad("time", "give at least 3 positive step counts and reference_steps larger than all of them".into());
             }
         }
@@ -198,9 +282,17 @@ impl StudyFile {
 
     /// gmsh parameters of the study family.
     pub fn family_parameters(&self) -> Vec<(String, f64)> {
-        let mut v: Vec<(String, f64)> = self.mesh.parameters.iter().map(|(k, v)| (k.clone(), *v)).collect();
+        let mut v: Vec<(String, f64)> = self
+            .mesh
+            .parameters
+            .iter()
+            .map(|(k, v)| (k.clone(), *v))
+            .collect();
         v.push((self.mesh.size_parameter_1.clone(), self.mesh.coarsest));
-        v.push((self.mesh.size_parameter_2.clone(), self.mesh.coarsest / self.mesh.ratio));
+        v.push((
+            self.mesh.size_parameter_2.clone(),
+            self.mesh.coarsest / self.mesh.ratio,
+        ));
         v
     }
 

@@ -50,7 +50,10 @@ pub fn clip(subject: &Tri, clipper: &Tri) -> Vec<[f64; 2]> {
             if ci != pi {
                 let (dp, dc) = (cross(p, q, prev), cross(p, q, cur));
                 let t = dp / (dp - dc);
-                poly.push([prev[0] + t * (cur[0] - prev[0]), prev[1] + t * (cur[1] - prev[1])]);
+                poly.push([
+                    prev[0] + t * (cur[0] - prev[0]),
+                    prev[1] + t * (cur[1] - prev[1]),
+                ]);
             }
             if ci {
                 poly.push(cur);
@@ -101,8 +104,16 @@ impl Grid {
         }
         let area = ((hi[0] - lo[0]) * (hi[1] - lo[1])).max(f64::MIN_POSITIVE);
         let cell = (area / tris.len().max(1) as f64).sqrt() * 1.5;
-        let n = [((hi[0] - lo[0]) / cell).ceil().max(1.0) as usize, ((hi[1] - lo[1]) / cell).ceil().max(1.0) as usize];
-        let mut g = Grid { x0: lo, cell, n, buckets: vec![Vec::new(); n[0] * n[1]] };
+        let n = [
+            ((hi[0] - lo[0]) / cell).ceil().max(1.0) as usize,
+            ((hi[1] - lo[1]) / cell).ceil().max(1.0) as usize,
+        ];
+        let mut g = Grid {
+            x0: lo,
+            cell,
+            n,
+            buckets: vec![Vec::new(); n[0] * n[1]],
+        };
         for (i, t) in tris.iter().enumerate() {
             let (a, b) = bbox(t);
             let (i0, j0) = g.index(a);
@@ -116,8 +127,12 @@ impl Grid {
         g
     }
     fn index(&self, p: [f64; 2]) -> (usize, usize) {
-        let i = ((p[0] - self.x0[0]) / self.cell).floor().clamp(0.0, (self.n[0] - 1) as f64) as usize;
-        let j = ((p[1] - self.x0[1]) / self.cell).floor().clamp(0.0, (self.n[1] - 1) as f64) as usize;
+        let i = ((p[0] - self.x0[0]) / self.cell)
+            .floor()
+            .clamp(0.0, (self.n[0] - 1) as f64) as usize;
+        let j = ((p[1] - self.x0[1]) / self.cell)
+            .floor()
+            .clamp(0.0, (self.n[1] - 1) as f64) as usize;
         (i, j)
     }
 }

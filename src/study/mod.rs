@@ -169,8 +169,18 @@ pub struct Progress(indicatif::ProgressBar);
 impl Progress {
     fn new(n: u64, name: &str) -> Self {
         use std::io::IsTerminal;
-        let pb = if std::io::stderr().is_terminal() { indicatif::ProgressBar::new(n) } else { indicatif::ProgressBar::hidden() };
-        pb.set_style(indicatif::ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} {msg} ({elapsed})").unwrap().progress_chars("=> "));
+        let pb = if std::io::stderr().is_terminal() {
+            indicatif::ProgressBar::new(n)
+        } else {
+            indicatif::ProgressBar::hidden()
+        };
+        pb.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{prefix} [{bar:30}] {pos}/{len} {msg} ({elapsed})",
+            )
+            .unwrap()
+            .progress_chars("=> "),
+        );
         pb.set_prefix(name.to_string());
         Progress(pb)
     }
@@ -180,9 +190,18 @@ impl Progress {
     }
 }
 
-fn relative_quantities(diff: &[SquaredNorms], refn: &[SquaredNorms], pdiff: &[(f64, f64)], pen: f64, uref: f64) -> BTreeMap<&'static str, f64> {
-    let maxn = |f: &dyn Fn(&SquaredNorms) -> f64, v: &[SquaredNorms]| v.iter().map(f).fold(0.0f64, f64::max);
-    let rel = |f: &dyn Fn(&SquaredNorms) -> f64| maxn(f, diff) / maxn(f, refn).max(f64::MIN_POSITIVE);
+fn relative_quantities(
+    diff: &[SquaredNorms],
+    refn: &[SquaredNorms],
+    pdiff: &[(f64, f64)],
+    pen: f64,
+    uref: f64,
+) -> BTreeMap<&'static str, f64> {
+    let maxn = |f: &dyn Fn(&SquaredNorms) -> f64, v: &[SquaredNorms]| {
+        v.iter().map(f).fold(0.0f64, f64::max)
+    };
+    let rel =
+        |f: &dyn Fn(&SquaredNorms) -> f64| maxn(f, diff) / maxn(f, refn).max(f64::MIN_POSITIVE);
     let mut q = BTreeMap::new();
     q.insert("theorem", rel(&|n| n.theorem()));
     q.insert("h1_u", rel(&|n| n.h1()));
@@ -197,15 +216,37 @@ fn relative_quantities(diff: &[SquaredNorms], refn: &[SquaredNorms], pdiff: &[(f
 
 fn solve_case(case: &Case, kind: SolverKind, steps: usize) -> Result<(Solution, f64)> {
     let t = Instant::now();
-    let sol = solve::solve(&case.problem, &Settings { kind, ..Settings::default() }, steps, true)?;
+    let sol = solve::solve(
+        &case.problem,
+        &Settings {
+            kind,
+            ..Settings::default()
+        },
+        steps,
+        true,
+    )?;
     Ok((sol, t.elapsed().as_secs_f64()))
 }
 
 /// Theorem-quantity distance of two solutions with the same time grid, relative to `b`.
 fn theorem_distance(ca: &Case, sa: &Solution, cb: &Case, sb: &Solution) -> f64 {
     let cmp = Comparison::new(&ca.problem.model, &cb.problem.model);
-    let d = sa.states.iter().zip(&sb.states).skip(1).map(|(x, y)| cmp.difference(&ca.problem.model, x, &cb.problem.model, y).theorem()).fold(0.0f64, f64::max);
-    let n = sb.states.iter().skip(1).map(|y| error::norms(&cb.problem.model, y).theorem()).fold(0.0f64, f64::max);
+    let d = sa
+        .states
+        .iter()
+        .zip(&sb.states)
+        .skip(1)
+        .map(|(x, y)| {
+            cmp.difference(&ca.problem.model, x, &cb.problem.model, y)
+                .theorem()
+        })
+        .fold(0.0f64, f64::max);
+    let n = sb
+        .states
+        .iter()
+        .skip(1)
+        .map(|y| error::norms(&cb.problem.model, y).theorem())
+        .fold(0.0f64, f64::max);
     d / n
 }
 
@@ -214,7 +255,10 @@ fn deformed(case: &Case, sol: &Solution, label: &str, magnification: f64) -> Def
     let s = sol.last();
     let pos = |n: usize| {
         let p = m.position(n);
-        [p[0] + magnification * s.u[2 * n], p[1] + magnification * s.u[2 * n + 1]]
+        [
+            p[0] + magnification * s.u[2 * n],
+            p[1] + magnification * s.u[2 * n + 1],
+        ]
     };
     DeformedMesh {
         label: label.to_string(),
@@ -225,18 +269,34 @@ fn deformed(case: &Case, sol: &Solution, label: &str, magnification: f64) -> Def
     }
 }
 
-fn profiles(case: &Case, sol: &Solution, label: &str, pressure: &mut Vec<ProfilePoint>, gap: &mut Vec<ProfilePoint>) {
+fn profiles(
+    case: &Case,
+    sol: &Solution,
+    label: &str,
+    pressure: &mut Vec<ProfilePoint>,
+    gap: &mut Vec<ProfilePoint>,
+) {
     let p = &case.problem;
     let s = sol.last();
     for prof in error::pressure_profile(p, s) {
         for (x, v) in prof {
-            pressure.push(ProfilePoint { label: label.into(), x: x[0], y: x[1], value: v });
+            pressure.push(ProfilePoint {
+                label: label.into(),
+                x: x[0],
+                y: x[1],
+                value: v,
+            });
         }
     }
     for (pi, sv, j) in crate::contact::normal_jumps(&p.interface, &s.u) {
         let pc = &p.interface.pieces[pi];
         // Gap = -[u.nu]: positive where the bodies separate.
-        gap.push(ProfilePoint { label: label.into(), x: pc.a[0] + sv * pc.tangent[0], y: pc.a[1] + sv * pc.tangent[1], value: -j });
+        gap.push(ProfilePoint {
+            label: label.into(),
+            x: pc.a[0] + sv * pc.tangent[0],
+            y: pc.a[1] + sv * pc.tangent[1],
+            value: -j,
+        });
     }
 }
 
@@ -248,16 +308,26 @@ pub fn run(name: &str) -> Result<StudyResult> {
     let study_name = path.file_stem().unwrap().to_string_lossy().to_string();
     let scene_path = {
         let p = path.parent().unwrap_or(Path::new(".")).join(&sf.scene);
-        if p.exists() { p.display().to_string() } else { sf.scene.clone() }
+        if p.exists() {
+            p.display().to_string()
+        } else {
+            sf.scene.clone()
+        }
     };
     let scene = Scene::load(&scene_path)?;
     let kind = SolverKind::parse(&sf.solver).unwrap();
-    let methods: Vec<Method> = sf.methods.iter().map(|m| Method::parse(m).unwrap()).collect();
+    let methods: Vec<Method> = sf
+        .methods
+        .iter()
+        .map(|m| Method::parse(m).unwrap())
+        .collect();
     let finest = *sf.mesh.levels.last().unwrap();
     let rlevel = finest + sf.reference.levels_above;
     let fam = sf.family_parameters();
     let refp = sf.reference_parameters();
-    let n_jobs = 3 + methods.len() * sf.mesh.levels.len() + sf.time.as_ref().map_or(0, |t| t.steps.len() + 1);
+    let n_jobs = 3
+        + methods.len() * sf.mesh.levels.len()
+        + sf.time.as_ref().map_or(0, |t| t.steps.len() + 1);
     let progress = Progress::new(n_jobs as u64, &study_name);
 
     // 1. The reference on matching meshes, and two coarser levels for its own error.
@@ -265,7 +335,11 @@ pub fn run(name: &str) -> Result<StudyResult> {
     for l in [rlevel - 2, rlevel - 1, rlevel] {
         let case = Case::build(&scene, l, Method::Mortar, &refp)?;
         if case.problem.interface.min_relative_separation() > 1e-9 {
-            return Err(Error::input(&path, "reference.parameters", "the reference meshes do not match on Gamma_C; set the .geo parameter that makes them match (e.g. matching = 1)"));
+            return Err(Error::input(
+                &path,
+                "reference.parameters",
+                "the reference meshes do not match on Gamma_C; set the .geo parameter that makes them match (e.g. matching = 1)",
+            ));
         }
         let (sol, wall) = solve_case(&case, kind, sf.steps)?;
         progress.tick(format!("reference level {l}"));
@@ -278,11 +352,23 @@ pub fn run(name: &str) -> Result<StudyResult> {
     // orthogonal: d(L, R)^2 = e_L^2 - e_R^2 with e_L = C h_L^p (measured on this scene:
     // d(R-2,R)/d(R-1,R) = 2.24 = sqrt(5), i.e. p = 1). Hence
     // (d(R-2,R)/d(R-1,R))^2 = 4^p + 1 and e_R = d(R-1,R) / sqrt(4^p - 1).
-    let p_ref = ((d2 / d1).powi(2) - 1.0).max(1.0 + 1e-12).log(4.0).clamp(0.25, 3.0);
+    let p_ref = ((d2 / d1).powi(2) - 1.0)
+        .max(1.0 + 1e-12)
+        .log(4.0)
+        .clamp(0.25, 3.0);
     let ref_err = d1 / (4f64.powf(p_ref) - 1.0).sqrt();
     drop(refs);
-    let ref_norms: Vec<SquaredNorms> = rsol.states.iter().skip(1).map(|s| error::norms(&rcase.problem.model, s)).collect();
-    let uref = rsol.states.iter().map(|s| s.u.iter().fold(0.0f64, |a, v| a.max(v.abs()))).fold(0.0f64, f64::max);
+    let ref_norms: Vec<SquaredNorms> = rsol
+        .states
+        .iter()
+        .skip(1)
+        .map(|s| error::norms(&rcase.problem.model, s))
+        .collect();
+    let uref = rsol
+        .states
+        .iter()
+        .map(|s| s.u.iter().fold(0.0f64, |a, v| a.max(v.abs())))
+        .fold(0.0f64, f64::max);
 
     // 2. Every level with every cone against the reference.
     let mut errors = Vec::new();
@@ -299,16 +385,44 @@ pub fn run(name: &str) -> Result<StudyResult> {
             let case = Case::build(&scene, level, method, &fam)?;
             let (sol, wall) = solve_case(&case, kind, sf.steps)?;
             let cmp = Comparison::new(&case.problem.model, &rcase.problem.model);
-            let diff: Vec<SquaredNorms> = sol.states.iter().zip(&rsol.states).skip(1).map(|(s, r)| cmp.difference(&case.problem.model, s, &rcase.problem.model, r)).collect();
-            let pdiff: Vec<(f64, f64)> = sol.states.iter().zip(&rsol.states).skip(1).map(|(s, r)| error::pressure_difference(&case.problem, s, &rcase.problem, r)).collect();
-            let pen = sol.states.iter().map(|s| metrics::max_penetration(&case.problem, s)).fold(0.0f64, f64::max);
+            let diff: Vec<SquaredNorms> = sol
+                .states
+                .iter()
+                .zip(&rsol.states)
+                .skip(1)
+                .map(|(s, r)| cmp.difference(&case.problem.model, s, &rcase.problem.model, r))
+                .collect();
+            let pdiff: Vec<(f64, f64)> = sol
+                .states
+                .iter()
+                .zip(&rsol.states)
+                .skip(1)
+                .map(|(s, r)| error::pressure_difference(&case.problem, s, &rcase.problem, r))
+                .collect();
+            let pen = sol
+                .states
+                .iter()
+                .map(|s| metrics::max_penetration(&case.problem, s))
+                .fold(0.0f64, f64::max);
             let q = relative_quantities(&diff, &ref_norms, &pdiff, pen, uref);
             for name in &sf.quantities {
                 let e = q[name.as_str()];
                 if !e.is_finite() {
-                    return Err(Error::NotConverged(format!("{} level {level}: the {name} error is not finite", method.name())));
+                    return Err(Error::NotConverged(format!(
+                        "{} level {level}: the {name} error is not finite",
+                        method.name()
+                    )));
                 }
-                errors.push(ErrorRow { method: method.name().into(), level, h: case.h, dofs: case.problem.model.n_free, steps: sf.steps, quantity: name.clone(), error: e, wall_s: wall });
+                errors.push(ErrorRow {
+                    method: method.name().into(),
+                    level,
+                    h: case.h,
+                    dofs: case.problem.model.n_free,
+                    steps: sf.steps,
+                    quantity: name.clone(),
+                    error: e,
+                    wall_s: wall,
+                });
             }
             let last = sol.last();
             levels.push(LevelInfo {
@@ -316,8 +430,20 @@ pub fn run(name: &str) -> Result<StudyResult> {
                 level,
                 h: case.h,
                 dofs: case.problem.model.n_free,
-                slave_nodes: case.problem.interface.pieces.iter().map(|p| p.slave_nodes.len()).sum(),
-                master_nodes: case.problem.interface.pieces.iter().map(|p| p.master_nodes.len()).sum(),
+                slave_nodes: case
+                    .problem
+                    .interface
+                    .pieces
+                    .iter()
+                    .map(|p| p.slave_nodes.len())
+                    .sum(),
+                master_nodes: case
+                    .problem
+                    .interface
+                    .pieces
+                    .iter()
+                    .map(|p| p.master_nodes.len())
+                    .sum(),
                 iterations: sol.iterations(),
                 max_step_iterations: sol.max_step_iterations(),
                 contact_fraction: metrics::contact_fraction(&case.problem, last),
@@ -336,33 +462,68 @@ pub fn run(name: &str) -> Result<StudyResult> {
     let mut rates_out = Vec::new();
     for &method in &methods {
         for qn in &sf.quantities {
-            let rows: Vec<&ErrorRow> = errors.iter().filter(|r| r.method == method.name() && &r.quantity == qn).collect();
-            let used: Vec<&&ErrorRow> = rows.iter().filter(|r| !levels.iter().any(|l| l.method == r.method && l.level == r.level && l.flagged)).collect();
+            let rows: Vec<&ErrorRow> = errors
+                .iter()
+                .filter(|r| r.method == method.name() && &r.quantity == qn)
+                .collect();
+            let exact_method = sf.thresholds.exact.iter().any(|m| m == method.name());
+            let used: Vec<&&ErrorRow> = rows
+                .iter()
+                .filter(|r| {
+                    exact_method
+                        || !levels
+                            .iter()
+                            .any(|l| l.method == r.method && l.level == r.level && l.flagged)
+                })
+                .collect();
             let h: Vec<f64> = used.iter().map(|r| r.h).collect();
             let e: Vec<f64> = used.iter().map(|r| r.error).collect();
             let dofs: Vec<f64> = used.iter().map(|r| r.dofs as f64).collect();
             let fit = rates::fit(&h, &e);
             let fit_d = rates::fit(&dofs, &e);
-            let threshold = (qn == "theorem").then(|| match method {
-                Method::Mortar => sf.thresholds.mortar,
-                Method::Nts => sf.thresholds.nts,
-            } - sf.thresholds.tolerance);
+            let exact = sf.thresholds.exact.iter().any(|m| m == method.name());
+            let threshold = (qn == "theorem").then(|| {
+                if exact {
+                    sf.thresholds.exact_tolerance
+                } else {
+                    let required = match method {
+                        Method::Mortar => sf.thresholds.mortar,
+                        Method::Nts => sf.thresholds.nts,
+                    };
+                    required - sf.thresholds.tolerance
+                }
+            });
             let (rate, stderr) = fit.map_or((f64::NAN, f64::NAN), |f| (f.rate, f.stderr));
             let enough = used.len() >= 3;
+            let max_err = rows.iter().map(|r| r.error).fold(0.0f64, f64::max);
+            let pass = threshold.map(|t| {
+                if exact {
+                    max_err <= t
+                } else {
+                    enough && rate >= t
+                }
+            });
             rates_out.push(RateRow {
                 method: method.name().into(),
                 quantity: qn.clone(),
                 rate,
                 stderr,
-                levels_used: used.iter().map(|r| r.level.to_string()).collect::<Vec<_>>().join(" "),
-                threshold,
-                pass: threshold.map(|t| enough && rate >= t),
-                rate_dofs: fit_d.map_or(f64::NAN, |f| -f.rate),
-                successive: rates::successive(&rows.iter().map(|r| r.h).collect::<Vec<_>>(), &rows.iter().map(|r| r.error).collect::<Vec<_>>())
+                levels_used: used
                     .iter()
-                    .map(|r| format!("{r:.3}"))
+                    .map(|r| r.level.to_string())
                     .collect::<Vec<_>>()
                     .join(" "),
+                threshold,
+                pass,
+                rate_dofs: fit_d.map_or(f64::NAN, |f| -f.rate),
+                successive: rates::successive(
+                    &rows.iter().map(|r| r.h).collect::<Vec<_>>(),
+                    &rows.iter().map(|r| r.error).collect::<Vec<_>>(),
+                )
+                .iter()
+                .map(|r| format!("{r:.3}"))
+                .collect::<Vec<_>>()
+                .join(" "),
             });
         }
     }
@@ -381,7 +542,11 @@ pub fn run(name: &str) -> Result<StudyResult> {
                 let (s, _) = solve_case(&case, kind, n)?;
                 let stride = ts.reference_steps / n;
                 if stride * n != ts.reference_steps {
-                    return Err(Error::input(&path, "time.reference_steps", "reference_steps must be a multiple of every step count"));
+                    return Err(Error::input(
+                        &path,
+                        "time.reference_steps",
+                        "reference_steps must be a multiple of every step count",
+                    ));
                 }
                 let mut err = 0.0f64;
                 let mut norm = 0.0f64;
@@ -391,7 +556,11 @@ pub fn run(name: &str) -> Result<StudyResult> {
                     err = err.max(d.theorem());
                     norm = norm.max(error::norms(m, r).theorem());
                 }
-                runs.push((n, case.problem.model.scene.final_time / n as f64, err / norm));
+                runs.push((
+                    n,
+                    case.problem.model.scene.final_time / n as f64,
+                    err / norm,
+                ));
                 progress.tick(format!("time study {n} steps"));
             }
             let ks: Vec<f64> = runs.iter().map(|r| r.1).collect();
@@ -402,9 +571,29 @@ pub fn run(name: &str) -> Result<StudyResult> {
     progress.0.finish_and_clear();
     let mut provenance = BTreeMap::new();
     provenance.insert("gmsh".into(), rcase.mesh.gmsh_version.clone());
-    provenance.insert("geo".into(), format!("{} (sha256 {})", scene.geo.file_name().unwrap().to_string_lossy(), rcase.mesh.geo_hash));
-    provenance.insert("solver".into(), format!("{} (tolerance {:.0e})", kind.name(), Settings::default().tol));
-    provenance.insert("cores".into(), std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1).to_string());
+    provenance.insert(
+        "geo".into(),
+        format!(
+            "{} (sha256 {})",
+            scene.geo.file_name().unwrap().to_string_lossy(),
+            rcase.mesh.geo_hash
+        ),
+    );
+    provenance.insert(
+        "solver".into(),
+        format!(
+            "{} (tolerance {:.0e})",
+            kind.name(),
+            Settings::default().tol
+        ),
+    );
+    provenance.insert(
+        "cores".into(),
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+            .to_string(),
+    );
     provenance.insert("commit".into(), commit());
     Ok(StudyResult {
         name: study_name,

@@ -13,7 +13,12 @@ pub struct Fit {
 
 /// Least-squares fit of log(y) = intercept + rate log(x); None with fewer than 2 points.
 pub fn fit(x: &[f64], y: &[f64]) -> Option<Fit> {
-    let pts: Vec<(f64, f64)> = x.iter().zip(y).filter(|(a, b)| **a > 0.0 && **b > 0.0 && a.is_finite() && b.is_finite()).map(|(a, b)| (a.ln(), b.ln())).collect();
+    let pts: Vec<(f64, f64)> = x
+        .iter()
+        .zip(y)
+        .filter(|(a, b)| **a > 0.0 && **b > 0.0 && a.is_finite() && b.is_finite())
+        .map(|(a, b)| (a.ln(), b.ln()))
+        .collect();
     let n = pts.len();
     if n < 2 {
         return None;
@@ -28,15 +33,25 @@ pub fn fit(x: &[f64], y: &[f64]) -> Option<Fit> {
     let rate = sxy / sxx;
     let intercept = my - rate * mx;
     let stderr = if n > 2 {
-        let ssr: f64 = pts.iter().map(|p| (p.1 - intercept - rate * p.0).powi(2)).sum();
+        let ssr: f64 = pts
+            .iter()
+            .map(|p| (p.1 - intercept - rate * p.0).powi(2))
+            .sum();
         (ssr / (n - 2) as f64 / sxx).sqrt()
     } else {
         0.0
     };
-    Some(Fit { rate, stderr, intercept })
+    Some(Fit {
+        rate,
+        stderr,
+        intercept,
+    })
 }
 
 /// Rates between neighbouring points: log(y_i/y_{i+1}) / log(x_i/x_{i+1}).
 pub fn successive(x: &[f64], y: &[f64]) -> Vec<f64> {
-    x.windows(2).zip(y.windows(2)).map(|(a, b)| (b[0] / b[1]).ln() / (a[0] / a[1]).ln()).collect()
+    x.windows(2)
+        .zip(y.windows(2))
+        .map(|(a, b)| (b[0] / b[1]).ln() / (a[0] / a[1]).ln())
+        .collect()
 }

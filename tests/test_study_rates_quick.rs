@@ -1,0 +1,111 @@
+//! Reference: Theorem 3.1 of the paper (H1 rates h^(3/4) for K_h^pi, h^(1/2) for K_h^I).
+//! Goal: the quick tier of `study rates` (levels 0-2, reference on matching meshes at
+//! level 5) meets the theorem's thresholds minus the study's tolerance, with every level
+//! in the fit and the reference's own error at least 5x below the finest level's error.
+//! Geometry and data: the `rates` scene, 4 time steps, newton solver.
+
+use contact_rates::study::{self, file::StudyFile, rates};
+
+#[test]
+fn quick_rates_study_meets_the_theorem_thresholds() {
+    contact_rates::init();
+    let res = study::run("rates-quick").unwrap();
+    let (ref_err, p) = res.reference_error;
+    println!("reference error estimate {ref_err:.3e} (fitted p = {p:.2})");
+    for r in res.rates.iter().filter(|r| r.quantity == "theorem") {
+        println!(
+            "{}: rate {:.3} +- {:.3} over levels {} (threshold {:?})",
+            r.method, r.rate, r.stderr, r.levels_used, r.threshold
+        );
+        assert_eq!(
+            r.levels_used.split(' ').count(),
+            3,
+            "all quick levels are asymptotic and unflagged"
+        );
+        assert_eq!(
+            r.pass,
+            Some(true),
+            "{} rate {} below {:?}",
+            r.method,
+            r.rate,
+            r.threshold
+        );
+        let finest = res
+            .errors
+            .iter()
+            .filter(|e| e.method == r.method && e.quantity == "theorem")
+            .map(|e| e.error)
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            finest >= 5.0 * ref_err,
+            "reference error {ref_err} not 5x below {finest}"
+        );
+    }
+    assert!(
+        res.errors
+            .iter()
+            .all(|e| e.error.is_finite() && e.wall_s.is_finite())
+    );
+    // The two cones differ where the contact condition acts: the contact pressure.
+    let pe = |m: &str| {
+        res.errors
+            .iter()
+            .filter(|e| e.method == m && e.quantity == "l2_pressure")
+            .map(|e| e.error)
+            .fold(f64::INFINITY, f64::min)
+    };
+    assert!(pe("mortar") != pe("nts"));
+}
+
+#[test]
+fn least_squares_rate_recovers_a_known_power_law() {
+    let h = [0.4, 0.2, 0.1, 0.05];
+    let e: Vec<f64> = h.iter().map(|x: &f64| 3.0 * x.powf(0.75)).collect();
+    let f = rates::fit(&h, &e).unwrap();
+    assert!((f.rate - 0.75).abs() < 1e-12 && f.stderr < 1e-12);
+    let s = rates::successive(&h, &e);
+    assert!(s.iter().all(|r| (r - 0.75).abs() < 1e-12));
+    // Noise gives a positive standard error.
+    let noisy = [e[0] * 1.05, e[1], e[2] * 0.97, e[3]];
+    assert!(rates::fit(&h, &noisy).unwrap().stderr > 0.0);
+}
+
+#[test]
+fn study_file_errors_name_the_file_and_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = std::fs::read_to_string(study::file::builtin_dir().join("rates.toml")).unwrap();
+    let cases = [
+        (
+            base.replace("steps = 4", "steps = 4\nspeed = 2"),
+            "unknown field `speed`",
+        ),
+        (base.replace("steps = 4\n", ""), "missing field `steps`"),
+        (base.replace("ratio = 1.4142", "ratio = 1.5"), "mesh.ratio"),
+        (
+            base.replace("levels_above = 3", "levels_above = 1"),
+            "reference.levels_above",
+        ),
+        (
+            base.replace("tolerance = 0.05", "tolerance = 0.2"),
+            "thresholds.tolerance",
+        ),
+        (
+            base.replace("methods = [\"mortar\", \"nts\"]", "methods = [\"penalty\"]"),
+            "unknown method 'penalty'",
+        ),
+        (
+            base.replace("levels = [0, 1, 2, 3]", "levels = [0, 1]"),
+            "mesh.levels",
+        ),
+        (base.replace("steps = 4", "steps = 0"), "steps"),
+    ];
+    for (text, needle) in cases {
+        let f = dir.path().join("bad.toml");
+        std::fs::write(&f, text).unwrap();
+        let e = StudyFile::load(&f).unwrap_err().to_string();
+        assert!(
+            e.contains("bad.toml") && e.contains(needle),
+            "'{needle}' not in: {e}"
+        );
+    }
+}
