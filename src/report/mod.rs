@@ -1,6 +1,7 @@
 //! Reports: CSV tables, PNG plots and a README.md per study, written into a temporary folder
 //! and swapped in whole, so a failed run leaves the previous report intact.
 
+pub mod paper;
 pub mod plot;
 
 use crate::error::{Error, Result};

@@ -254,7 +254,7 @@ pub struct Panel {
 /// Panels side by side sharing one colour bar.
 pub fn field_panels(path: &Path, title: &str, bar_label: &str, panels: &[Panel]) -> Result<()> {
     register();
-    let w = 560 * panels.len() as u32 + 140;
+    let w = (560 * panels.len() as u32 + 140).max(1000);
     let root = BitMapBackend::new(path, (w, 640)).into_drawing_area();
     root.fill(&WHITE).map_err(err(path))?;
     let root = root.titled(title, ("sans-serif", 20)).map_err(err(path))?;
@@ -341,6 +341,75 @@ pub fn field_panels(path: &Path, title: &str, bar_label: &str, panels: &[Panel])
             colormap((k as f64 + 0.5) / n as f64).filled(),
         )))
         .map_err(err(path))?;
+    }
+    root.present().map_err(err(path))?;
+    Ok(())
+}
+
+/// One panel of a mesh plot: the two bodies filled in two light colours, edges thin, the
+/// contact line highlighted and the interface nodes of each body marked.
+pub struct MeshPanel {
+    /// Panel title.
+    pub title: String,
+    /// Triangles (coordinates, possibly deformed).
+    pub triangles: Vec<[[f64; 2]; 3]>,
+    /// Body per triangle (1 or 2).
+    pub body: Vec<u8>,
+    /// Contact-line segments to highlight.
+    pub highlight: Vec<[[f64; 2]; 2]>,
+    /// Interface nodes of body 1 (drawn as circles) and body 2 (drawn as crosses).
+    pub nodes: [Vec<[f64; 2]>; 2],
+    /// Undeformed outline segments to draw dashed (empty for none).
+    pub outline: Vec<[[f64; 2]; 2]>,
+}
+
+/// Mesh panels side by side.
+pub fn mesh_panels(path: &Path, title: &str, panels: &[MeshPanel]) -> Result<()> {
+    register();
+    let w = 600 * panels.len() as u32;
+    let root = BitMapBackend::new(path, (w, 640)).into_drawing_area();
+    root.fill(&WHITE).map_err(err(path))?;
+    let root = root.titled(title, ("sans-serif", 20)).map_err(err(path))?;
+    let areas = root.split_evenly((1, panels.len()));
+    let fills = [RGBColor(198, 219, 239), RGBColor(253, 208, 162)];
+    for (p, area) in panels.iter().zip(areas.iter()) {
+        let (x0, x1) = range(p.triangles.iter().flat_map(|t| t.iter().map(|v| v[0])), false);
+        let (y0, y1) = range(p.triangles.iter().flat_map(|t| t.iter().map(|v| v[1])), false);
+        let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+        let half = 0.5 * (x1 - x0).max(y1 - y0);
+        let mut chart = ChartBuilder::on(area)
+            .caption(&p.title, ("sans-serif", 16))
+            .margin(10)
+            .x_label_area_size(30)
+            .y_label_area_size(40)
+            .build_cartesian_2d(cx - half..cx + half, cy - half..cy + half)
+            .map_err(err(path))?;
+        chart.configure_mesh().disable_mesh().label_style(("sans-serif", 12)).draw().map_err(err(path))?;
+        for (i, t) in p.triangles.iter().enumerate() {
+            let pts: Vec<(f64, f64)> = t.iter().map(|v| (v[0], v[1])).collect();
+            let fill = fills[(p.body[i].max(1) - 1) as usize % 2];
+            chart.draw_series(std::iter::once(Polygon::new(pts.clone(), fill.filled()))).map_err(err(path))?;
+            let mut closed = pts;
+            closed.push(closed[0]);
+            chart.draw_series(std::iter::once(PathElement::new(closed, BLACK.mix(0.5).stroke_width(1)))).map_err(err(path))?;
+        }
+        for s in &p.outline {
+            chart.draw_series(std::iter::once(PathElement::new(vec![(s[0][0], s[0][1]), (s[1][0], s[1][1])], RGBColor(120, 120, 120).stroke_width(1)))).map_err(err(path))?;
+        }
+        for s in &p.highlight {
+            chart.draw_series(std::iter::once(PathElement::new(vec![(s[0][0], s[0][1]), (s[1][0], s[1][1])], RED.stroke_width(2)))).map_err(err(path))?;
+        }
+        chart
+            .draw_series(p.nodes[0].iter().map(|v| Circle::new((v[0], v[1]), 4, COLORS[0].stroke_width(2))))
+            .map_err(err(path))?
+            .label("body 1 interface nodes")
+            .legend(|(x, y)| Circle::new((x + 8, y), 4, COLORS[0].stroke_width(2)));
+        chart
+            .draw_series(p.nodes[1].iter().map(|v| Cross::new((v[0], v[1]), 4, COLORS[1].stroke_width(2))))
+            .map_err(err(path))?
+            .label("body 2 interface nodes")
+            .legend(|(x, y)| Cross::new((x + 8, y), 4, COLORS[1].stroke_width(2)));
+        chart.configure_series_labels().background_style(WHITE.mix(0.9)).border_style(BLACK).label_font(("sans-serif", 13)).position(SeriesLabelPosition::LowerRight).draw().map_err(err(path))?;
     }
     root.present().map_err(err(path))?;
     Ok(())

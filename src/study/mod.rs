@@ -12,6 +12,7 @@
 pub mod error;
 pub mod file;
 pub mod intersect;
+pub mod paper;
 pub mod rates;
 
 use crate::case::Case;
@@ -214,7 +215,7 @@ fn relative_quantities(
     q
 }
 
-fn solve_case(case: &Case, kind: SolverKind, steps: usize) -> Result<(Solution, f64)> {
+pub(crate) fn solve_case(case: &Case, kind: SolverKind, steps: usize) -> Result<(Solution, f64)> {
     let t = Instant::now();
     let sol = solve::solve(
         &case.problem,
@@ -229,7 +230,7 @@ fn solve_case(case: &Case, kind: SolverKind, steps: usize) -> Result<(Solution, 
 }
 
 /// Theorem-quantity distance of two solutions with the same time grid, relative to `b`.
-fn theorem_distance(ca: &Case, sa: &Solution, cb: &Case, sb: &Solution) -> f64 {
+pub(crate) fn theorem_distance(ca: &Case, sa: &Solution, cb: &Case, sb: &Solution) -> f64 {
     let cmp = Comparison::new(&ca.problem.model, &cb.problem.model);
     let d = sa
         .states
