@@ -101,7 +101,11 @@ fn run() -> anyhow::Result<()> {
     match cli.command {
         Command::Study { name } => {
             if name == "list" {
-                println!("{:12} {}", "paper", "The paper's three numerical tests (section 5): figures and the numbers behind its words");
+                println!(
+                    "{:12} {}",
+                    "paper",
+                    "The paper's three numerical tests (section 5): figures and the numbers behind its words"
+                );
                 for (n, d) in contact_rates::study::file::list() {
                     println!("{n:12} {d}");
                 }
@@ -112,7 +116,13 @@ fn run() -> anyhow::Result<()> {
                 let dir = contact_rates::report::reports_dir().join("paper");
                 contact_rates::report::paper::write_paper(&res, &dir)?;
                 let t = &res.test2_numbers;
-                println!("Test 2: mortar stress error {:.2e}, nts interpenetration {:.3e} ({:.2e} of max |u|), nts spurious stress {:.3}", t.mortar_stress_error, t.nts_penetration.0, t.nts_penetration.1, t.nts_stress_error.0);
+                println!(
+                    "Test 2: mortar stress error {:.2e}, nts interpenetration {:.3e} ({:.2e} of max |u|), nts spurious stress {:.3}",
+                    t.mortar_stress_error,
+                    t.nts_penetration.0,
+                    t.nts_penetration.1,
+                    t.nts_stress_error.0
+                );
                 for (l, h, d) in &res.test3_agreement {
                     println!("Test 3: level {l} h {h:.4}: non-matching vs matching {d:.3e}");
                 }

@@ -112,7 +112,9 @@ pub struct SceneFile {
 pub struct Expr {
     /// The source text.
     pub text: String,
-    flat: FlatEx<f64>,
+    // Boxed: a FlatEx keeps its nodes inline and is several kilobytes, which overflowed
+    // the 2 MiB stack of test threads once a Scene (seven expressions) was moved around.
+    flat: Box<FlatEx<f64>>,
     /// For each variable of the expression (alphabetical order), which input it reads.
     slots: Vec<u8>,
 }
@@ -137,7 +139,7 @@ impl Expr {
         }
         Ok(Expr {
             text: text.to_string(),
-            flat,
+            flat: Box::new(flat),
             slots,
         })
     }

@@ -373,8 +373,14 @@ pub fn mesh_panels(path: &Path, title: &str, panels: &[MeshPanel]) -> Result<()>
     let areas = root.split_evenly((1, panels.len()));
     let fills = [RGBColor(198, 219, 239), RGBColor(253, 208, 162)];
     for (p, area) in panels.iter().zip(areas.iter()) {
-        let (x0, x1) = range(p.triangles.iter().flat_map(|t| t.iter().map(|v| v[0])), false);
-        let (y0, y1) = range(p.triangles.iter().flat_map(|t| t.iter().map(|v| v[1])), false);
+        let (x0, x1) = range(
+            p.triangles.iter().flat_map(|t| t.iter().map(|v| v[0])),
+            false,
+        );
+        let (y0, y1) = range(
+            p.triangles.iter().flat_map(|t| t.iter().map(|v| v[1])),
+            false,
+        );
         let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
         let half = 0.5 * (x1 - x0).max(y1 - y0);
         let mut chart = ChartBuilder::on(area)
@@ -384,32 +390,69 @@ pub fn mesh_panels(path: &Path, title: &str, panels: &[MeshPanel]) -> Result<()>
             .y_label_area_size(40)
             .build_cartesian_2d(cx - half..cx + half, cy - half..cy + half)
             .map_err(err(path))?;
-        chart.configure_mesh().disable_mesh().label_style(("sans-serif", 12)).draw().map_err(err(path))?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .label_style(("sans-serif", 12))
+            .draw()
+            .map_err(err(path))?;
         for (i, t) in p.triangles.iter().enumerate() {
             let pts: Vec<(f64, f64)> = t.iter().map(|v| (v[0], v[1])).collect();
             let fill = fills[(p.body[i].max(1) - 1) as usize % 2];
-            chart.draw_series(std::iter::once(Polygon::new(pts.clone(), fill.filled()))).map_err(err(path))?;
+            chart
+                .draw_series(std::iter::once(Polygon::new(pts.clone(), fill.filled())))
+                .map_err(err(path))?;
             let mut closed = pts;
             closed.push(closed[0]);
-            chart.draw_series(std::iter::once(PathElement::new(closed, BLACK.mix(0.5).stroke_width(1)))).map_err(err(path))?;
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    closed,
+                    BLACK.mix(0.5).stroke_width(1),
+                )))
+                .map_err(err(path))?;
         }
         for s in &p.outline {
-            chart.draw_series(std::iter::once(PathElement::new(vec![(s[0][0], s[0][1]), (s[1][0], s[1][1])], RGBColor(120, 120, 120).stroke_width(1)))).map_err(err(path))?;
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(s[0][0], s[0][1]), (s[1][0], s[1][1])],
+                    RGBColor(120, 120, 120).stroke_width(1),
+                )))
+                .map_err(err(path))?;
         }
         for s in &p.highlight {
-            chart.draw_series(std::iter::once(PathElement::new(vec![(s[0][0], s[0][1]), (s[1][0], s[1][1])], RED.stroke_width(2)))).map_err(err(path))?;
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(s[0][0], s[0][1]), (s[1][0], s[1][1])],
+                    RED.stroke_width(2),
+                )))
+                .map_err(err(path))?;
         }
         chart
-            .draw_series(p.nodes[0].iter().map(|v| Circle::new((v[0], v[1]), 4, COLORS[0].stroke_width(2))))
+            .draw_series(
+                p.nodes[0]
+                    .iter()
+                    .map(|v| Circle::new((v[0], v[1]), 4, COLORS[0].stroke_width(2))),
+            )
             .map_err(err(path))?
             .label("body 1 interface nodes")
             .legend(|(x, y)| Circle::new((x + 8, y), 4, COLORS[0].stroke_width(2)));
         chart
-            .draw_series(p.nodes[1].iter().map(|v| Cross::new((v[0], v[1]), 4, COLORS[1].stroke_width(2))))
+            .draw_series(
+                p.nodes[1]
+                    .iter()
+                    .map(|v| Cross::new((v[0], v[1]), 4, COLORS[1].stroke_width(2))),
+            )
             .map_err(err(path))?
             .label("body 2 interface nodes")
             .legend(|(x, y)| Cross::new((x + 8, y), 4, COLORS[1].stroke_width(2)));
-        chart.configure_series_labels().background_style(WHITE.mix(0.9)).border_style(BLACK).label_font(("sans-serif", 13)).position(SeriesLabelPosition::LowerRight).draw().map_err(err(path))?;
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 13))
+            .position(SeriesLabelPosition::LowerRight)
+            .draw()
+            .map_err(err(path))?;
     }
     root.present().map_err(err(path))?;
     Ok(())

@@ -104,8 +104,20 @@ fn describe(label: &str, case: &Case, sol: &Solution, wall: f64) -> Run {
     let mut pressure = Vec::new();
     let mut offset = 0.0;
     for (pi, piece) in p.interface.pieces.iter().enumerate() {
-        for (row, l) in p.rows.iter().zip(&last.lambda).filter(|(r, _)| r.piece == pi) {
-            pressure.push((offset + piece.slave_s[row.i], if row.weight > 0.0 { l / row.weight } else { 0.0 }));
+        for (row, l) in p
+            .rows
+            .iter()
+            .zip(&last.lambda)
+            .filter(|(r, _)| r.piece == pi)
+        {
+            pressure.push((
+                offset + piece.slave_s[row.i],
+                if row.weight > 0.0 {
+                    l / row.weight
+                } else {
+                    0.0
+                },
+            ));
         }
         offset += piece.length;
     }
@@ -127,13 +139,19 @@ fn describe(label: &str, case: &Case, sol: &Solution, wall: f64) -> Run {
         steps: sol.reports.len(),
         iterations: (sol.iterations(), sol.max_step_iterations()),
         wall_s: wall,
-        max_penetration: sol.states.iter().map(|s| metrics::max_penetration(p, s)).fold(0.0, f64::max),
+        max_penetration: sol
+            .states
+            .iter()
+            .map(|s| metrics::max_penetration(p, s))
+            .fold(0.0, f64::max),
         contact_fraction: metrics::contact_fraction(p, last),
         plastic_fraction: metrics::plastic_fraction(p, last),
         pressure,
         mesh: MeshData {
             nodes: (0..m.n_nodes).map(|g| m.position(g)).collect(),
-            u: (0..m.n_nodes).map(|g| [last.u[2 * g], last.u[2 * g + 1]]).collect(),
+            u: (0..m.n_nodes)
+                .map(|g| [last.u[2 * g], last.u[2 * g + 1]])
+                .collect(),
             triangles: m.elements.iter().map(|e| e.nodes).collect(),
             body: m.elements.iter().map(|e| e.body as u8 + 1).collect(),
             von_mises: last.sigma.iter().map(von_mises).collect(),
@@ -144,7 +162,12 @@ fn describe(label: &str, case: &Case, sol: &Solution, wall: f64) -> Run {
     }
 }
 
-fn solve(scene: &Scene, method: Method, level: usize, params: &[(String, f64)]) -> Result<(Case, Solution, f64)> {
+fn solve(
+    scene: &Scene,
+    method: Method,
+    level: usize,
+    params: &[(String, f64)],
+) -> Result<(Case, Solution, f64)> {
     let case = Case::build(scene, level, method, params)?;
     let (sol, wall) = solve_case(&case, SolverKind::Newton, scene.steps)?;
     Ok((case, sol, wall))
@@ -153,16 +176,49 @@ fn solve(scene: &Scene, method: Method, level: usize, params: &[(String, f64)]) 
 /// Test 2's numbers from its two solved cases.
 pub fn test2_numbers(mortar: (&Case, &Solution), nts: (&Case, &Solution)) -> Test2Numbers {
     let exact = |t: f64| Vector3::new(0.0, -10.0 * t, 0.0);
-    let umax = |s: &Solution| s.states.iter().map(|st| st.u.iter().fold(0.0f64, |a, v| a.max(v.abs()))).fold(0.0, f64::max);
+    let umax = |s: &Solution| {
+        s.states
+            .iter()
+            .map(|st| st.u.iter().fold(0.0f64, |a, v| a.max(v.abs())))
+            .fold(0.0, f64::max)
+    };
     let (mc, ms) = mortar;
-    let mortar_stress_error = ms.states.iter().skip(1).map(|st| st.sigma.iter().map(|s| (s - exact(st.time)).amax() / (10.0 * st.time)).fold(0.0, f64::max)).fold(0.0, f64::max);
+    let mortar_stress_error = ms
+        .states
+        .iter()
+        .skip(1)
+        .map(|st| {
+            st.sigma
+                .iter()
+                .map(|s| (s - exact(st.time)).amax() / (10.0 * st.time))
+                .fold(0.0, f64::max)
+        })
+        .fold(0.0, f64::max);
     let last = ms.last();
     let s11 = last.sigma.iter().map(|s| s[0].abs()).fold(0.0, f64::max);
     let s12 = last.sigma.iter().map(|s| s[2].abs()).fold(0.0, f64::max);
-    let s22 = (last.sigma.iter().map(|s| s[1]).fold(f64::INFINITY, f64::min), last.sigma.iter().map(|s| s[1]).fold(f64::NEG_INFINITY, f64::max));
-    let mpen = ms.states.iter().map(|s| metrics::max_penetration(&mc.problem, s)).fold(0.0, f64::max) / umax(ms);
+    let s22 = (
+        last.sigma
+            .iter()
+            .map(|s| s[1])
+            .fold(f64::INFINITY, f64::min),
+        last.sigma
+            .iter()
+            .map(|s| s[1])
+            .fold(f64::NEG_INFINITY, f64::max),
+    );
+    let mpen = ms
+        .states
+        .iter()
+        .map(|s| metrics::max_penetration(&mc.problem, s))
+        .fold(0.0, f64::max)
+        / umax(ms);
     let (nc, ns) = nts;
-    let npen = ns.states.iter().map(|s| metrics::max_penetration(&nc.problem, s)).fold(0.0, f64::max);
+    let npen = ns
+        .states
+        .iter()
+        .map(|s| metrics::max_penetration(&nc.problem, s))
+        .fold(0.0, f64::max);
     let nl = ns.last();
     let (mut worst, mut at) = (0.0, [0.0; 2]);
     for (e, s) in nc.problem.model.elements.iter().zip(&nl.sigma) {
@@ -170,7 +226,10 @@ pub fn test2_numbers(mortar: (&Case, &Solution), nts: (&Case, &Solution)) -> Tes
         if d > worst {
             worst = d;
             let p = e.nodes.map(|n| nc.problem.model.position(n));
-            at = [(p[0][0] + p[1][0] + p[2][0]) / 3.0, (p[0][1] + p[1][1] + p[2][1]) / 3.0];
+            at = [
+                (p[0][0] + p[1][0] + p[2][0]) / 3.0,
+                (p[0][1] + p[1][1] + p[2][1]) / 3.0,
+            ];
         }
     }
     Test2Numbers {
@@ -198,7 +257,10 @@ pub fn run() -> Result<PaperResult> {
     let (mc, ms, mw) = solve(&s2, Method::Mortar, 0, &[])?;
     let (nc, ns, nw) = solve(&s2, Method::Nts, 0, &[])?;
     let test2_numbers = test2_numbers((&mc, &ms), (&nc, &ns));
-    let test2 = vec![describe("mortar", &mc, &ms, mw), describe("nts", &nc, &ns, nw)];
+    let test2 = vec![
+        describe("mortar", &mc, &ms, mw),
+        describe("nts", &nc, &ns, nw),
+    ];
     // Test 3: piecewise-straight contact line, non-matching against matching meshes.
     let s3 = Scene::load("paper-3")?;
     let matching = vec![("matching".to_string(), 1.0)];
@@ -215,5 +277,12 @@ pub fn run() -> Result<PaperResult> {
             test3.push(describe("mortar, matching", &cm, &sm, wm));
         }
     }
-    Ok(PaperResult { test1, test2, test2_numbers, test3, test3_agreement, wall_s: t0.elapsed().as_secs_f64() })
+    Ok(PaperResult {
+        test1,
+        test2,
+        test2_numbers,
+        test3,
+        test3_agreement,
+        wall_s: t0.elapsed().as_secs_f64(),
+    })
 }
