@@ -23,6 +23,57 @@ pub struct Case {
     pub mesh_s: f64,
     /// Seconds to build the model, interface and constraint rows.
     pub setup_s: f64,
+    /// Warnings about the scene (e.g. a body free to move), for the user.
+    pub warnings: Vec<String>,
+}
+
+/// Warnings for bodies that neither a support nor the contact holds: for each displacement
+/// component a body's clamps and rollers leave free, the net load at T must press the body
+/// against Gamma_C (contact pushes body b along -nu^b) or the body can move freely.
+pub fn support_warnings(
+    model: &Model,
+    interface: &Interface,
+    raw: &crate::mesh::RawMesh,
+) -> Result<Vec<String>> {
+    let sc = &model.scene;
+    let f = model.load(sc.final_time)?;
+    let mut out = Vec::new();
+    for b in 0..2 {
+        let mesh = &model.meshes[b];
+        let mut held = [false; 2];
+        for c in &sc.clamps {
+            if !mesh.curve_edges(raw, c).is_empty() {
+                held = [true, true];
+            }
+        }
+        for r in &sc.rollers {
+            if !mesh.curve_edges(raw, &r.curve).is_empty() {
+                held[r.component] = true;
+            }
+        }
+        let range = model.node_offset[b]..model.node_offset[b] + mesh.nodes.len();
+        let load = [0, 1].map(|c| range.clone().map(|n| f[2 * n + c]).sum::<f64>());
+        let scale = load[0].abs().max(load[1].abs()).max(f64::MIN_POSITIVE);
+        for c in 0..2 {
+            if held[c] {
+                continue;
+            }
+            let pressed = interface.pieces.iter().any(|p| {
+                let nu = if b == 0 { p.normal[c] } else { -p.normal[c] };
+                nu * load[c] > 1e-9 * scale
+            });
+            if !pressed {
+                out.push(format!(
+                    "{}: body '{}' has no clamp or roller holding u_{} and its net load at T ({:.3e}) does not press it against Gamma_C in that direction: it is free to move; add a roller or a clamp",
+                    sc.file.display(),
+                    sc.bodies[b].surface,
+                    ["x", "y"][c],
+                    load[c]
+                ));
+            }
+        }
+    }
+    Ok(out)
 }
 
 impl Case {
@@ -53,6 +104,7 @@ impl Case {
         let model = Model::new(scene, &raw, &generated.path)?;
         let interface = Interface::new(&model, &raw)?;
         let h = model.h();
+        let warnings = support_warnings(&model, &interface, &raw)?;
         let problem = Problem::new(model, interface, method);
         Ok(Case {
             problem,
@@ -61,6 +113,7 @@ impl Case {
             mesh: generated,
             mesh_s,
             setup_s: t1.elapsed().as_secs_f64(),
+            warnings,
         })
     }
 }

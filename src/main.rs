@@ -26,6 +26,9 @@ enum Command {
     Study {
         /// Study name (studies/NAME.toml), a path to a study file, or `list`.
         name: String,
+        /// Report folder (default: reports/NAME).
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// Solve one scene on one mesh level and write solution.vtu and summary.csv.
     Solve {
@@ -99,7 +102,7 @@ fn run() -> anyhow::Result<()> {
     contact_rates::init();
     let cli = Cli::parse();
     match cli.command {
-        Command::Study { name } => {
+        Command::Study { name, out } => {
             if name == "list" {
                 println!(
                     "{:12} {}",
@@ -113,7 +116,7 @@ fn run() -> anyhow::Result<()> {
             }
             if name == "paper" {
                 let res = contact_rates::study::paper::run()?;
-                let dir = contact_rates::report::reports_dir().join("paper");
+                let dir = out.unwrap_or_else(|| contact_rates::report::reports_dir().join("paper"));
                 contact_rates::report::paper::write_paper(&res, &dir)?;
                 let t = &res.test2_numbers;
                 println!(
@@ -130,7 +133,11 @@ fn run() -> anyhow::Result<()> {
                 return Ok(());
             }
             let result = contact_rates::study::run(&name)?;
-            let dir = contact_rates::report::reports_dir().join(&result.name);
+            for w in &result.warnings {
+                eprintln!("warning: {w}");
+            }
+            let dir =
+                out.unwrap_or_else(|| contact_rates::report::reports_dir().join(&result.name));
             contact_rates::report::write_study(&result, &dir)?;
             for r in &result.rates {
                 println!(
@@ -227,6 +234,9 @@ fn run() -> anyhow::Result<()> {
             }
             let t0 = std::time::Instant::now();
             let case = Case::build(&scene, level, method, &parse_sets(&set)?)?;
+            for w in &case.warnings {
+                eprintln!("warning: {w}");
+            }
             let settings = Settings {
                 kind,
                 tol,

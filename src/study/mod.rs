@@ -162,6 +162,8 @@ pub struct StudyResult {
     pub provenance: BTreeMap<String, String>,
     /// Total wall time (s).
     pub wall_s: f64,
+    /// Scene warnings (from the reference case).
+    pub warnings: Vec<String>,
 }
 
 /// Progress reporting: one tick per solve; silent when stderr is not a terminal.
@@ -347,6 +349,7 @@ pub fn run(name: &str) -> Result<StudyResult> {
         refs.push((case, sol, wall));
     }
     let (rcase, rsol, rwall) = refs.pop().unwrap();
+    let warnings = rcase.warnings.clone();
     let d1 = theorem_distance(&refs[1].0, &refs[1].1, &rcase, &rsol);
     let d2 = theorem_distance(&refs[0].0, &refs[0].1, &rcase, &rsol);
     // The reference levels are nested conforming spaces, so their errors are close to
@@ -612,6 +615,7 @@ pub fn run(name: &str) -> Result<StudyResult> {
         time_study,
         provenance,
         wall_s: t0.elapsed().as_secs_f64(),
+        warnings,
         file: sf,
     })
 }
