@@ -97,60 +97,43 @@ impl StepSolver for Newton<'_> {
         let mut last_active: Option<Vec<bool>> = None;
         let mut changes = 0;
         let mut iterations = 0;
-        loop {
-            let (sigma, tangents) = model.update_stresses(&u, &prev.u, &prev.sigma, k, true);
-            let elastic = model
-                .elements
-                .iter()
-                .zip(&sigma)
-                .all(|(e, s)| !model.materials[e.body].is_plastic(s));
+        let mut factorizations = 0;
+        let mut last_merit = f64::INFINITY;
+        // Residual of (2.1) with the return map at (u, lambda): (r over free dofs, gaps, the
+        // consistent tangents, scale of the forces).
+        let residual = |u: &[f64], lambda: &[f64], tangent: bool| {
+            let (sigma, tangents) = model.update_stresses(u, &prev.u, &prev.sigma, k, tangent);
             let f_int = model.internal_force(&sigma);
             let mut r = f_int.clone();
             for (ri, f) in r.iter_mut().zip(&f_ext) {
                 *ri -= f;
             }
-            contact::add_transpose(&p.rows, &lambda, &mut r);
-            let r_free = model.restrict(&r);
-            let scale = inf_norm(&f_free)
-                .max(inf_norm(&model.restrict(&f_int)))
-                .max(f64::MIN_POSITIVE);
-            let g = contact::apply_rows(&p.rows, &u);
+            contact::add_transpose(&p.rows, lambda, &mut r);
+            let scale = inf_norm(&f_free).max(inf_norm(&model.restrict(&f_int))).max(f64::MIN_POSITIVE);
+            let g = contact::apply_rows(&p.rows, u);
+            (sigma, tangents, model.restrict(&r), g, scale)
+        };
+        let merit_of = |r: &[f64], g: &[f64], lambda: &[f64]| -> f64 { r.iter().map(|v| v * v).sum::<f64>() + (0..m).map(|i| lambda[i].min(-c * g[i]).powi(2)).sum::<f64>() };
+        loop {
+            let (sigma, tangents, r_free, g, scale) = residual(&u, &lambda, true);
+            let elastic = model.elements.iter().zip(&sigma).all(|(e, s)| !model.materials[e.body].is_plastic(s));
             let active: Vec<bool> = (0..m).map(|i| lambda[i] + c * g[i] >= 0.0).collect();
-            let ncp = (0..m)
-                .map(|i| lambda[i].min(-c * g[i]).abs())
-                .fold(0.0f64, f64::max);
+            let compl = (0..m).map(|i| lambda[i].min(-c * g[i]).abs()).fold(0.0f64, f64::max) / scale;
             let res = inf_norm(&r_free) / scale;
-            let compl = ncp / scale;
             let same_set = last_active.as_ref().is_some_and(|a| *a == active);
             if let Some(a) = &last_active {
                 changes += a.iter().zip(&active).filter(|(x, y)| x != y).count();
             }
-            if iterations > 0 && res <= self.settings.tol && compl <= self.settings.tol && same_set
-            {
-                let state = State {
-                    time: t,
-                    u,
-                    sigma,
-                    lambda,
-                };
-                return Ok((
-                    state,
-                    StepReport {
-                        iterations,
-                        outer_iterations: iterations,
-                        residual: res,
-                        active_set_changes: changes,
-                        reason: format!(
-                            "residual {res:.2e} and complementarity {compl:.2e} below {:.0e}, active set settled",
-                            self.settings.tol
-                        ),
-                    },
-                ));
+            if iterations > 0 && res <= self.settings.tol && compl <= self.settings.tol && same_set {
+                let state = State { time: t, u, sigma, lambda };
+                let reason = format!(
+                    "residual {res:.2e} and complementarity {compl:.2e} below {:.0e}, active set settled ({factorizations} factorizations)",
+                    self.settings.tol
+                );
+                return Ok((state, StepReport { iterations, outer_iterations: iterations, residual: res, active_set_changes: changes, reason }));
             }
             if !res.is_finite() {
-                return Err(Error::NotConverged(format!(
-                    "Newton iterate became non-finite after {iterations} iterations"
-                )));
+                return Err(Error::NotConverged(format!("Newton iterate became non-finite after {iterations} iterations")));
             }
             if iterations >= self.settings.max_iterations {
                 return Err(Error::NotConverged(format!(
@@ -158,73 +141,81 @@ impl StepSolver for Newton<'_> {
                     self.settings.tol
                 )));
             }
-            // Refactorize unless the matrix is the one already factored.
-            let reuse = matches!(&self.factored, Some((a, el)) if *el && elastic && *a == active);
-            if !reuse {
-                let vals = self.system.values_mut();
-                vals.iter_mut().for_each(|v| *v = 0.0);
-                model.add_tangent(&tangents, &self.slots, vals);
+            let merit0 = merit_of(&r_free, &g, &lambda);
+            // Factorization reuse (a chord step) while the active set is the factored one and
+            // the previous iteration reduced the merit at least fourfold; otherwise refactor
+            // with the current consistent tangent (a full semismooth Newton step). The
+            // elastic factorization is exact whenever no triangle is viscoplastic.
+            let factored_here = matches!(&self.factored, Some((a, el)) if *a == active && (*el && elastic || merit0 <= 0.25 * last_merit));
+            let mut reused = factored_here;
+            let rhs0: Vec<f64> = {
+                let mut rhs = vec![0.0; n + m];
+                for (i, v) in r_free.iter().enumerate() {
+                    rhs[i] = -v;
+                }
                 for i in 0..m {
-                    for &(rs, cs, _, v) in &self.row_slots[i] {
-                        vals[cs] = v;
-                        vals[rs] = if active[i] { c * v } else { 0.0 };
-                    }
-                    vals[self.diag_slots[i]] = if active[i] { 0.0 } else { c };
+                    rhs[n + i] = if active[i] { -c * g[i] } else { -c * lambda[i] };
                 }
-                self.system.factor_lu()?;
-                self.factored = Some((active.clone(), elastic));
-            }
-            let mut rhs = vec![0.0; n + m];
-            for (i, v) in r_free.iter().enumerate() {
-                rhs[i] = -v;
-            }
-            for i in 0..m {
-                rhs[n + i] = if active[i] { -c * g[i] } else { -c * lambda[i] };
-            }
-            self.system.solve(&mut rhs);
-            // Backtracking on the merit |r|^2 + |min(lambda, -c g)|^2: full steps near the
-            // solution, shorter ones when a large step flips many triangles between
-            // elastic and viscoplastic (stiff k E / lambda) or many contact rows.
-            let merit = |u: &[f64], lambda: &[f64]| -> f64 {
-                let (sig, _) = model.update_stresses(u, &prev.u, &prev.sigma, k, false);
-                let mut r = model.internal_force(&sig);
-                for (ri, f) in r.iter_mut().zip(&f_ext) {
-                    *ri -= f;
-                }
-                contact::add_transpose(&p.rows, lambda, &mut r);
-                let g = contact::apply_rows(&p.rows, u);
-                let rr: f64 = model.restrict(&r).iter().map(|v| v * v).sum();
-                let cc: f64 = (0..m).map(|i| lambda[i].min(-c * g[i]).powi(2)).sum();
-                rr + cc
+                rhs
             };
-            let merit0 = r_free.iter().map(|v| v * v).sum::<f64>()
-                + (0..m)
-                    .map(|i| lambda[i].min(-c * g[i]).powi(2))
-                    .sum::<f64>();
-            let trial = |alpha: f64| -> (Vec<f64>, Vec<f64>) {
-                let mut ut = u.clone();
-                for (d, &eq) in model.equation.iter().enumerate() {
-                    if eq != FIXED {
-                        ut[d] += alpha * rhs[eq];
+            let (best, best_merit) = loop {
+                if !reused {
+                    let vals = self.system.values_mut();
+                    vals.iter_mut().for_each(|v| *v = 0.0);
+                    model.add_tangent(&tangents, &self.slots, vals);
+                    for i in 0..m {
+                        for &(rs, cs, _, v) in &self.row_slots[i] {
+                            vals[cs] = v;
+                            vals[rs] = if active[i] { c * v } else { 0.0 };
+                        }
+                        vals[self.diag_slots[i]] = if active[i] { 0.0 } else { c };
+                    }
+                    self.system.factor_lu()?;
+                    factorizations += 1;
+                    self.factored = Some((active.clone(), elastic));
+                }
+                let mut rhs = rhs0.clone();
+                self.system.solve(&mut rhs);
+                // Backtracking on the merit |r|^2 + |min(lambda, -c g)|^2: full steps near the
+                // solution, shorter ones when a large step flips many triangles between
+                // elastic and viscoplastic (stiff k E / lambda) or many contact rows.
+                let trial = |alpha: f64| -> (Vec<f64>, Vec<f64>) {
+                    let mut ut = u.clone();
+                    for (d, &eq) in model.equation.iter().enumerate() {
+                        if eq != FIXED {
+                            ut[d] += alpha * rhs[eq];
+                        }
+                    }
+                    let lt: Vec<f64> = (0..m).map(|i| lambda[i] + alpha * rhs[n + i]).collect();
+                    (ut, lt)
+                };
+                let mut alpha = 1.0;
+                let (mut best, mut best_merit) = (trial(1.0), f64::INFINITY);
+                for _ in 0..12 {
+                    let tr = trial(alpha);
+                    let (_, _, rt, gt, _) = residual(&tr.0, &tr.1, false);
+                    let mv = merit_of(&rt, &gt, &tr.1);
+                    if mv < best_merit {
+                        best_merit = mv;
+                        best = tr;
+                    }
+                    if mv <= (1.0 - 1e-4 * alpha) * merit0 {
+                        break;
+                    }
+                    alpha *= 0.5;
+                    if reused {
+                        // A reused factorization that needs damping is too stale.
+                        break;
                     }
                 }
-                let lt: Vec<f64> = (0..m).map(|i| lambda[i] + alpha * rhs[n + i]).collect();
-                (ut, lt)
+                if reused && best_merit > 0.25 * merit0 && !(elastic && matches!(&self.factored, Some((_, true)))) {
+                    reused = false;
+                    continue;
+                }
+                break (best, best_merit);
             };
-            let mut alpha = 1.0;
-            let (mut best, mut best_merit) = (trial(1.0), f64::INFINITY);
-            for _ in 0..12 {
-                let t = trial(alpha);
-                let mv = merit(&t.0, &t.1);
-                if mv < best_merit {
-                    best_merit = mv;
-                    best = t;
-                }
-                if mv <= (1.0 - 1e-4 * alpha) * merit0 {
-                    break;
-                }
-                alpha *= 0.5;
-            }
+            last_merit = merit0;
+            let _ = best_merit;
             (u, lambda) = best;
             last_active = Some(active);
             iterations += 1;
