@@ -82,6 +82,16 @@ struct Summary {
     contact_fraction: f64,
     plastic_fraction: f64,
     converged: bool,
+    mesh_s: f64,
+    assembly_s: f64,
+    factor_s: f64,
+    solve_s: f64,
+    constitutive_s: f64,
+    contact_s: f64,
+    factorizations: usize,
+    active_set_changes: usize,
+    floor_s: f64,
+    ratio_to_floor: f64,
 }
 
 fn parse_sets(set: &[String]) -> anyhow::Result<Vec<(String, f64)>> {
@@ -245,6 +255,7 @@ fn run() -> anyhow::Result<()> {
                 ..Settings::default()
             };
             let sol = solve::solve(&case.problem, &settings, steps, false)?;
+            let floor_s = solve::floor_time(&case.problem, steps)?;
             let last = sol.last();
             let p = &case.problem;
             let summary = Summary {
@@ -262,6 +273,16 @@ fn run() -> anyhow::Result<()> {
                 contact_fraction: metrics::contact_fraction(p, last),
                 plastic_fraction: metrics::plastic_fraction(p, last),
                 converged: true,
+                mesh_s: case.mesh_s,
+                assembly_s: sol.timings.assembly_s,
+                factor_s: sol.timings.factor_s,
+                solve_s: sol.timings.solve_s,
+                constitutive_s: sol.timings.constitutive_s,
+                contact_s: sol.timings.contact_s,
+                factorizations: sol.timings.factorizations,
+                active_set_changes: sol.active_set_changes(),
+                floor_s,
+                ratio_to_floor: sol.wall_s / floor_s,
             };
             io::write_atomic(
                 &out.join("solution.vtu"),
@@ -282,9 +303,21 @@ fn run() -> anyhow::Result<()> {
                 summary.contact_fraction,
                 summary.plastic_fraction
             );
+            let t = &sol.timings;
             println!(
-                "  mesh {:.3} s, setup {:.3} s, time loop {:.3} s, of which {} numeric factorizations {:.3} s",
-                case.mesh_s, case.setup_s, sol.wall_s, sol.factorizations, sol.factor_s
+                "  mesh {:.3} s, setup {:.3} s; time loop {:.3} s = {:.2} x the floor ({:.3} s): {} factorizations {:.3} s, solves {:.3} s, assembly {:.3} s, constitutive {:.3} s, contact {:.3} s; {} active-set changes",
+                case.mesh_s,
+                case.setup_s,
+                sol.wall_s,
+                sol.wall_s / floor_s,
+                floor_s,
+                t.factorizations,
+                t.factor_s,
+                t.solve_s,
+                t.assembly_s,
+                t.constitutive_s,
+                t.contact_s,
+                sol.active_set_changes()
             );
             println!(
                 "wrote {} and {}",

@@ -371,10 +371,11 @@ impl StepSolver for FixedPoint<'_> {
         )))
     }
 
-    fn factor_stats(&self) -> (f64, usize) {
-        (
-            self.system.factor_s + self.clarabel_s,
-            self.system.factorizations,
-        )
+    fn timings(&self) -> super::Timings {
+        super::Timings {
+            factor_s: self.system.factor_s + self.clarabel_s,
+            factorizations: self.system.factorizations,
+            ..Default::default()
+        }
     }
 }

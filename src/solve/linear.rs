@@ -113,3 +113,103 @@ impl SparseSystem {
         }
     }
 }
+
+impl SparseSystem {
+    /// `y = A x` with the current values.
+    pub fn matvec(&self, x: &[f64], y: &mut [f64]) {
+        let (sym, val) = self.mat.parts();
+        let cp = sym.col_ptr();
+        let ri = sym.row_idx();
+        y.iter_mut().for_each(|v| *v = 0.0);
+        for c in 0..x.len() {
+            let xc = x[c];
+            if xc != 0.0 {
+                for s in cp[c]..cp[c + 1] {
+                    y[ri[s]] += val[s] * xc;
+                }
+            }
+        }
+    }
+
+    /// Whether a factorization is available.
+    pub fn is_factored(&self) -> bool {
+        self.lu.is_some() || self.llt.is_some()
+    }
+
+    /// Solve `A x = b` with the current values of A by GMRES, right-preconditioned with the
+    /// last factorization (of a possibly older matrix). Returns the iterations used, or None
+    /// when the relative residual `rtol` is not reached in `max_iter` iterations. `b` is
+    /// replaced by x.
+    ///
+    /// Written by hand: a few dozen lines, and the preconditioner is faer's factorization.
+    pub fn gmres(&self, b: &mut [f64], rtol: f64, max_iter: usize) -> Option<usize> {
+        let n = b.len();
+        let dot = |a: &[f64], c: &[f64]| a.iter().zip(c).map(|(x, y)| x * y).sum::<f64>();
+        let bnorm = dot(b, b).sqrt();
+        if bnorm == 0.0 {
+            return Some(0);
+        }
+        let mut v: Vec<Vec<f64>> = vec![b.iter().map(|x| x / bnorm).collect()];
+        let mut h = vec![vec![0.0; max_iter]; max_iter + 1];
+        let (mut cs, mut sn) = (vec![0.0; max_iter], vec![0.0; max_iter]);
+        let mut g = vec![0.0; max_iter + 1];
+        g[0] = bnorm;
+        let mut z = vec![0.0; n];
+        let mut w = vec![0.0; n];
+        let mut k_done = 0;
+        let mut converged = false;
+        for k in 0..max_iter {
+            z.copy_from_slice(&v[k]);
+            self.solve(&mut z);
+            self.matvec(&z, &mut w);
+            for i in 0..=k {
+                h[i][k] = dot(&w, &v[i]);
+                for (wj, vj) in w.iter_mut().zip(&v[i]) {
+                    *wj -= h[i][k] * vj;
+                }
+            }
+            h[k + 1][k] = dot(&w, &w).sqrt();
+            for i in 0..k {
+                let tmp = cs[i] * h[i][k] + sn[i] * h[i + 1][k];
+                h[i + 1][k] = -sn[i] * h[i][k] + cs[i] * h[i + 1][k];
+                h[i][k] = tmp;
+            }
+            let r = h[k][k].hypot(h[k + 1][k]);
+            cs[k] = h[k][k] / r;
+            sn[k] = h[k + 1][k] / r;
+            h[k][k] = r;
+            h[k + 1][k] = 0.0;
+            g[k + 1] = -sn[k] * g[k];
+            g[k] *= cs[k];
+            k_done = k + 1;
+            if g[k + 1].abs() <= rtol * bnorm {
+                converged = true;
+                break;
+            }
+            let nw = dot(&w, &w).sqrt();
+            if nw == 0.0 {
+                converged = true;
+                break;
+            }
+            v.push(w.iter().map(|x| x / nw).collect());
+        }
+        if !converged {
+            return None;
+        }
+        // y = H^{-1} g, x = M^{-1} V y.
+        let mut y = vec![0.0; k_done];
+        for i in (0..k_done).rev() {
+            let s: f64 = (i + 1..k_done).map(|j| h[i][j] * y[j]).sum();
+            y[i] = (g[i] - s) / h[i][i];
+        }
+        let mut x = vec![0.0; n];
+        for (j, yj) in y.iter().enumerate() {
+            for (xi, vi) in x.iter_mut().zip(&v[j]) {
+                *xi += yj * vi;
+            }
+        }
+        self.solve(&mut x);
+        b.copy_from_slice(&x);
+        Some(k_done)
+    }
+}

@@ -124,6 +124,31 @@ pub struct StepReport {
     pub reason: String,
 }
 
+/// Where the time of a solve went (s), and the factorization count.
+#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
+pub struct Timings {
+    /// Assembling internal forces, tangents and the KKT values.
+    pub assembly_s: f64,
+    /// Numeric factorizations (for `qp`, also Clarabel's solves).
+    pub factor_s: f64,
+    /// Triangular solves.
+    pub solve_s: f64,
+    /// Constitutive updates (return map per triangle).
+    pub constitutive_s: f64,
+    /// Contact rows: gaps and C^T lambda.
+    pub contact_s: f64,
+    /// Number of numeric factorizations.
+    pub factorizations: usize,
+}
+
+/// Run `f`, adding its wall time to `cell`.
+pub fn timed<T>(cell: &std::cell::Cell<f64>, f: impl FnOnce() -> T) -> T {
+    let t = Instant::now();
+    let r = f();
+    cell.set(cell.get() + t.elapsed().as_secs_f64());
+    r
+}
+
 /// A solved history.
 #[derive(Debug, Clone)]
 pub struct Solution {
@@ -137,6 +162,8 @@ pub struct Solution {
     pub factor_s: f64,
     /// Number of numeric factorizations.
     pub factorizations: usize,
+    /// Where the time went.
+    pub timings: Timings,
 }
 
 impl Solution {
@@ -152,14 +179,25 @@ impl Solution {
     pub fn max_step_iterations(&self) -> usize {
         self.reports.iter().map(|r| r.iterations).max().unwrap_or(0)
     }
+    /// Active-set changes summed over the steps.
+    pub fn active_set_changes(&self) -> usize {
+        self.reports.iter().map(|r| r.active_set_changes).sum()
+    }
+}
+
+/// The floor a solver is judged by (SPEC section 7), measured on the same KKT matrix and
+/// machine: assembling it once, one numeric factorization, and two triangular solves
+/// (one forward-backward pair) per time step. Seconds.
+pub fn floor_time(p: &Problem, steps: usize) -> Result<f64> {
+    newton::floor_time(p, steps)
 }
 
 /// One solver's per-step interface.
 pub trait StepSolver {
     /// Advance from `prev` to time `t` with step `k`, starting from `guess`.
     fn step(&mut self, prev: &State, guess: &State, t: f64, k: f64) -> Result<(State, StepReport)>;
-    /// (seconds in numeric factorizations, count).
-    fn factor_stats(&self) -> (f64, usize);
+    /// Where the time went so far.
+    fn timings(&self) -> Timings;
 }
 
 /// Relative residual of (2.1) at a state: `|f_int(sigma) - F + C^T lambda|_inf / scale`
@@ -282,12 +320,13 @@ pub fn solve_times(
     if !keep_history {
         states.push(prev);
     }
-    let (factor_s, factorizations) = solver.factor_stats();
+    let timings = solver.timings();
     Ok(Solution {
         states,
         reports,
         wall_s: start.elapsed().as_secs_f64(),
-        factor_s,
-        factorizations,
+        factor_s: timings.factor_s,
+        factorizations: timings.factorizations,
+        timings,
     })
 }

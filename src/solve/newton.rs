@@ -6,9 +6,11 @@
 
 use super::linear::SparseSystem;
 use super::{Problem, Settings, State, StepReport, StepSolver};
+use super::{Timings, timed};
 use crate::contact;
 use crate::error::{Error, Result};
 use crate::fe::{FIXED, Pattern};
+use std::cell::Cell;
 
 /// Newton solver state (pattern, slots, factorization) for one problem.
 pub struct Newton<'a> {
@@ -20,10 +22,44 @@ pub struct Newton<'a> {
     row_slots: Vec<Vec<(usize, usize, usize, f64)>>,
     diag_slots: Vec<usize>,
     system: SparseSystem,
-    /// Active set and "tangent was elastic everywhere" of the current factorization.
-    factored: Option<(Vec<bool>, bool)>,
+    /// The factorization is too old to precondition well: refactor at the next iteration.
+    stale: bool,
     /// Scale turning gaps into forces in the complementarity function (force/length).
     c_scale: f64,
+    clock: Clock,
+}
+
+/// Accumulated times of the solver's parts.
+#[derive(Default)]
+struct Clock {
+    assembly: Cell<f64>,
+    solve: Cell<f64>,
+    constitutive: Cell<f64>,
+    contact: Cell<f64>,
+}
+
+/// See [`super::floor_time`].
+pub fn floor_time(p: &Problem, steps: usize) -> Result<f64> {
+    let mut nw = Newton::new(p, &super::Settings::default())?;
+    let t0 = std::time::Instant::now();
+    let tangents = p.model.elastic_tangents();
+    let m = p.rows.len();
+    let c = nw.c_scale;
+    let vals = nw.system.values_mut();
+    vals.iter_mut().for_each(|v| *v = 0.0);
+    p.model.add_tangent(&tangents, &nw.slots, vals);
+    for i in 0..m {
+        for &(rs, cs, _, v) in &nw.row_slots[i] {
+            vals[cs] = v;
+            vals[rs] = c * v;
+        }
+    }
+    nw.system.factor_lu()?;
+    let mut rhs = vec![1.0; nw.n + m];
+    for _ in 0..steps {
+        nw.system.solve(&mut rhs);
+    }
+    Ok(t0.elapsed().as_secs_f64())
 }
 
 impl<'a> Newton<'a> {
@@ -73,8 +109,9 @@ impl<'a> Newton<'a> {
             row_slots,
             diag_slots,
             system: SparseSystem::new(&pattern),
-            factored: None,
+            stale: false,
             c_scale,
+            clock: Clock::default(),
         })
     }
 }
@@ -98,42 +135,83 @@ impl StepSolver for Newton<'_> {
         let mut changes = 0;
         let mut iterations = 0;
         let mut factorizations = 0;
-        let mut last_merit = f64::INFINITY;
         // Residual of (2.1) with the return map at (u, lambda): (r over free dofs, gaps, the
         // consistent tangents, scale of the forces).
+        let clock = &self.clock;
         let residual = |u: &[f64], lambda: &[f64], tangent: bool| {
-            let (sigma, tangents) = model.update_stresses(u, &prev.u, &prev.sigma, k, tangent);
-            let f_int = model.internal_force(&sigma);
+            let (sigma, tangents) = timed(&clock.constitutive, || {
+                model.update_stresses(u, &prev.u, &prev.sigma, k, tangent)
+            });
+            let f_int = timed(&clock.assembly, || model.internal_force(&sigma));
             let mut r = f_int.clone();
             for (ri, f) in r.iter_mut().zip(&f_ext) {
                 *ri -= f;
             }
-            contact::add_transpose(&p.rows, lambda, &mut r);
-            let scale = inf_norm(&f_free).max(inf_norm(&model.restrict(&f_int))).max(f64::MIN_POSITIVE);
-            let g = contact::apply_rows(&p.rows, u);
+            let g = timed(&clock.contact, || {
+                contact::add_transpose(&p.rows, lambda, &mut r);
+                contact::apply_rows(&p.rows, u)
+            });
+            let scale = inf_norm(&f_free)
+                .max(inf_norm(&model.restrict(&f_int)))
+                .max(f64::MIN_POSITIVE);
             (sigma, tangents, model.restrict(&r), g, scale)
         };
-        let merit_of = |r: &[f64], g: &[f64], lambda: &[f64]| -> f64 { r.iter().map(|v| v * v).sum::<f64>() + (0..m).map(|i| lambda[i].min(-c * g[i]).powi(2)).sum::<f64>() };
+        let merit_of = |r: &[f64], g: &[f64], lambda: &[f64]| -> f64 {
+            r.iter().map(|v| v * v).sum::<f64>()
+                + (0..m)
+                    .map(|i| lambda[i].min(-c * g[i]).powi(2))
+                    .sum::<f64>()
+        };
         loop {
             let (sigma, tangents, r_free, g, scale) = residual(&u, &lambda, true);
-            let elastic = model.elements.iter().zip(&sigma).all(|(e, s)| !model.materials[e.body].is_plastic(s));
+            let elastic = model
+                .elements
+                .iter()
+                .zip(&sigma)
+                .all(|(e, s)| !model.materials[e.body].is_plastic(s));
             let active: Vec<bool> = (0..m).map(|i| lambda[i] + c * g[i] >= 0.0).collect();
-            let compl = (0..m).map(|i| lambda[i].min(-c * g[i]).abs()).fold(0.0f64, f64::max) / scale;
+            let compl = (0..m)
+                .map(|i| lambda[i].min(-c * g[i]).abs())
+                .fold(0.0f64, f64::max)
+                / scale;
             let res = inf_norm(&r_free) / scale;
             let same_set = last_active.as_ref().is_some_and(|a| *a == active);
             if let Some(a) = &last_active {
                 changes += a.iter().zip(&active).filter(|(x, y)| x != y).count();
             }
-            if iterations > 0 && res <= self.settings.tol && compl <= self.settings.tol && same_set {
-                let state = State { time: t, u, sigma, lambda };
+            if iterations > 0 && res <= self.settings.tol && compl <= self.settings.tol && same_set
+            {
+                // Inactive rows carry no force; GMRES leaves round-off there.
+                for i in 0..m {
+                    if !active[i] {
+                        lambda[i] = 0.0;
+                    }
+                }
+                let state = State {
+                    time: t,
+                    u,
+                    sigma,
+                    lambda,
+                };
                 let reason = format!(
                     "residual {res:.2e} and complementarity {compl:.2e} below {:.0e}, active set settled ({factorizations} factorizations)",
                     self.settings.tol
                 );
-                return Ok((state, StepReport { iterations, outer_iterations: iterations, residual: res, active_set_changes: changes, reason }));
+                return Ok((
+                    state,
+                    StepReport {
+                        iterations,
+                        outer_iterations: iterations,
+                        residual: res,
+                        active_set_changes: changes,
+                        reason,
+                    },
+                ));
             }
             if !res.is_finite() {
-                return Err(Error::NotConverged(format!("Newton iterate became non-finite after {iterations} iterations")));
+                return Err(Error::NotConverged(format!(
+                    "Newton iterate became non-finite after {iterations} iterations"
+                )));
             }
             if iterations >= self.settings.max_iterations {
                 return Err(Error::NotConverged(format!(
@@ -142,12 +220,11 @@ impl StepSolver for Newton<'_> {
                 )));
             }
             let merit0 = merit_of(&r_free, &g, &lambda);
-            // Factorization reuse (a chord step) while the active set is the factored one and
-            // the previous iteration reduced the merit at least fourfold; otherwise refactor
-            // with the current consistent tangent (a full semismooth Newton step). The
-            // elastic factorization is exact whenever no triangle is viscoplastic.
-            let factored_here = matches!(&self.factored, Some((a, el)) if *a == active && (*el && elastic || merit0 <= 0.25 * last_merit));
-            let mut reused = factored_here;
+            // Every iteration is a full semismooth Newton step with the current consistent
+            // tangent and active set. Its linear system is solved by GMRES preconditioned
+            // with the last factorization (of an older matrix: the tangent and the active
+            // rows change little between iterations and steps); the matrix is refactorized
+            // only when GMRES needs many iterations.
             let rhs0: Vec<f64> = {
                 let mut rhs = vec![0.0; n + m];
                 for (i, v) in r_free.iter().enumerate() {
@@ -158,24 +235,42 @@ impl StepSolver for Newton<'_> {
                 }
                 rhs
             };
-            let (best, best_merit) = loop {
-                if !reused {
-                    let vals = self.system.values_mut();
-                    vals.iter_mut().for_each(|v| *v = 0.0);
-                    model.add_tangent(&tangents, &self.slots, vals);
-                    for i in 0..m {
-                        for &(rs, cs, _, v) in &self.row_slots[i] {
-                            vals[cs] = v;
-                            vals[rs] = if active[i] { c * v } else { 0.0 };
-                        }
-                        vals[self.diag_slots[i]] = if active[i] { 0.0 } else { c };
+            let t_asm = std::time::Instant::now();
+            {
+                let vals = self.system.values_mut();
+                vals.iter_mut().for_each(|v| *v = 0.0);
+                model.add_tangent(&tangents, &self.slots, vals);
+                for i in 0..m {
+                    for &(rs, cs, _, v) in &self.row_slots[i] {
+                        vals[cs] = v;
+                        vals[rs] = if active[i] { c * v } else { 0.0 };
                     }
-                    self.system.factor_lu()?;
-                    factorizations += 1;
-                    self.factored = Some((active.clone(), elastic));
+                    vals[self.diag_slots[i]] = if active[i] { 0.0 } else { c };
                 }
-                let mut rhs = rhs0.clone();
-                self.system.solve(&mut rhs);
+            }
+            self.clock
+                .assembly
+                .set(self.clock.assembly.get() + t_asm.elapsed().as_secs_f64());
+            let mut rhs = rhs0.clone();
+            let mut solved = false;
+            if self.system.is_factored() && !self.stale {
+                if let Some(its) =
+                    timed(&self.clock.solve, || self.system.gmres(&mut rhs, 1e-12, 30))
+                {
+                    solved = true;
+                    self.stale = its > 10;
+                } else {
+                    rhs.copy_from_slice(&rhs0);
+                }
+            }
+            if !solved {
+                self.system.factor_lu()?;
+                factorizations += 1;
+                self.stale = false;
+                timed(&self.clock.solve, || self.system.solve(&mut rhs));
+            }
+            let _ = elastic;
+            let (best, _best_merit) = {
                 // Backtracking on the merit |r|^2 + |min(lambda, -c g)|^2: full steps near the
                 // solution, shorter ones when a large step flips many triangles between
                 // elastic and viscoplastic (stiff k E / lambda) or many contact rows.
@@ -203,26 +298,23 @@ impl StepSolver for Newton<'_> {
                         break;
                     }
                     alpha *= 0.5;
-                    if reused {
-                        // A reused factorization that needs damping is too stale.
-                        break;
-                    }
                 }
-                if reused && best_merit > 0.25 * merit0 && !(elastic && matches!(&self.factored, Some((_, true)))) {
-                    reused = false;
-                    continue;
-                }
-                break (best, best_merit);
+                (best, best_merit)
             };
-            last_merit = merit0;
-            let _ = best_merit;
             (u, lambda) = best;
             last_active = Some(active);
             iterations += 1;
         }
     }
 
-    fn factor_stats(&self) -> (f64, usize) {
-        (self.system.factor_s, self.system.factorizations)
+    fn timings(&self) -> Timings {
+        Timings {
+            assembly_s: self.clock.assembly.get(),
+            factor_s: self.system.factor_s,
+            solve_s: self.clock.solve.get(),
+            constitutive_s: self.clock.constitutive.get(),
+            contact_s: self.clock.contact.get(),
+            factorizations: self.system.factorizations,
+        }
     }
 }
