@@ -124,6 +124,19 @@ fn run() -> anyhow::Result<()> {
                 }
                 return Ok(());
             }
+            if name == "speed" {
+                let res = contact_rates::study::speed::run()?;
+                let dir = out.unwrap_or_else(|| contact_rates::report::reports_dir().join("speed"));
+                contact_rates::report::write_speed(&res, &dir)?;
+                for r in &res.rows {
+                    println!(
+                        "{:7} {:7} level {} {:7} dofs: {:3} iterations, {:2} factorizations, {:8.3} s = {:5.2} x floor ({:.3} s), error {}",
+                        r.method, r.solver, r.level, r.dofs, r.iterations, r.factorizations, r.wall_s, r.ratio_to_floor, r.floor_s, r.error.map(|e| format!("{e:.3e}")).unwrap_or_default()
+                    );
+                }
+                println!("wrote {} ({:.1} s)", dir.display(), res.wall_s);
+                return Ok(());
+            }
             if name == "paper" {
                 let res = contact_rates::study::paper::run()?;
                 let dir = out.unwrap_or_else(|| contact_rates::report::reports_dir().join("paper"));

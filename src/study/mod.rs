@@ -14,6 +14,7 @@ pub mod file;
 pub mod intersect;
 pub mod paper;
 pub mod rates;
+pub mod speed;
 
 use crate::case::Case;
 use crate::contact::Method;
