@@ -308,22 +308,7 @@ impl Scene {
 
     /// Parse and validate scene TOML text; `file` locates the .geo and names errors.
     pub fn from_toml(text: &str, file: &Path) -> Result<Self> {
-        let sf: SceneFile = toml::from_str(text).map_err(|e| {
-            let span = e
-                .span()
-                .map(|s| {
-                    format!(
-                        " (line {})",
-                        text[..s.start.min(text.len())].lines().count().max(1)
-                    )
-                })
-                .unwrap_or_default();
-            Error::input(
-                file,
-                format!("toml{span}"),
-                format!("{}; fix the scene file", e.message()),
-            )
-        })?;
+        let sf: SceneFile = crate::error::parse_toml(text, file, "scene file")?;
         let name = file
             .file_stem()
             .map(|s| s.to_string_lossy().to_string())

@@ -162,22 +162,7 @@ impl StudyFile {
     /// Read and validate a study file.
     pub fn load(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        let s: StudyFile = toml::from_str(&text).map_err(|e| {
-            let span = e
-                .span()
-                .map(|s| {
-                    format!(
-                        " (line {})",
-                        text[..s.start.min(text.len())].lines().count().max(1)
-                    )
-                })
-                .unwrap_or_default();
-            Error::input(
-                path,
-                format!("toml{span}"),
-                format!("{}; fix the study file", e.message()),
-            )
-        })?;
+        let s: StudyFile = crate::error::parse_toml(&text, path, "study file")?;
         let bad = |field: &str, msg: String| Err(Error::input(path, field, msg));
         for m in &s.methods {
             if crate::contact::Method::parse(m).is_none() {
