@@ -59,9 +59,25 @@ impl Error {
 
 /// Deserialize TOML `text` read from `file`; a syntax error, unknown key or missing field
 /// becomes one error naming the file, the line and the fix (`what` names the kind of file).
-pub fn parse_toml<T: serde::de::DeserializeOwned>(text: &str, file: &std::path::Path, what: &str) -> Result<T> {
+pub fn parse_toml<T: serde::de::DeserializeOwned>(
+    text: &str,
+    file: &std::path::Path,
+    what: &str,
+) -> Result<T> {
     toml::from_str(text).map_err(|e| {
-        let line = e.span().map(|s| format!(" (line {})", text[..s.start.min(text.len())].lines().count().max(1))).unwrap_or_default();
-        Error::input(file, format!("toml{line}"), format!("{}; fix the {what}", e.message()))
+        let line = e
+            .span()
+            .map(|s| {
+                format!(
+                    " (line {})",
+                    text[..s.start.min(text.len())].lines().count().max(1)
+                )
+            })
+            .unwrap_or_default();
+        Error::input(
+            file,
+            format!("toml{line}"),
+            format!("{}; fix the {what}", e.message()),
+        )
     })
 }

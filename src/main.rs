@@ -29,6 +29,13 @@ enum Command {
         /// Report folder (default: reports/NAME).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Run only the i-th of n slices of the study's solves and store their records
+        /// (for a cluster's job array); no report.
+        #[arg(long, value_name = "i/n", conflicts_with = "merge")]
+        shard: Option<String>,
+        /// Build the report from the records of all shards.
+        #[arg(long)]
+        merge: bool,
     },
     /// Solve one scene on one mesh level and write solution.vtu and summary.csv.
     Solve {
@@ -112,7 +119,12 @@ fn run() -> anyhow::Result<()> {
     contact_rates::init();
     let cli = Cli::parse();
     match cli.command {
-        Command::Study { name, out } => {
+        Command::Study {
+            name,
+            out,
+            shard,
+            merge,
+        } => {
             if name == "list" {
                 println!(
                     "{:12} {}",
@@ -131,7 +143,16 @@ fn run() -> anyhow::Result<()> {
                 for r in &res.rows {
                     println!(
                         "{:7} {:7} level {} {:7} dofs: {:3} iterations, {:2} factorizations, {:8.3} s = {:5.2} x floor ({:.3} s), error {}",
-                        r.method, r.solver, r.level, r.dofs, r.iterations, r.factorizations, r.wall_s, r.ratio_to_floor, r.floor_s, r.error.map(|e| format!("{e:.3e}")).unwrap_or_default()
+                        r.method,
+                        r.solver,
+                        r.level,
+                        r.dofs,
+                        r.iterations,
+                        r.factorizations,
+                        r.wall_s,
+                        r.ratio_to_floor,
+                        r.floor_s,
+                        r.error.map(|e| format!("{e:.3e}")).unwrap_or_default()
                     );
                 }
                 println!("wrote {} ({:.1} s)", dir.display(), res.wall_s);
@@ -155,7 +176,14 @@ fn run() -> anyhow::Result<()> {
                 println!("wrote {} ({:.1} s)", dir.display(), res.wall_s);
                 return Ok(());
             }
-            let result = contact_rates::study::run(&name)?;
+            let mode = match (&shard, merge) {
+                (Some(sh), _) => contact_rates::study::jobs::Mode::shard(sh)?,
+                (None, true) => contact_rates::study::jobs::Mode::Merge,
+                (None, false) => contact_rates::study::jobs::Mode::All,
+            };
+            let Some(result) = contact_rates::study::run_mode(&name, mode)? else {
+                return Ok(());
+            };
             for w in &result.warnings {
                 eprintln!("warning: {w}");
             }

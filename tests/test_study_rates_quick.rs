@@ -4,7 +4,7 @@
 //! in the fit and the reference's own error at least 5x below the finest level's error.
 //! Geometry and data: the `rates` scene, 4 time steps, newton solver.
 
-use contact_rates::study::{self, file::StudyFile, rates};
+use contact_rates::study::{self, file::StudyFile, jobs::Mode, rates};
 
 #[test]
 fn quick_rates_study_meets_the_theorem_thresholds() {
@@ -55,6 +55,45 @@ fn quick_rates_study_meets_the_theorem_thresholds() {
             .fold(f64::INFINITY, f64::min)
     };
     assert!(pe("mortar") != pe("nts"));
+
+    // The same study spread over two shards and merged from their records gives the same
+    // errors and rates to the last bit (the jobs are independent and deterministic).
+    assert!(
+        study::run_mode("rates-quick", Mode::Shard(1, 2))
+            .unwrap()
+            .is_none()
+    );
+    assert!(
+        study::run_mode("rates-quick", Mode::Shard(2, 2))
+            .unwrap()
+            .is_none()
+    );
+    let merged = study::run_mode("rates-quick", Mode::Merge)
+        .unwrap()
+        .unwrap();
+    assert_eq!(res.errors.len(), merged.errors.len());
+    for (a, b) in res.errors.iter().zip(&merged.errors) {
+        assert_eq!(
+            (
+                a.method.as_str(),
+                a.level,
+                a.quantity.as_str(),
+                a.error.to_bits()
+            ),
+            (
+                b.method.as_str(),
+                b.level,
+                b.quantity.as_str(),
+                b.error.to_bits()
+            )
+        );
+    }
+    for (a, b) in res.rates.iter().zip(&merged.rates) {
+        assert_eq!(
+            (a.rate.to_bits(), a.stderr.to_bits(), &a.levels_used, a.pass),
+            (b.rate.to_bits(), b.stderr.to_bits(), &b.levels_used, b.pass)
+        );
+    }
 }
 
 #[test]
@@ -107,5 +146,14 @@ fn study_file_errors_name_the_file_and_key() {
             e.contains("bad.toml") && e.contains(needle),
             "'{needle}' not in: {e}"
         );
+    }
+}
+
+#[test]
+fn shard_argument_is_checked() {
+    assert_eq!(Mode::shard("2/4").unwrap(), Mode::Shard(2, 4));
+    for bad in ["0/2", "3/2", "1", "a/b", "1/0"] {
+        let e = Mode::shard(bad).unwrap_err().to_string();
+        assert!(e.contains("--shard") && e.contains(bad), "{e}");
     }
 }

@@ -400,12 +400,22 @@ fn readme(res: &StudyResult) -> String {
 pub fn write_speed(res: &crate::study::speed::SpeedResult, dir: &Path) -> Result<()> {
     write_folder(dir, |d| {
         write(d, "speed.csv", &csv_bytes(&res.rows)?)?;
-        let combos = [("mortar", "newton", 0usize), ("nts", "newton", 1), ("mortar", "paper", 3), ("nts", "paper", 2)];
+        let combos = [
+            ("mortar", "newton", 0usize),
+            ("nts", "newton", 1),
+            ("mortar", "paper", 3),
+            ("nts", "paper", 2),
+        ];
         let series: Vec<Series> = combos
             .iter()
             .map(|(m, so, c)| Series {
                 label: format!("{m}, {so}"),
-                points: res.rows.iter().filter(|r| r.method == *m && r.solver == *so).filter_map(|r| r.error.map(|e| (r.wall_s.max(1e-4), e))).collect(),
+                points: res
+                    .rows
+                    .iter()
+                    .filter(|r| r.method == *m && r.solver == *so)
+                    .filter_map(|r| r.error.map(|e| (r.wall_s.max(1e-4), e)))
+                    .collect(),
                 markers: true,
                 line: true,
                 color: *c,
@@ -413,10 +423,21 @@ pub fn write_speed(res: &crate::study::speed::SpeedResult, dir: &Path) -> Result
             })
             .filter(|s| !s.points.is_empty())
             .collect();
-        plot::loglog(&d.join("work_precision.png"), "speed: error against wall time (rates scene, 4 steps)", "wall time of the time loop (s)", "relative error (theorem norm)", &series, &[])?;
+        plot::loglog(
+            &d.join("work_precision.png"),
+            "speed: error against wall time (rates scene, 4 steps)",
+            "wall time of the time loop (s)",
+            "relative error (theorem norm)",
+            &series,
+            &[],
+        )?;
         let mut series = Vec::new();
         for (m, so, c) in combos {
-            let rows: Vec<_> = res.rows.iter().filter(|r| r.method == m && r.solver == so).collect();
+            let rows: Vec<_> = res
+                .rows
+                .iter()
+                .filter(|r| r.method == m && r.solver == so)
+                .collect();
             if rows.is_empty() {
                 continue;
             }
@@ -424,34 +445,101 @@ pub fn write_speed(res: &crate::study::speed::SpeedResult, dir: &Path) -> Result
             let y: Vec<f64> = rows.iter().map(|r| r.wall_s).collect();
             // Exponent over the levels with at least 1e4 dofs (below, fixed costs dominate).
             let big: Vec<usize> = (0..x.len()).filter(|&i| x[i] >= 1e4).collect();
-            let fit = crate::study::rates::fit(&big.iter().map(|&i| x[i]).collect::<Vec<_>>(), &big.iter().map(|&i| y[i]).collect::<Vec<_>>());
+            let fit = crate::study::rates::fit(
+                &big.iter().map(|&i| x[i]).collect::<Vec<_>>(),
+                &big.iter().map(|&i| y[i]).collect::<Vec<_>>(),
+            );
             let label = match fit {
                 Some(f) => format!("{m}, {so}: time ~ dofs^{:.2}", f.rate),
                 None => format!("{m}, {so}"),
             };
-            series.push(Series { label, points: x.iter().copied().zip(y.iter().copied()).collect(), markers: true, line: true, color: c, thin: so == "paper" });
+            series.push(Series {
+                label,
+                points: x.iter().copied().zip(y.iter().copied()).collect(),
+                markers: true,
+                line: true,
+                color: c,
+                thin: so == "paper",
+            });
         }
-        let floor: Vec<(f64, f64)> = res.rows.iter().filter(|r| r.method == "mortar" && r.solver == "newton").map(|r| (r.dofs as f64, r.floor_s)).collect();
-        series.push(Series { label: "floor (mortar): assembly + 1 factorization + 2 solves per step".into(), points: floor, markers: false, line: true, color: 2, thin: true });
-        plot::loglog(&d.join("time_vs_dofs.png"), "speed: wall time against dofs", "free dofs", "wall time (s)", &series, &[])?;
+        let floor: Vec<(f64, f64)> = res
+            .rows
+            .iter()
+            .filter(|r| r.method == "mortar" && r.solver == "newton")
+            .map(|r| (r.dofs as f64, r.floor_s))
+            .collect();
+        series.push(Series {
+            label: "floor (mortar): assembly + 1 factorization + 2 solves per step".into(),
+            points: floor,
+            markers: false,
+            line: true,
+            color: 2,
+            thin: true,
+        });
+        plot::loglog(
+            &d.join("time_vs_dofs.png"),
+            "speed: wall time against dofs",
+            "free dofs",
+            "wall time (s)",
+            &series,
+            &[],
+        )?;
         let mut s = String::new();
-        let _ = writeln!(s, "# Study `speed`\n\nWhat each accuracy costs on the `rates` scene (h1/h2 = 1.4142, {} time steps). Every run's time loop is compared with the floor measured in the same run on the same KKT matrix: assembling it once, one numeric factorization, and two triangular solves per time step. Errors are in the theorem norm against a matching-mesh reference at level {} ({} dofs), shown where the reference is at least 3 levels finer. Regenerate with `cargo run --release -- study speed` ({:.0} s).\n", crate::study::speed::STEPS, res.reference.0, res.reference.1, res.wall_s);
-        let _ = writeln!(s, "![work precision](work_precision.png)\n\n![time against dofs](time_vs_dofs.png)\n");
-        let _ = writeln!(s, "| method | solver | level | dofs | iterations | factorizations | time loop (s) | floor (s) | ratio to floor | factorizations (s) | solves (s) | assembly (s) | constitutive (s) | error |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+        let _ = writeln!(
+            s,
+            "# Study `speed`\n\nWhat each accuracy costs on the `rates` scene (h1/h2 = 1.4142, {} time steps). Every run's time loop is compared with the floor measured in the same run on the same KKT matrix: assembling it once, one numeric factorization, and two triangular solves per time step. Errors are in the theorem norm against a matching-mesh reference at level {} ({} dofs), shown where the reference is at least 3 levels finer. Regenerate with `cargo run --release -- study speed` ({:.0} s).\n",
+            crate::study::speed::STEPS,
+            res.reference.0,
+            res.reference.1,
+            res.wall_s
+        );
+        let _ = writeln!(
+            s,
+            "![work precision](work_precision.png)\n\n![time against dofs](time_vs_dofs.png)\n"
+        );
+        let _ = writeln!(
+            s,
+            "| method | solver | level | dofs | iterations | factorizations | time loop (s) | floor (s) | ratio to floor | factorizations (s) | solves (s) | assembly (s) | constitutive (s) | error |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+        );
         for r in &res.rows {
             let _ = writeln!(
                 s,
                 "| {} | {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.2} | {:.3} | {:.3} | {:.3} | {:.3} | {} |",
-                r.method, r.solver, r.level, r.dofs, r.iterations, r.factorizations, r.wall_s, r.floor_s, r.ratio_to_floor, r.factor_s, r.solve_s, r.assembly_s, r.constitutive_s,
+                r.method,
+                r.solver,
+                r.level,
+                r.dofs,
+                r.iterations,
+                r.factorizations,
+                r.wall_s,
+                r.floor_s,
+                r.ratio_to_floor,
+                r.factor_s,
+                r.solve_s,
+                r.assembly_s,
+                r.constitutive_s,
                 r.error.map(|e| format!("{e:.3e}")).unwrap_or_default()
             );
         }
         for m in ["mortar", "nts"] {
             let finest = crate::study::speed::PAPER_LEVELS.iter().max().unwrap();
-            let nw = res.rows.iter().find(|r| r.method == m && r.solver == "newton" && r.level == *finest);
-            let pp = res.rows.iter().find(|r| r.method == m && r.solver == "paper" && r.level == *finest);
+            let nw = res
+                .rows
+                .iter()
+                .find(|r| r.method == m && r.solver == "newton" && r.level == *finest);
+            let pp = res
+                .rows
+                .iter()
+                .find(|r| r.method == m && r.solver == "paper" && r.level == *finest);
             if let (Some(a), Some(b)) = (nw, pp) {
-                let _ = writeln!(s, "\n{m}, level {finest}: newton {:.3} s ({:.2} x the floor), paper {:.3} s at the same final tolerance: newton is {:.1} x faster.", a.wall_s, a.ratio_to_floor, b.wall_s, b.wall_s / a.wall_s);
+                let _ = writeln!(
+                    s,
+                    "\n{m}, level {finest}: newton {:.3} s ({:.2} x the floor), paper {:.3} s at the same final tolerance: newton is {:.1} x faster.",
+                    a.wall_s,
+                    a.ratio_to_floor,
+                    b.wall_s,
+                    b.wall_s / a.wall_s
+                );
             }
         }
         write(d, "README.md", s.as_bytes())

@@ -12,6 +12,7 @@
 pub mod error;
 pub mod file;
 pub mod intersect;
+pub mod jobs;
 pub mod paper;
 pub mod rates;
 pub mod speed;
@@ -306,6 +307,12 @@ fn profiles(
 
 /// Run the study `name` (built-in name or path).
 pub fn run(name: &str) -> Result<StudyResult> {
+    run_mode(name, jobs::Mode::All).map(|r| r.expect("a full run gives a result"))
+}
+
+/// Run the study `name` in `mode`: all jobs here, one shard of them (records only, no
+/// result), or a merge of the records of all shards.
+pub fn run_mode(name: &str, mode: jobs::Mode) -> Result<Option<StudyResult>> {
     let t0 = Instant::now();
     let path = file::resolve(name)?;
     let sf = StudyFile::load(&path)?;
@@ -334,10 +341,87 @@ pub fn run(name: &str) -> Result<StudyResult> {
         + sf.time.as_ref().map_or(0, |t| t.steps.len() + 1);
     let progress = Progress::new(n_jobs as u64, &study_name);
 
-    // 1. The reference on matching meshes, and two coarser levels for its own error.
-    let mut refs = Vec::new();
+    // The independent solves, planned in order: the reference levels, every cone on every
+    // level, then the time study.
+    let mut plan = Vec::new();
+    let mut add =
+        |label: String, method: Method, level: usize, params: &Vec<(String, f64)>, steps: usize| {
+            let id = plan.len();
+            plan.push(jobs::Job {
+                id,
+                label,
+                method,
+                level,
+                params: params.clone(),
+                steps,
+            });
+        };
     for l in [rlevel - 2, rlevel - 1, rlevel] {
-        let case = Case::build(&scene, l, Method::Mortar, &refp)?;
+        add(
+            format!("reference level {l}"),
+            Method::Mortar,
+            l,
+            &refp,
+            sf.steps,
+        );
+    }
+    for &method in &methods {
+        for &level in &sf.mesh.levels {
+            add(
+                format!("{} level {level}", method.name()),
+                method,
+                level,
+                &fam,
+                sf.steps,
+            );
+        }
+    }
+    if let Some(ts) = &sf.time {
+        add(
+            format!("time reference ({} steps)", ts.reference_steps),
+            methods[0],
+            ts.level,
+            &fam,
+            ts.reference_steps,
+        );
+        for &n in &ts.steps {
+            if ts.reference_steps % n != 0 {
+                return Err(Error::input(
+                    &path,
+                    "time.reference_steps",
+                    "reference_steps must be a multiple of every step count",
+                ));
+            }
+            add(
+                format!("time study ({n} steps)"),
+                methods[0],
+                ts.level,
+                &fam,
+                n,
+            );
+        }
+    }
+    let study_text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+    let outputs = jobs::execute(&plan, &scene, kind, &study_text, mode, &|l: &str| {
+        progress.tick(l.to_string())
+    })?;
+    if let jobs::Mode::Shard(i, n) = mode {
+        progress.0.finish_and_clear();
+        eprintln!(
+            "shard {i}/{n}: {} of {} jobs solved, records in {}",
+            outputs.iter().filter(|o| o.is_some()).count(),
+            plan.len(),
+            jobs::records_dir().display()
+        );
+        return Ok(None);
+    }
+    let mut outputs: std::collections::VecDeque<(Case, Solution)> = outputs
+        .into_iter()
+        .map(|o| o.expect("all jobs ran"))
+        .collect();
+    let mut refs = Vec::new();
+    for _ in 0..3 {
+        let (case, sol) = outputs.pop_front().unwrap();
         if case.problem.interface.min_relative_separation() > 1e-9 {
             return Err(Error::input(
                 &path,
@@ -345,8 +429,7 @@ pub fn run(name: &str) -> Result<StudyResult> {
                 "the reference meshes do not match on Gamma_C; set the .geo parameter that makes them match (e.g. matching = 1)",
             ));
         }
-        let (sol, wall) = solve_case(&case, kind, sf.steps)?;
-        progress.tick(format!("reference level {l}"));
+        let wall = sol.wall_s;
         refs.push((case, sol, wall));
     }
     let (rcase, rsol, rwall) = refs.pop().unwrap();
@@ -387,8 +470,8 @@ pub fn run(name: &str) -> Result<StudyResult> {
     let magnification = 0.1 / umax_ref.max(f64::MIN_POSITIVE);
     for &method in &methods {
         for &level in &sf.mesh.levels {
-            let case = Case::build(&scene, level, method, &fam)?;
-            let (sol, wall) = solve_case(&case, kind, sf.steps)?;
+            let (case, sol) = outputs.pop_front().unwrap();
+            let wall = sol.wall_s;
             let cmp = Comparison::new(&case.problem.model, &rcase.problem.model);
             let diff: Vec<SquaredNorms> = sol
                 .states
@@ -459,7 +542,6 @@ pub fn run(name: &str) -> Result<StudyResult> {
                 profiles(&case, &sol, method.name(), &mut pressure, &mut gap);
                 deformed_meshes.push(deformed(&case, &sol, method.name(), magnification));
             }
-            progress.tick(format!("{} level {level}", method.name()));
         }
     }
 
@@ -537,22 +619,12 @@ pub fn run(name: &str) -> Result<StudyResult> {
     let time_study = match &sf.time {
         None => None,
         Some(ts) => {
-            let method = methods[0];
-            let case = Case::build(&scene, ts.level, method, &fam)?;
-            let (rs, _) = solve_case(&case, kind, ts.reference_steps)?;
-            progress.tick("time reference".into());
+            let (case, rs) = outputs.pop_front().unwrap();
             let m = &case.problem.model;
             let mut runs = Vec::new();
             for &n in &ts.steps {
-                let (s, _) = solve_case(&case, kind, n)?;
+                let (_, s) = outputs.pop_front().unwrap();
                 let stride = ts.reference_steps / n;
-                if stride * n != ts.reference_steps {
-                    return Err(Error::input(
-                        &path,
-                        "time.reference_steps",
-                        "reference_steps must be a multiple of every step count",
-                    ));
-                }
                 let mut err = 0.0f64;
                 let mut norm = 0.0f64;
                 for (i, st) in s.states.iter().enumerate().skip(1) {
@@ -566,7 +638,6 @@ pub fn run(name: &str) -> Result<StudyResult> {
                     case.problem.model.scene.final_time / n as f64,
                     err / norm,
                 ));
-                progress.tick(format!("time study {n} steps"));
             }
             let ks: Vec<f64> = runs.iter().map(|r| r.1).collect();
             let es: Vec<f64> = runs.iter().map(|r| r.2).collect();
@@ -600,7 +671,7 @@ pub fn run(name: &str) -> Result<StudyResult> {
             .to_string(),
     );
     provenance.insert("commit".into(), commit());
-    Ok(StudyResult {
+    Ok(Some(StudyResult {
         name: study_name,
         description: sf.description.clone(),
         scene,
@@ -618,7 +689,7 @@ pub fn run(name: &str) -> Result<StudyResult> {
         wall_s: t0.elapsed().as_secs_f64(),
         warnings,
         file: sf,
-    })
+    }))
 }
 
 /// Differences of two states on the same mesh.

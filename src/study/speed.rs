@@ -68,7 +68,14 @@ pub const REFERENCE_LEVEL: usize = 6;
 /// Time steps.
 pub const STEPS: usize = 4;
 
-fn row(scene: &Scene, case: &Case, kind: SolverKind, sol: &Solution, floor_s: f64, error: Option<f64>) -> SpeedRow {
+fn row(
+    scene: &Scene,
+    case: &Case,
+    kind: SolverKind,
+    sol: &Solution,
+    floor_s: f64,
+    error: Option<f64>,
+) -> SpeedRow {
     let t = &sol.timings;
     SpeedRow {
         scene: scene.name.clone(),
@@ -94,7 +101,10 @@ fn row(scene: &Scene, case: &Case, kind: SolverKind, sol: &Solution, floor_s: f6
 pub fn run() -> Result<SpeedResult> {
     let t0 = std::time::Instant::now();
     let scene = Scene::load("rates")?;
-    let fam = vec![("h_upper".to_string(), 0.3), ("h_lower".to_string(), 0.3 / 1.4142)];
+    let fam = vec![
+        ("h_upper".to_string(), 0.3),
+        ("h_lower".to_string(), 0.3 / 1.4142),
+    ];
     let mut refp = fam.clone();
     refp.push(("matching".to_string(), 1.0));
     let rcase = Case::build(&scene, REFERENCE_LEVEL, Method::Mortar, &refp)?;
@@ -110,11 +120,16 @@ pub fn run() -> Result<SpeedResult> {
                 let (sol, _) = solve_case(&case, kind, STEPS)?;
                 let floor_s = solve::floor_time(&case.problem, STEPS)?;
                 // Errors only where the reference is at least 3 levels finer.
-                let err = (level + 3 <= REFERENCE_LEVEL).then(|| super::theorem_distance(&case, &sol, &rcase, &rsol));
+                let err = (level + 3 <= REFERENCE_LEVEL)
+                    .then(|| super::theorem_distance(&case, &sol, &rcase, &rsol));
                 rows.push(row(&scene, &case, kind, &sol, floor_s, err));
             }
         }
     }
     let _ = error::norms;
-    Ok(SpeedResult { rows, reference: (REFERENCE_LEVEL, rcase.problem.model.n_free), wall_s: t0.elapsed().as_secs_f64() })
+    Ok(SpeedResult {
+        rows,
+        reference: (REFERENCE_LEVEL, rcase.problem.model.n_free),
+        wall_s: t0.elapsed().as_secs_f64(),
+    })
 }
