@@ -87,3 +87,25 @@ pub fn csv_bytes<T: serde::Serialize>(records: &[T]) -> Result<Vec<u8>> {
     w.into_inner()
         .map_err(|e| Error::io("csv", std::io::Error::other(e.to_string())))
 }
+
+/// Serialize a number as itself when finite and as an empty field otherwise, so no NaN or
+/// infinity reaches a CSV report (a rate that cannot be fitted is blank).
+pub fn finite_or_empty<S: serde::Serializer>(
+    v: &f64,
+    s: S,
+) -> std::result::Result<S::Ok, S::Error> {
+    if v.is_finite() {
+        s.serialize_f64(*v)
+    } else {
+        s.serialize_str("")
+    }
+}
+
+/// `{:.3}` of a finite number, "n/a" otherwise.
+pub fn fmt3(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:.3}")
+    } else {
+        "n/a".into()
+    }
+}

@@ -192,11 +192,11 @@ fn run() -> anyhow::Result<()> {
             contact_rates::report::write_study(&result, &dir)?;
             for r in &result.rates {
                 println!(
-                    "{:7} {:16} rate {:6.3} +- {:.3} (levels {}){}",
+                    "{:7} {:16} rate {:>6} +- {} (levels {}){}",
                     r.method,
                     r.quantity,
-                    r.rate,
-                    r.stderr,
+                    contact_rates::io::fmt3(r.rate),
+                    contact_rates::io::fmt3(r.stderr),
                     r.levels_used,
                     r.threshold
                         .map(|t| format!(

@@ -73,6 +73,21 @@ fn user_scene_solves_and_studies_with_both_cones() {
     ] {
         assert!(report.join(f).exists(), "{f} missing");
     }
+    for f in [
+        "rates.csv",
+        "levels.csv",
+        "pressure.csv",
+        "gap.csv",
+        "README.md",
+    ] {
+        let text = std::fs::read_to_string(report.join(f))
+            .unwrap()
+            .to_lowercase();
+        let bad = text
+            .split(|c: char| !c.is_alphanumeric())
+            .any(|w| w == "nan" || w == "inf" || w == "infinity");
+        assert!(!bad, "{f}: {text}");
+    }
     let errors = std::fs::read_to_string(report.join("errors.csv")).unwrap();
     assert!(
         !errors.contains("NaN") && !errors.contains("inf"),

@@ -282,12 +282,12 @@ fn readme(res: &StudyResult) -> String {
     for r in &res.rates {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {:.3} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} |",
             r.method,
             r.quantity,
             fmt_rate(r),
             r.levels_used,
-            r.rate_dofs,
+            crate::io::fmt3(r.rate_dofs),
             r.successive,
             r.threshold
                 .map(|t| if t < 0.01 {

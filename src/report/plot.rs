@@ -237,6 +237,40 @@ pub fn colormap(t: f64) -> RGBColor {
     RGBColor(c(0), c(1), c(2))
 }
 
+type Square<'a, 'b> = ChartContext<
+    'a,
+    BitMapBackend<'b>,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// A chart with equal aspect ratio around the triangles (the shorter range padded).
+fn square_chart<'a, 'b>(
+    area: &'a DrawingArea<BitMapBackend<'b>, plotters::coord::Shift>,
+    title: &str,
+    size: u32,
+    triangles: &[[[f64; 2]; 3]],
+    path: &Path,
+) -> Result<Square<'a, 'b>> {
+    let (x0, x1) = range(triangles.iter().flat_map(|t| t.iter().map(|v| v[0])), false);
+    let (y0, y1) = range(triangles.iter().flat_map(|t| t.iter().map(|v| v[1])), false);
+    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    let half = 0.5 * (x1 - x0).max(y1 - y0);
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, ("sans-serif", size))
+        .margin(10)
+        .x_label_area_size(30)
+        .y_label_area_size(40)
+        .build_cartesian_2d(cx - half..cx + half, cy - half..cy + half)
+        .map_err(err(path))?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .label_style(("sans-serif", 12))
+        .draw()
+        .map_err(err(path))?;
+    Ok(chart)
+}
+
 /// One panel of a field plot: triangles coloured by a value.
 pub struct Panel {
     /// Panel title.
@@ -262,30 +296,7 @@ pub fn field_panels(path: &Path, title: &str, bar_label: &str, panels: &[Panel])
     let (main, bar) = root.split_horizontally(w - 140);
     let areas = main.split_evenly((1, panels.len()));
     for (p, area) in panels.iter().zip(areas.iter()) {
-        let (x0, x1) = range(
-            p.triangles.iter().flat_map(|t| t.iter().map(|v| v[0])),
-            false,
-        );
-        let (y0, y1) = range(
-            p.triangles.iter().flat_map(|t| t.iter().map(|v| v[1])),
-            false,
-        );
-        // Equal aspect: pad the shorter range.
-        let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-        let half = 0.5 * (x1 - x0).max(y1 - y0);
-        let mut chart = ChartBuilder::on(area)
-            .caption(&p.title, ("sans-serif", 17))
-            .margin(10)
-            .x_label_area_size(30)
-            .y_label_area_size(40)
-            .build_cartesian_2d(cx - half..cx + half, cy - half..cy + half)
-            .map_err(err(path))?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .label_style(("sans-serif", 12))
-            .draw()
-            .map_err(err(path))?;
+        let mut chart = square_chart(area, &p.title, 17, &p.triangles, path)?;
         for (i, t) in p.triangles.iter().enumerate() {
             let c = colormap((p.values[i] - vmin) / (vmax - vmin).max(f64::MIN_POSITIVE));
             let pts: Vec<(f64, f64)> = t.iter().map(|v| (v[0], v[1])).collect();
@@ -373,29 +384,7 @@ pub fn mesh_panels(path: &Path, title: &str, panels: &[MeshPanel]) -> Result<()>
     let areas = root.split_evenly((1, panels.len()));
     let fills = [RGBColor(198, 219, 239), RGBColor(253, 208, 162)];
     for (p, area) in panels.iter().zip(areas.iter()) {
-        let (x0, x1) = range(
-            p.triangles.iter().flat_map(|t| t.iter().map(|v| v[0])),
-            false,
-        );
-        let (y0, y1) = range(
-            p.triangles.iter().flat_map(|t| t.iter().map(|v| v[1])),
-            false,
-        );
-        let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-        let half = 0.5 * (x1 - x0).max(y1 - y0);
-        let mut chart = ChartBuilder::on(area)
-            .caption(&p.title, ("sans-serif", 16))
-            .margin(10)
-            .x_label_area_size(30)
-            .y_label_area_size(40)
-            .build_cartesian_2d(cx - half..cx + half, cy - half..cy + half)
-            .map_err(err(path))?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .label_style(("sans-serif", 12))
-            .draw()
-            .map_err(err(path))?;
+        let mut chart = square_chart(area, &p.title, 16, &p.triangles, path)?;
         for (i, t) in p.triangles.iter().enumerate() {
             let pts: Vec<(f64, f64)> = t.iter().map(|v| (v[0], v[1])).collect();
             let fill = fills[(p.body[i].max(1) - 1) as usize % 2];

@@ -59,8 +59,10 @@ pub struct RateRow {
     /// Quantity.
     pub quantity: String,
     /// Fitted rate in h.
+    #[serde(serialize_with = "crate::io::finite_or_empty")]
     pub rate: f64,
     /// Standard error of the rate.
+    #[serde(serialize_with = "crate::io::finite_or_empty")]
     pub stderr: f64,
     /// Levels used in the fit, e.g. "0 1 2 3".
     pub levels_used: String,
@@ -69,6 +71,7 @@ pub struct RateRow {
     /// Whether the rate meets the threshold (theorem only).
     pub pass: Option<bool>,
     /// Rate against dofs (error ~ dofs^-rate_dofs).
+    #[serde(serialize_with = "crate::io::finite_or_empty")]
     pub rate_dofs: f64,
     /// Successive rates between neighbouring levels, space separated.
     pub successive: String,

@@ -12,11 +12,12 @@ pub struct Fit {
 }
 
 /// Least-squares fit of log(y) = intercept + rate log(x); None with fewer than 2 points.
+/// Values of y at or below 1e-12 are left out: relative errors at round-off carry no rate.
 pub fn fit(x: &[f64], y: &[f64]) -> Option<Fit> {
     let pts: Vec<(f64, f64)> = x
         .iter()
         .zip(y)
-        .filter(|(a, b)| **a > 0.0 && **b > 0.0 && a.is_finite() && b.is_finite())
+        .filter(|(a, b)| **a > 0.0 && **b > 1e-12 && a.is_finite() && b.is_finite())
         .map(|(a, b)| (a.ln(), b.ln()))
         .collect();
     let n = pts.len();
