@@ -5,7 +5,7 @@
 // sides of both bodies. The two contact lines are separate copies (AutoCoherence = 0), so
 // the meshes do not match there.
 Geometry.AutoCoherence = 0;
-DefineConstant[ h1 = 0.105, h2 = 0.09, matching = 0 ];
+DefineConstant[ h1 = 0.12, h2 = 0.0985, matching = 0 ];
 Point(1) = {0, 0, 0, h1}; Point(2) = {1, 0, 0, h1}; Point(3) = {1, 0.25, 0, h1};
 Point(4) = {1, 0.75, 0, h1}; Point(5) = {1, 1, 0, h1}; Point(6) = {0, 1, 0, h1};
 Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 5}; Line(5) = {5, 6}; Line(6) = {6, 1};

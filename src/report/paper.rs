@@ -168,7 +168,7 @@ pub fn write_paper(res: &PaperResult, dir: &Path) -> Result<()> {
         )?;
         let _ = writeln!(
             s,
-            "## Test 1: straight contact line\n\nReconstruction: body 1 = [0,1]x[0,1] embedded on its left side x = 0, body 2 = [1,2]x[0.25,0.75]; symmetry (u_y = 0, zero tangential traction) on the upper and lower sides of both bodies, body 1's right side free outside the contact line; contact line x = 1, 0.25 <= y <= 0.75 (body 1 carries the constraint); a pressure of magnitude 10 t on body 2's right side pushing the bodies together (the paper prints g^2 = (10t, 0); with body 2 on the right this is (-10 t, 0) in our axes). E = 100, nu = 0.3, lambda = 100, sigma_Y = sqrt(10). Mesh sizes 0.105 and 0.09 give {} and {} triangles (paper: 214 and 141).\n",
+            "## Test 1: straight contact line\n\nReconstruction: body 1 = [0,1]x[0,1] embedded on its left side x = 0, body 2 = [1,2]x[0.25,0.75]; symmetry (u_y = 0, zero tangential traction) on the upper and lower sides of both bodies, body 1's right side free outside the contact line; contact line x = 1, 0.25 <= y <= 0.75 (body 1 carries the constraint); a pressure of magnitude 10 t on body 2's right side pushing the bodies together (the paper prints g^2 = (10t, 0); with body 2 on the right this is (-10 t, 0) in our axes). E = 100, nu = 0.3, lambda = 100, sigma_Y = sqrt(10). Mesh sizes 0.12 and 0.0985 give {} and {} triangles (paper: 214 and 141).\n",
             m1.triangles[0], m1.triangles[1]
         );
         let _ = writeln!(
