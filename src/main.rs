@@ -136,6 +136,37 @@ fn run() -> anyhow::Result<()> {
                 }
                 return Ok(());
             }
+            if name == "stability" {
+                let res = contact_rates::study::stability::run()?;
+                let dir =
+                    out.unwrap_or_else(|| contact_rates::report::reports_dir().join("stability"));
+                contact_rates::report::write_stability(&res, &dir)?;
+                for r in &res.rows {
+                    println!(
+                        "{:26} {:36} {:7} {:7} converged {:5} iterations max {:3} mean {:6.1} error {:9} {:.2} s{}",
+                        r.case,
+                        r.parameter,
+                        r.method,
+                        r.solver,
+                        r.converged,
+                        r.max_step_iterations,
+                        r.mean_step_iterations,
+                        if r.error.is_finite() {
+                            format!("{:.2e}", r.error)
+                        } else {
+                            "-".into()
+                        },
+                        r.wall_s,
+                        if r.converged {
+                            String::new()
+                        } else {
+                            format!(": {}", r.reason)
+                        }
+                    );
+                }
+                println!("wrote {} ({:.1} s)", dir.display(), res.wall_s);
+                return Ok(());
+            }
             if name == "speed" {
                 let res = contact_rates::study::speed::run()?;
                 let dir = out.unwrap_or_else(|| contact_rates::report::reports_dir().join("speed"));

@@ -545,3 +545,131 @@ pub fn write_speed(res: &crate::study::speed::SpeedResult, dir: &Path) -> Result
         write(d, "README.md", s.as_bytes())
     })
 }
+
+/// Write the report of `study stability`.
+pub fn write_stability(res: &crate::study::stability::StabilityResult, dir: &Path) -> Result<()> {
+    write_folder(dir, |d| {
+        write(d, "stability.csv", &csv_bytes(&res.rows)?)?;
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "# Study `stability`\n\nHard cases, each run with every solver and both cones (level 1 of the `rates` scene with 4 steps unless stated). A failure is a result: `converged = no` with the solver's reason. `error` is the largest nodal difference to newton's solution of the same discrete problem, relative to the largest displacement. Regenerate with `cargo run --release -- study stability` ({:.0} s).\n",
+            res.wall_s
+        );
+        for (name, file) in [
+            ("stiff viscosity", "stiff_viscosity"),
+            ("omega sweep", "omega_sweep"),
+        ] {
+            let rows: Vec<_> = res
+                .rows
+                .iter()
+                .filter(|r| r.case == name && r.method == "mortar")
+                .collect();
+            let mut its = Vec::new();
+            let mut errs = Vec::new();
+            for (i, so) in ["newton", "paper", "qp"].iter().enumerate() {
+                let pts: Vec<(f64, f64)> = rows
+                    .iter()
+                    .filter(|r| r.solver == *so && r.converged)
+                    .map(|r| (r.value, r.mean_step_iterations.max(1e-3)))
+                    .collect();
+                if !pts.is_empty() {
+                    its.push(Series {
+                        label: format!("{so} (converged runs)"),
+                        points: pts,
+                        markers: true,
+                        line: true,
+                        color: i,
+                        thin: false,
+                    });
+                }
+                let pe: Vec<(f64, f64)> = rows
+                    .iter()
+                    .filter(|r| r.solver == *so && r.converged && r.error > 0.0)
+                    .map(|r| (r.value, r.error))
+                    .collect();
+                if !pe.is_empty() {
+                    errs.push(Series {
+                        label: format!("{so}: difference to newton"),
+                        points: pe,
+                        markers: true,
+                        line: true,
+                        color: i,
+                        thin: false,
+                    });
+                }
+            }
+            let xlabel = if name == "stiff viscosity" {
+                "k E / lambda"
+            } else {
+                "omega / automatic omega"
+            };
+            plot::loglog(
+                &d.join(format!("{file}_iterations.png")),
+                &format!("{name}: mean iterations per step (mortar)"),
+                xlabel,
+                "iterations per step",
+                &its,
+                &[],
+            )?;
+            if !errs.is_empty() {
+                plot::loglog(
+                    &d.join(format!("{file}_error.png")),
+                    &format!("{name}: difference to newton (mortar)"),
+                    xlabel,
+                    "relative nodal difference",
+                    &errs,
+                    &[],
+                )?;
+            }
+        }
+        let mut cases: Vec<&str> = Vec::new();
+        for r in &res.rows {
+            if !cases.contains(&r.case.as_str()) {
+                cases.push(&r.case);
+            }
+        }
+        for c in cases {
+            let _ = writeln!(s, "## {c}\n");
+            if c == "stiff viscosity" {
+                let _ = writeln!(s, "![iterations](stiff_viscosity_iterations.png)\n");
+            }
+            if c == "omega sweep" {
+                let _ = writeln!(
+                    s,
+                    "![iterations](omega_sweep_iterations.png)\n\n![error](omega_sweep_error.png)\n"
+                );
+            }
+            let _ = writeln!(
+                s,
+                "| parameter | method | solver | converged | max / mean iterations per step | error | max penetration | wall (s) | reason |\n|---|---|---|---|---|---|---|---|---|"
+            );
+            for r in res.rows.iter().filter(|r| r.case == c) {
+                let _ = writeln!(
+                    s,
+                    "| {} | {} | {} | {} | {} / {:.1} | {} | {} | {:.3} | {} |",
+                    r.parameter,
+                    r.method,
+                    r.solver,
+                    if r.converged { "yes" } else { "**no**" },
+                    r.max_step_iterations,
+                    r.mean_step_iterations,
+                    if r.error.is_finite() {
+                        format!("{:.2e}", r.error)
+                    } else {
+                        String::new()
+                    },
+                    if r.max_penetration.is_finite() {
+                        format!("{:.2e}", r.max_penetration)
+                    } else {
+                        String::new()
+                    },
+                    r.wall_s,
+                    r.reason.replace('|', "/")
+                );
+            }
+            let _ = writeln!(s);
+        }
+        write(d, "README.md", s.as_bytes())
+    })
+}

@@ -16,6 +16,7 @@ pub mod jobs;
 pub mod paper;
 pub mod rates;
 pub mod speed;
+pub mod stability;
 
 use crate::case::Case;
 use crate::contact::Method;

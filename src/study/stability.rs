@@ -1,0 +1,314 @@
+//! `study stability`: hard cases where naive solvers fail, each run with every solver and
+//! both cones. A case where a solver fails is a result (converged = false, with its reason),
+//! not an error. The error of a run is its largest nodal difference to the `newton` solution
+//! of the same discrete problem, relative to the largest displacement.
+
+use crate::case::Case;
+use crate::contact::Method;
+use crate::error::{Error, Result};
+use crate::metrics;
+use crate::scene::Scene;
+use crate::solve::{self, Settings, Solution, SolverKind};
+use serde::Serialize;
+
+/// One row of stability.csv.
+#[derive(Debug, Clone, Serialize)]
+pub struct StabilityRow {
+    /// Case name.
+    pub case: String,
+    /// Swept parameter and its value, e.g. "k E / lambda = 1e2".
+    pub parameter: String,
+    /// Numeric value of the parameter (for plots).
+    pub value: f64,
+    /// Cone.
+    pub method: String,
+    /// Solver.
+    pub solver: String,
+    /// Whether the solver converged on every step.
+    pub converged: bool,
+    /// Why it stopped (for a failure, the solver's message).
+    pub reason: String,
+    /// Largest iteration count of one step.
+    pub max_step_iterations: usize,
+    /// Mean iterations per step.
+    pub mean_step_iterations: f64,
+    /// Relative nodal difference to newton's solution of the same problem (blank if none).
+    #[serde(serialize_with = "crate::io::finite_or_empty")]
+    pub error: f64,
+    /// Largest interpenetration over the history (length units; blank if not converged).
+    #[serde(serialize_with = "crate::io::finite_or_empty")]
+    pub max_penetration: f64,
+    /// Wall time (s).
+    pub wall_s: f64,
+}
+
+/// What `study stability` measured.
+#[derive(Debug, Clone)]
+pub struct StabilityResult {
+    /// All runs.
+    pub rows: Vec<StabilityRow>,
+    /// Total wall time (s).
+    pub wall_s: f64,
+}
+
+struct Variant {
+    case: &'static str,
+    parameter: String,
+    value: f64,
+    scene: Scene,
+    level: usize,
+    params: Vec<(String, f64)>,
+    steps: usize,
+    solvers: Vec<(SolverKind, Settings)>,
+}
+
+fn default_solvers() -> Vec<(SolverKind, Settings)> {
+    [SolverKind::Newton, SolverKind::Paper, SolverKind::Qp]
+        .into_iter()
+        .map(|k| {
+            (
+                k,
+                Settings {
+                    kind: k,
+                    max_iterations: 100,
+                    ..Settings::default()
+                },
+            )
+        })
+        .collect()
+}
+
+fn set_young(scene: &mut Scene, body: usize, e: f64) {
+    scene.bodies[body].material.elastic.young = e;
+}
+
+fn plan() -> Result<Vec<Variant>> {
+    let rates = Scene::load("rates")?;
+    let patch = Scene::load("patch")?;
+    let mut v = Vec::new();
+    let base = |case: &'static str, parameter: String, value: f64, scene: Scene| Variant {
+        case,
+        parameter,
+        value,
+        scene,
+        level: 1,
+        params: Vec::new(),
+        steps: 4,
+        solvers: default_solvers(),
+    };
+    // Stiff viscosity: k E / lambda from 1e-2 to 1e4 at k = 0.25, E = 100.
+    for exp in [-2, -1, 0, 1, 2, 3, 4] {
+        let ratio = 10f64.powi(exp);
+        let mut s = rates.clone();
+        for b in 0..2 {
+            if let Some(vp) = s.bodies[b].material.viscoplastic.as_mut() {
+                vp.lambda = 0.25 * 100.0 / ratio;
+            }
+        }
+        v.push(base(
+            "stiff viscosity",
+            format!("k E / lambda = 1e{exp}"),
+            ratio,
+            s,
+        ));
+    }
+    // Young's modulus contrast between the bodies.
+    for exp in [0, 2, 4, 6] {
+        let mut s = rates.clone();
+        set_young(&mut s, 1, 100.0 * 10f64.powi(exp));
+        v.push(base(
+            "modulus contrast",
+            format!("E2 / E1 = 1e{exp}"),
+            10f64.powi(exp),
+            s,
+        ));
+    }
+    // Mesh-size ratio h1/h2 from 1/16 to 16.
+    for r in [1.0 / 16.0, 0.25, 1.0, 4.0, 16.0] {
+        let mut var = base(
+            "mesh-size ratio",
+            format!("h1 / h2 = {r}"),
+            r,
+            rates.clone(),
+        );
+        var.params = vec![
+            ("h_upper".into(), 0.2 * f64::sqrt(r)),
+            ("h_lower".into(), 0.2 / f64::sqrt(r)),
+            ("grading".into(), 1.3),
+        ];
+        var.level = 0;
+        v.push(var);
+    }
+    // Slave and master swapped: the lower block carries the constraint.
+    {
+        let mut s = rates.clone();
+        s.bodies.swap(0, 1);
+        std::mem::swap(&mut s.slave_curve, &mut s.master_curve);
+        v.push(base(
+            "slave and master swapped",
+            "slave = lower block".into(),
+            1.0,
+            s,
+        ));
+    }
+    // A body held only by contact (the patch scene's upper block), E = 3e5: the paper's
+    // fixed point needs k L < 1, so it is run with 4 steps like the others.
+    v.push(base(
+        "held only by contact",
+        "patch, upper block".into(),
+        1.0,
+        patch.clone(),
+    ));
+    // Near-coincident (uniform sizing: 1e-11 h apart after splitting) and coincident nodes.
+    {
+        let mut var = base(
+            "near-coincident nodes",
+            "grading = 1 (nodes 1e-11 h apart)".into(),
+            1.0,
+            rates.clone(),
+        );
+        var.params = vec![("grading".into(), 1.0)];
+        var.level = 2;
+        v.push(var);
+        let mut var = base(
+            "coincident nodes",
+            "matching = 1".into(),
+            1.0,
+            rates.clone(),
+        );
+        var.params = vec![("matching".into(), 1.0)];
+        v.push(var);
+    }
+    // One single time step over [0, T].
+    {
+        let mut var = base("single time step", "steps = 1".into(), 1.0, rates.clone());
+        var.steps = 1;
+        v.push(var);
+    }
+    // The paper's penalty parameter omega over 8 decades around the automatic value.
+    for exp in [-4, -2, 0, 2, 4] {
+        let mut var = base(
+            "omega sweep",
+            format!("omega = 1e{exp} x automatic"),
+            10f64.powi(exp),
+            rates.clone(),
+        );
+        var.solvers = vec![
+            (SolverKind::Newton, Settings::default()),
+            (
+                SolverKind::Paper,
+                Settings {
+                    kind: SolverKind::Paper,
+                    max_iterations: 100,
+                    omega: Some(omega_auto(&rates)? * 10f64.powi(exp)),
+                    ..Settings::default()
+                },
+            ),
+        ];
+        v.push(var);
+    }
+    Ok(v)
+}
+
+/// The automatic omega of the paper solver on the rates scene at level 1 (mean stiffness
+/// diagonal over mean trace weight), so the sweep is stated relative to it.
+fn omega_auto(scene: &Scene) -> Result<f64> {
+    let case = Case::build(scene, 1, Method::Mortar, &[])?;
+    let p = &case.problem;
+    let (pattern, slots) = p.model.stiffness_pattern(&[], p.model.n_free);
+    let mut vals = vec![0.0; pattern.nnz()];
+    p.model
+        .add_tangent(&p.model.elastic_tangents(), &slots, &mut vals);
+    let d = (0..p.model.n_free)
+        .map(|i| vals[pattern.slot(i, i)])
+        .sum::<f64>()
+        / p.model.n_free as f64;
+    let w = p.rows.iter().map(|r| r.weight).sum::<f64>() / p.rows.len() as f64;
+    Ok(d / w)
+}
+
+fn rel_diff(a: &Solution, b: &Solution) -> f64 {
+    let (ua, ub) = (&a.last().u, &b.last().u);
+    let m = ub
+        .iter()
+        .fold(0.0f64, |x, v| x.max(v.abs()))
+        .max(f64::MIN_POSITIVE);
+    ua.iter()
+        .zip(ub)
+        .fold(0.0f64, |x, (p, q)| x.max((p - q).abs()))
+        / m
+}
+
+/// Run every case with every solver and both cones.
+pub fn run() -> Result<StabilityResult> {
+    let t0 = std::time::Instant::now();
+    let mut rows = Vec::new();
+    for var in plan()? {
+        for method in [Method::Mortar, Method::Nts] {
+            let case = Case::build(&var.scene, var.level, method, &var.params)?;
+            let mut newton: Option<Solution> = None;
+            for (kind, settings) in &var.solvers {
+                let t = std::time::Instant::now();
+                let out = solve::solve(&case.problem, settings, var.steps, true);
+                let wall_s = t.elapsed().as_secs_f64();
+                let row = match out {
+                    Ok(sol) => {
+                        let error = match &newton {
+                            Some(n) => rel_diff(&sol, n),
+                            None if *kind == SolverKind::Newton => 0.0,
+                            None => f64::NAN,
+                        };
+                        let pen = sol
+                            .states
+                            .iter()
+                            .map(|s| metrics::max_penetration(&case.problem, s))
+                            .fold(0.0, f64::max);
+                        let r = StabilityRow {
+                            case: var.case.into(),
+                            parameter: var.parameter.clone(),
+                            value: var.value,
+                            method: method.name().into(),
+                            solver: kind.name().into(),
+                            converged: true,
+                            reason: sol
+                                .reports
+                                .last()
+                                .map(|r| r.reason.clone())
+                                .unwrap_or_default(),
+                            max_step_iterations: sol.max_step_iterations(),
+                            mean_step_iterations: sol.iterations() as f64
+                                / sol.reports.len().max(1) as f64,
+                            error,
+                            max_penetration: pen,
+                            wall_s,
+                        };
+                        if *kind == SolverKind::Newton {
+                            newton = Some(sol);
+                        }
+                        r
+                    }
+                    Err(Error::NotConverged(msg)) => StabilityRow {
+                        case: var.case.into(),
+                        parameter: var.parameter.clone(),
+                        value: var.value,
+                        method: method.name().into(),
+                        solver: kind.name().into(),
+                        converged: false,
+                        reason: msg,
+                        max_step_iterations: 0,
+                        mean_step_iterations: 0.0,
+                        error: f64::NAN,
+                        max_penetration: f64::NAN,
+                        wall_s,
+                    },
+                    Err(e) => return Err(e),
+                };
+                rows.push(row);
+            }
+        }
+    }
+    Ok(StabilityResult {
+        rows,
+        wall_s: t0.elapsed().as_secs_f64(),
+    })
+}
