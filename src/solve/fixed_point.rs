@@ -340,6 +340,13 @@ impl StepSolver for FixedPoint<'_> {
                     lambda,
                 };
                 let residual = super::equilibrium_residual(p, &state, &f_ext);
+                // The fixed point can settle while an inaccurate inner solve (an interior
+                // point on an ill-conditioned QP) leaves the equations unsatisfied: check them.
+                if !(residual <= 1e-6) {
+                    return Err(Error::NotConverged(format!(
+                        "the fixed point settled after {outer} iterations but the equilibrium residual of (2.1) is {residual:.3e} (> 1e-6): the contact subproblems were solved inaccurately"
+                    )));
+                }
                 return Ok((
                     state,
                     StepReport {
