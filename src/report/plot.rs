@@ -60,42 +60,31 @@ fn range(points: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
     }
 }
 
-/// A log-log plot with optional reference slope triangles (slopes given with labels).
-pub fn loglog(
-    path: &Path,
-    title: &str,
-    xlabel: &str,
-    ylabel: &str,
+/// The x and y ranges of all series' points (padded; positive values only when `log`).
+fn bounds(series: &[Series], log: bool) -> ((f64, f64), (f64, f64)) {
+    (
+        range(
+            series.iter().flat_map(|s| s.points.iter().map(|p| p.0)),
+            log,
+        ),
+        range(
+            series.iter().flat_map(|s| s.points.iter().map(|p| p.1)),
+            log,
+        ),
+    )
+}
+
+/// Draw every series (lines with their legend entry, markers of `radius` pixels, a marker
+/// legend entry for marker-only series) on a chart with (f64, f64) data coordinates.
+fn draw_series<'b, CT>(
+    chart: &mut ChartContext<'_, BitMapBackend<'b>, CT>,
     series: &[Series],
-    slopes: &[(f64, &str)],
-) -> Result<()> {
-    register();
-    let root = BitMapBackend::new(path, (900, 650)).into_drawing_area();
-    root.fill(&WHITE).map_err(err(path))?;
-    let (x0, x1) = range(
-        series.iter().flat_map(|s| s.points.iter().map(|p| p.0)),
-        true,
-    );
-    let (y0, y1) = range(
-        series.iter().flat_map(|s| s.points.iter().map(|p| p.1)),
-        true,
-    );
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 22))
-        .margin(15)
-        .x_label_area_size(50)
-        .y_label_area_size(80)
-        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
-        .map_err(err(path))?;
-    chart
-        .configure_mesh()
-        .x_desc(xlabel)
-        .y_desc(ylabel)
-        .label_style(("sans-serif", 15))
-        .x_label_formatter(&|v| format!("{v:.3}"))
-        .y_label_formatter(&|v| format!("{v:.1e}"))
-        .draw()
-        .map_err(err(path))?;
+    radius: u32,
+    path: &Path,
+) -> Result<()>
+where
+    CT: CoordTranslate<From = (f64, f64)>,
+{
     for s in series {
         let c = COLORS[s.color % COLORS.len()];
         let style = if s.thin {
@@ -112,14 +101,47 @@ pub fn loglog(
         }
         if s.markers {
             let a = chart
-                .draw_series(s.points.iter().map(|&p| Circle::new(p, 5, c.filled())))
+                .draw_series(s.points.iter().map(|&p| Circle::new(p, radius, c.filled())))
                 .map_err(err(path))?;
             if !s.line {
                 a.label(s.label.clone())
-                    .legend(move |(x, y)| Circle::new((x + 10, y), 5, c.filled()));
+                    .legend(move |(x, y)| Circle::new((x + 10, y), radius, c.filled()));
             }
         }
     }
+    Ok(())
+}
+
+/// A log-log plot with optional reference slope triangles (slopes given with labels).
+pub fn loglog(
+    path: &Path,
+    title: &str,
+    xlabel: &str,
+    ylabel: &str,
+    series: &[Series],
+    slopes: &[(f64, &str)],
+) -> Result<()> {
+    register();
+    let root = BitMapBackend::new(path, (900, 650)).into_drawing_area();
+    root.fill(&WHITE).map_err(err(path))?;
+    let ((x0, x1), (y0, y1)) = bounds(series, true);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 22))
+        .margin(15)
+        .x_label_area_size(50)
+        .y_label_area_size(80)
+        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+        .map_err(err(path))?;
+    chart
+        .configure_mesh()
+        .x_desc(xlabel)
+        .y_desc(ylabel)
+        .label_style(("sans-serif", 15))
+        .x_label_formatter(&|v| format!("{v:.3}"))
+        .y_label_formatter(&|v| format!("{v:.1e}"))
+        .draw()
+        .map_err(err(path))?;
+    draw_series(&mut chart, series, 5, path)?;
     // Reference slope triangles in the lower right corner, stacked.
     let lx1 = x1 / 2.2;
     let lx0 = lx1 / 1.5;
@@ -164,14 +186,7 @@ pub fn lines(
     register();
     let root = BitMapBackend::new(path, (900, 550)).into_drawing_area();
     root.fill(&WHITE).map_err(err(path))?;
-    let (x0, x1) = range(
-        series.iter().flat_map(|s| s.points.iter().map(|p| p.0)),
-        false,
-    );
-    let (y0, y1) = range(
-        series.iter().flat_map(|s| s.points.iter().map(|p| p.1)),
-        false,
-    );
+    let ((x0, x1), (y0, y1)) = bounds(series, false);
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 20))
         .margin(15)
@@ -187,24 +202,7 @@ pub fn lines(
         .y_label_formatter(&|v| format!("{v:.2e}"))
         .draw()
         .map_err(err(path))?;
-    for s in series {
-        let c = COLORS[s.color % COLORS.len()];
-        let style = if s.thin {
-            c.stroke_width(1)
-        } else {
-            c.stroke_width(2)
-        };
-        chart
-            .draw_series(LineSeries::new(s.points.iter().copied(), style))
-            .map_err(err(path))?
-            .label(s.label.clone())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
-        if s.markers {
-            chart
-                .draw_series(s.points.iter().map(|&p| Circle::new(p, 3, c.filled())))
-                .map_err(err(path))?;
-        }
-    }
+    draw_series(&mut chart, series, 3, path)?;
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.85))
