@@ -444,6 +444,8 @@ impl Model {
         k: f64,
         tangent: bool,
     ) -> (Vec<Stress>, Vec<Matrix3<f64>>) {
+        // Serial on purpose: a rayon version (chunks of 1024 triangles) was measured slower
+        // on 2 cores at 14k triangles (9-11 ms against 6 ms per 4-step solve).
         let mut sig = Vec::with_capacity(self.elements.len());
         let mut tan = Vec::with_capacity(if tangent { self.elements.len() } else { 0 });
         for (i, e) in self.elements.iter().enumerate() {
@@ -483,6 +485,34 @@ impl Model {
         for ((e, d), sl) in self.elements.iter().zip(tangents).zip(slots) {
             let b = e.b_matrix();
             let ke = b.transpose() * (d * s) * b * e.area;
+            for i in 0..6 {
+                for j in 0..6 {
+                    let slot = sl[6 * i + j];
+                    if slot != FIXED {
+                        values[slot] += ke[(i, j)];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Add `|T| B^T (D - E) S B` for the elements whose tangent D differs from the elastic
+    /// E of their body (the viscoplastic ones): on top of the assembled elastic stiffness,
+    /// this assembles the consistent tangent while elastic triangles cost nothing.
+    pub fn add_tangent_change(
+        &self,
+        tangents: &[Matrix3<f64>],
+        slots: &[[usize; 36]],
+        values: &mut [f64],
+    ) {
+        let s = Matrix3::from_diagonal(&SVector::<f64, 3>::new(1.0, 1.0, 0.5));
+        for ((e, d), sl) in self.elements.iter().zip(tangents).zip(slots) {
+            let elastic = self.materials[e.body].elastic.matrix();
+            if *d == elastic {
+                continue;
+            }
+            let b = e.b_matrix();
+            let ke = b.transpose() * ((d - elastic) * s) * b * e.area;
             for i in 0..6 {
                 for j in 0..6 {
                     let slot = sl[6 * i + j];

@@ -38,6 +38,8 @@ pub struct FixedPoint<'a> {
     /// Stored eta of the last step (warm start).
     eta: Option<Vec<Stress>>,
     clarabel_s: f64,
+    /// Seconds building the pattern and slot map (once per mesh).
+    pattern_s: f64,
 }
 
 fn inf_norm(v: &[f64]) -> f64 {
@@ -47,6 +49,7 @@ fn inf_norm(v: &[f64]) -> f64 {
 impl<'a> FixedPoint<'a> {
     /// Assemble and factorize the constant matrix.
     pub fn new(p: &'a Problem, settings: &Settings, inner: Inner) -> Result<Self> {
+        let t_setup = std::time::Instant::now();
         let model = &p.model;
         let n = model.n_free;
         let mut extra = Vec::new();
@@ -61,6 +64,7 @@ impl<'a> FixedPoint<'a> {
         }
         let (pattern, slots) = model.stiffness_pattern(&extra, n);
         let mut system = SparseSystem::new(&pattern);
+        let pattern_s = t_setup.elapsed().as_secs_f64();
         let tangents = model.elastic_tangents();
         let vals = system.values_mut();
         model.add_tangent(&tangents, &slots, vals);
@@ -105,6 +109,7 @@ impl<'a> FixedPoint<'a> {
             q: vec![0.0; p.rows.len()],
             eta: None,
             clarabel_s: 0.0,
+            pattern_s,
         })
     }
 
@@ -382,6 +387,7 @@ impl StepSolver for FixedPoint<'_> {
         super::Timings {
             factor_s: self.system.factor_s + self.clarabel_s,
             factorizations: self.system.factorizations,
+            setup_s: self.pattern_s + self.system.symbolic_s,
             ..Default::default()
         }
     }

@@ -3,9 +3,9 @@
 
 use crate::error::{Error, Result};
 use crate::fe::Pattern;
+use faer::Side;
 use faer::sparse::linalg::solvers::{Llt, Lu, SymbolicLlt, SymbolicLu};
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
-use faer::{Mat, Side};
 use std::time::Instant;
 
 /// A square sparse matrix with a fixed pattern and a reusable symbolic factorization.
@@ -18,6 +18,8 @@ pub struct SparseSystem {
     llt: Option<Llt<usize, f64>>,
     /// Seconds spent in numeric factorizations.
     pub factor_s: f64,
+    /// Seconds spent in the one-off symbolic analysis (ordering, elimination tree).
+    pub symbolic_s: f64,
     /// Number of numeric factorizations.
     pub factorizations: usize,
 }
@@ -40,6 +42,7 @@ impl SparseSystem {
             lu: None,
             llt: None,
             factor_s: 0.0,
+            symbolic_s: 0.0,
             factorizations: 0,
         }
     }
@@ -49,14 +52,23 @@ impl SparseSystem {
         self.mat.val_mut()
     }
 
-    /// LU factorization with partial pivoting (any invertible matrix).
-    pub fn factor_lu(&mut self) -> Result<()> {
+    /// The symbolic analysis of the LU factorization (once per pattern; timed apart from
+    /// the numeric factorizations).
+    pub fn analyze_lu(&mut self) -> Result<()> {
         if self.symbolic_lu.is_none() {
+            let t = Instant::now();
             self.symbolic_lu = Some(
                 SymbolicLu::try_new(self.mat.symbolic())
                     .map_err(|e| Error::NotConverged(format!("symbolic LU failed: {e:?}")))?,
             );
+            self.symbolic_s += t.elapsed().as_secs_f64();
         }
+        Ok(())
+    }
+
+    /// LU factorization with partial pivoting (any invertible matrix).
+    pub fn factor_lu(&mut self) -> Result<()> {
+        self.analyze_lu()?;
         let t = Instant::now();
         let lu = Lu::try_new_with_symbolic(self.symbolic_lu.clone().unwrap(), self.mat.as_ref())
             .map_err(|e| {
@@ -74,10 +86,12 @@ impl SparseSystem {
     /// Cholesky factorization (symmetric positive definite matrices; lower triangle read).
     pub fn factor_llt(&mut self) -> Result<()> {
         if self.symbolic_llt.is_none() {
+            let t = Instant::now();
             self.symbolic_llt = Some(
                 SymbolicLlt::try_new(self.mat.symbolic(), Side::Lower)
                     .map_err(|e| Error::NotConverged(format!("symbolic Cholesky failed: {e:?}")))?,
             );
+            self.symbolic_s += t.elapsed().as_secs_f64();
         }
         let t = Instant::now();
         let llt = Llt::try_new_with_symbolic(
@@ -99,22 +113,27 @@ impl SparseSystem {
 
     /// Solve with the last factorization, in place.
     pub fn solve(&self, rhs: &mut [f64]) {
-        use faer::linalg::solvers::Solve;
-        let mut m = Mat::<f64>::from_fn(rhs.len(), 1, |i, _| rhs[i]);
-        if let Some(lu) = &self.lu {
-            lu.solve_in_place(m.as_mut());
-        } else if let Some(llt) = &self.llt {
-            llt.solve_in_place(m.as_mut());
-        } else {
-            panic!("solve before factor");
-        }
-        for (i, r) in rhs.iter_mut().enumerate() {
-            *r = m[(i, 0)];
-        }
+        self.solve_many(rhs, 1);
     }
 }
 
 impl SparseSystem {
+    /// Solve with the last factorization for `k` right-hand sides stored column after
+    /// column in `rhs`, in place (one blocked solve: several times cheaper per column than
+    /// `k` single solves).
+    pub fn solve_many(&self, rhs: &mut [f64], k: usize) {
+        use faer::linalg::solvers::Solve;
+        let n = rhs.len() / k;
+        let m = faer::MatMut::from_column_major_slice_mut(rhs, n, k);
+        if let Some(lu) = &self.lu {
+            lu.solve_in_place(m);
+        } else if let Some(llt) = &self.llt {
+            llt.solve_in_place(m);
+        } else {
+            panic!("solve before factor");
+        }
+    }
+
     /// `y = A x` with the current values.
     pub fn matvec(&self, x: &[f64], y: &mut [f64]) {
         let (sym, val) = self.mat.parts();
@@ -136,13 +155,19 @@ impl SparseSystem {
         self.lu.is_some() || self.llt.is_some()
     }
 
-    /// Solve `A x = b` with the current values of A by GMRES, right-preconditioned with the
-    /// last factorization (of a possibly older matrix). Returns the iterations used, or None
-    /// when the relative residual `rtol` is not reached in `max_iter` iterations. `b` is
-    /// replaced by x.
+    /// Solve `A x = b` with the current values of A by GMRES, right-preconditioned with
+    /// `precondition` (in place: v -> M^{-1} v; typically the last factorization, of a
+    /// possibly older matrix). Returns the iterations used, or None when the relative
+    /// residual `rtol` is not reached in `max_iter` iterations. `b` is replaced by x.
     ///
     /// Written by hand: a few dozen lines, and the preconditioner is faer's factorization.
-    pub fn gmres(&self, b: &mut [f64], rtol: f64, max_iter: usize) -> Option<usize> {
+    pub fn gmres(
+        &self,
+        b: &mut [f64],
+        rtol: f64,
+        max_iter: usize,
+        precondition: &dyn Fn(&mut [f64]),
+    ) -> Option<usize> {
         let n = b.len();
         let dot = |a: &[f64], c: &[f64]| a.iter().zip(c).map(|(x, y)| x * y).sum::<f64>();
         let bnorm = dot(b, b).sqrt();
@@ -154,14 +179,16 @@ impl SparseSystem {
         let (mut cs, mut sn) = (vec![0.0; max_iter], vec![0.0; max_iter]);
         let mut g = vec![0.0; max_iter + 1];
         g[0] = bnorm;
-        let mut z = vec![0.0; n];
+        // Z = M^{-1} V is kept (flexible GMRES): x = Z y needs no further solve.
+        let mut zs: Vec<Vec<f64>> = Vec::with_capacity(max_iter);
         let mut w = vec![0.0; n];
         let mut k_done = 0;
         let mut converged = false;
         for k in 0..max_iter {
-            z.copy_from_slice(&v[k]);
-            self.solve(&mut z);
+            let mut z = v[k].clone();
+            precondition(&mut z);
             self.matvec(&z, &mut w);
+            zs.push(z);
             for i in 0..=k {
                 h[i][k] = dot(&w, &v[i]);
                 for (wj, vj) in w.iter_mut().zip(&v[i]) {
@@ -196,7 +223,7 @@ impl SparseSystem {
         if !converged {
             return None;
         }
-        // y = H^{-1} g, x = M^{-1} V y.
+        // y = H^{-1} g, x = M^{-1} V y = Z y.
         let mut y = vec![0.0; k_done];
         for i in (0..k_done).rev() {
             let s: f64 = (i + 1..k_done).map(|j| h[i][j] * y[j]).sum();
@@ -204,11 +231,10 @@ impl SparseSystem {
         }
         let mut x = vec![0.0; n];
         for (j, yj) in y.iter().enumerate() {
-            for (xi, vi) in x.iter_mut().zip(&v[j]) {
-                *xi += yj * vi;
+            for (xi, zi) in x.iter_mut().zip(&zs[j]) {
+                *xi += yj * zi;
             }
         }
-        self.solve(&mut x);
         b.copy_from_slice(&x);
         Some(k_done)
     }

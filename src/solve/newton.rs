@@ -1,8 +1,10 @@
 //! The default solver: exact implicit return map per triangle, consistent tangent, and a
 //! semismooth Newton (primal-dual active set) treatment of the contact rows, on the KKT
 //! system `[K C^T; C_A 0]` whose pattern (all rows present) and symbolic LU are fixed per
-//! mesh. The factorization is reused while the tangent is elastic and the active set is
-//! unchanged.
+//! mesh. One factorization serves many iterations and steps: each Newton system is solved
+//! by GMRES preconditioned with the last factorization, corrected exactly (Woodbury) for
+//! the contact rows whose active set changed since; it is refactorized only when GMRES
+//! needs many iterations (the tangent moved far from the factored one).
 
 use super::linear::SparseSystem;
 use super::{Problem, Settings, State, StepReport, StepSolver};
@@ -27,7 +29,15 @@ pub struct Newton<'a> {
 
     /// Scale turning gaps into forces in the complementarity function (force/length).
     c_scale: f64,
-    clock: Clock,
+    clock: std::rc::Rc<Clock>,
+    /// Seconds building the pattern, slot maps and symbolic analysis (once per mesh).
+    setup_s: f64,
+    /// Active set of the factored matrix.
+    factored_active: Vec<bool>,
+    /// The elastic stiffness in pattern order (contact entries zero).
+    elastic_values: Vec<f64>,
+    /// Columns A0^{-1} e_{n+i} of the factored matrix, computed when row i changes.
+    w_columns: Vec<Option<Vec<f64>>>,
 }
 
 /// Accumulated times of the solver's parts.
@@ -66,6 +76,7 @@ pub fn floor_time(p: &Problem, steps: usize) -> Result<f64> {
 impl<'a> Newton<'a> {
     /// Set up the KKT pattern and the symbolic analysis for `p`.
     pub fn new(p: &'a Problem, settings: &Settings) -> Result<Self> {
+        let t_setup = std::time::Instant::now();
         let n = p.model.n_free;
         let m = p.rows.len();
         let mut extra = Vec::new();
@@ -102,6 +113,8 @@ impl<'a> Newton<'a> {
             *d = vals[pattern.slot(i, i)];
         }
         let c_scale = diag.iter().sum::<f64>() / n.max(1) as f64;
+        let mut system = SparseSystem::new(&pattern);
+        system.analyze_lu()?;
         Ok(Newton {
             p,
             settings: *settings,
@@ -109,16 +122,122 @@ impl<'a> Newton<'a> {
             slots,
             row_slots,
             diag_slots,
-            system: SparseSystem::new(&pattern),
+            system,
             stale: false,
             c_scale,
-            clock: Clock::default(),
+            clock: Default::default(),
+            setup_s: t_setup.elapsed().as_secs_f64(),
+            factored_active: vec![true; m],
+            elastic_values: vals,
+            w_columns: vec![None; m],
         })
     }
 }
 
 fn inf_norm(v: &[f64]) -> f64 {
     v.iter().fold(0.0f64, |a, x| a.max(x.abs()))
+}
+
+/// An exact correction of the last factorization for the contact rows whose active or
+/// inactive form changed since it was computed (Sherman-Morrison-Woodbury on replaced rows):
+/// with A0 the factored KKT matrix and A = A0 + E_R D_R^T (rows n+i, i in R, replaced),
+/// A^{-1} = A0^{-1} - W (I + D_R^T W)^{-1} D_R^T A0^{-1}, W = A0^{-1} E_R. A change of the
+/// active set then costs one blocked solve for the new columns of W and a small dense LU
+/// instead of a sparse refactorization; GMRES is left with the tangent's changes only.
+struct RowUpdate {
+    /// Contact rows i in R.
+    rows: Vec<usize>,
+    /// Sign s_i: +1 when row i is active now and was inactive in A0, -1 the other way.
+    signs: Vec<f64>,
+    /// LU of the capacitance matrix I + D_R^T W (r x r).
+    capacitance: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
+}
+
+/// Largest number of stored entries of W (columns A0^{-1} e_{n+i}) before a refactorization
+/// is cheaper in memory: 5e7 doubles = 400 MB.
+const MAX_CORRECTION_ENTRIES: usize = 50_000_000;
+
+impl Newton<'_> {
+    /// Difference row D_i = s_i c (C_i - e_{n+i}) applied to `y`.
+    fn d_dot(&self, i: usize, sign: f64, y: &[f64]) -> f64 {
+        let dot: f64 = self.row_slots[i]
+            .iter()
+            .map(|&(_, _, eq, v)| v * y[eq])
+            .sum();
+        sign * self.c_scale * (dot - y[self.n + i])
+    }
+
+    /// Make the columns W_i = A0^{-1} e_{n+i} of `rows` available (one blocked solve for
+    /// those missing) and factor the capacitance matrix. None when W would be too large.
+    fn row_update(&mut self, active: &[bool]) -> Option<RowUpdate> {
+        let big_n = self.n + self.p.rows.len();
+        let rows: Vec<usize> = (0..active.len())
+            .filter(|&i| active[i] != self.factored_active[i])
+            .collect();
+        if rows.len() * big_n > MAX_CORRECTION_ENTRIES {
+            return None;
+        }
+        let missing: Vec<usize> = rows
+            .iter()
+            .copied()
+            .filter(|&i| self.w_columns[i].is_none())
+            .collect();
+        if !missing.is_empty() {
+            let t = std::time::Instant::now();
+            let mut block = vec![0.0; big_n * missing.len()];
+            for (j, &i) in missing.iter().enumerate() {
+                block[j * big_n + self.n + i] = 1.0;
+            }
+            self.system.solve_many(&mut block, missing.len());
+            for (j, &i) in missing.iter().enumerate() {
+                self.w_columns[i] = Some(block[j * big_n..(j + 1) * big_n].to_vec());
+            }
+            self.clock
+                .solve
+                .set(self.clock.solve.get() + t.elapsed().as_secs_f64());
+        }
+        let signs: Vec<f64> = rows
+            .iter()
+            .map(|&i| if active[i] { 1.0 } else { -1.0 })
+            .collect();
+        let r = rows.len();
+        let capacitance = (r > 0).then(|| {
+            let cap = nalgebra::DMatrix::from_fn(r, r, |a, b| {
+                let w = self.w_columns[rows[b]].as_ref().expect("computed above");
+                (a == b) as u8 as f64 + self.d_dot(rows[a], signs[a], w)
+            });
+            cap.lu()
+        });
+        Some(RowUpdate {
+            rows,
+            signs,
+            capacitance,
+        })
+    }
+
+    /// Apply the corrected inverse of [`RowUpdate`] to `v` in place.
+    fn precondition(&self, update: &RowUpdate, v: &mut [f64]) {
+        self.system.solve(v);
+        if let Some(cap) = &update.capacitance {
+            let z = nalgebra::DVector::from_iterator(
+                update.rows.len(),
+                update
+                    .rows
+                    .iter()
+                    .zip(&update.signs)
+                    .map(|(&i, &s)| self.d_dot(i, s, v)),
+            );
+            let t = cap
+                .solve(&z)
+                .unwrap_or_else(|| nalgebra::DVector::zeros(z.len()));
+            for (b, &i) in update.rows.iter().enumerate() {
+                let w = self.w_columns[i].as_ref().expect("computed in row_update");
+                for (vj, wj) in v.iter_mut().zip(w) {
+                    *vj -= t[b] * wj;
+                }
+            }
+        }
+    }
 }
 
 impl StepSolver for Newton<'_> {
@@ -136,12 +255,19 @@ impl StepSolver for Newton<'_> {
         let mut changes = 0;
         let mut iterations = 0;
         let mut factorizations = 0;
-        // Residual of (2.1) with the return map at (u, lambda): (r over free dofs, gaps, the
-        // consistent tangents, scale of the forces).
-        let clock = &self.clock;
-        let residual = |u: &[f64], lambda: &[f64], tangent: bool| {
+        // Residual of (2.1) with the return map at (u, lambda): (stresses, consistent
+        // tangents, r over free dofs, gaps, scale of the forces).
+        type Evaluation = (
+            Vec<crate::material::Stress>,
+            Vec<nalgebra::Matrix3<f64>>,
+            Vec<f64>,
+            Vec<f64>,
+            f64,
+        );
+        let clock = std::rc::Rc::clone(&self.clock);
+        let residual = |u: &[f64], lambda: &[f64]| -> Evaluation {
             let (sigma, tangents) = timed(&clock.constitutive, || {
-                model.update_stresses(u, &prev.u, &prev.sigma, k, tangent)
+                model.update_stresses(u, &prev.u, &prev.sigma, k, true)
             });
             let f_int = timed(&clock.assembly, || model.internal_force(&sigma));
             let mut r = f_int.clone();
@@ -163,13 +289,10 @@ impl StepSolver for Newton<'_> {
                     .map(|i| lambda[i].min(-c * g[i]).powi(2))
                     .sum::<f64>()
         };
+        // The line search's accepted evaluation is the next iteration's residual.
+        let mut evaluation = residual(&u, &lambda);
         loop {
-            let (sigma, tangents, r_free, g, scale) = residual(&u, &lambda, true);
-            let elastic = model
-                .elements
-                .iter()
-                .zip(&sigma)
-                .all(|(e, s)| !model.materials[e.body].is_plastic(s));
+            let (sigma, tangents, r_free, g, scale) = evaluation;
             let active: Vec<bool> = (0..m).map(|i| lambda[i] + c * g[i] >= 0.0).collect();
             let compl = (0..m)
                 .map(|i| lambda[i].min(-c * g[i]).abs())
@@ -223,9 +346,10 @@ impl StepSolver for Newton<'_> {
             let merit0 = merit_of(&r_free, &g, &lambda);
             // Every iteration is a full semismooth Newton step with the current consistent
             // tangent and active set. Its linear system is solved by GMRES preconditioned
-            // with the last factorization (of an older matrix: the tangent and the active
-            // rows change little between iterations and steps); the matrix is refactorized
-            // only when GMRES needs many iterations.
+            // with the last factorization (of an older matrix: the tangent changes little
+            // between iterations and steps), corrected exactly for the contact rows whose
+            // active set changed since; the matrix is refactorized only when GMRES needs
+            // many iterations.
             let rhs0: Vec<f64> = {
                 let mut rhs = vec![0.0; n + m];
                 for (i, v) in r_free.iter().enumerate() {
@@ -239,8 +363,8 @@ impl StepSolver for Newton<'_> {
             let t_asm = std::time::Instant::now();
             {
                 let vals = self.system.values_mut();
-                vals.iter_mut().for_each(|v| *v = 0.0);
-                model.add_tangent(&tangents, &self.slots, vals);
+                vals.copy_from_slice(&self.elastic_values);
+                model.add_tangent_change(&tangents, &self.slots, vals);
                 for i in 0..m {
                     for &(rs, cs, _, v) in &self.row_slots[i] {
                         vals[cs] = v;
@@ -260,62 +384,67 @@ impl StepSolver for Newton<'_> {
             // seconds, so the results do not depend on the machine's load.
             let budget = 10;
             if self.system.is_factored() && !self.stale {
-                let t = std::time::Instant::now();
-                // Inexact Newton: the linear solve needs only to beat the nonlinear residual
-                // (forcing term min(1e-2, residual)); the final accuracy is the residual test's.
-                let forcing = res.min(1e-2).max(1e-12);
-                let result = self.system.gmres(&mut rhs, forcing, budget);
-                let dt = t.elapsed().as_secs_f64();
-                self.clock.solve.set(self.clock.solve.get() + dt);
-                if let Some(its) = result {
-                    solved = true;
-                    self.stale = 2 * its > budget;
-                } else {
-                    rhs.copy_from_slice(&rhs0);
+                if let Some(update) = self.row_update(&active) {
+                    let t = std::time::Instant::now();
+                    // Inexact Newton: the linear solve needs only to beat the nonlinear
+                    // residual (forcing term min(1e-2, residual): quadratic convergence), and
+                    // never more than the tolerance asks for (0.1 tol / residual, for the last
+                    // iteration of a step); the final accuracy is the residual test's.
+                    let forcing = res.max(0.1 * self.settings.tol / res).min(1e-2).max(1e-12);
+                    let result = self.system.gmres(&mut rhs, forcing, budget, &|v| {
+                        self.precondition(&update, v)
+                    });
+                    let dt = t.elapsed().as_secs_f64();
+                    self.clock.solve.set(self.clock.solve.get() + dt);
+                    if let Some(its) = result {
+                        solved = true;
+                        self.stale = 2 * its > budget;
+                    } else {
+                        rhs.copy_from_slice(&rhs0);
+                    }
                 }
             }
             if !solved {
                 self.system.factor_lu()?;
                 factorizations += 1;
                 self.stale = false;
+                self.factored_active.clone_from(&active);
+                self.w_columns.iter_mut().for_each(|w| *w = None);
                 let t = std::time::Instant::now();
                 self.system.solve(&mut rhs);
                 let dt = t.elapsed().as_secs_f64();
                 self.clock.solve.set(self.clock.solve.get() + dt);
             }
-            let _ = elastic;
-            let (best, _best_merit) = {
-                // Backtracking on the merit |r|^2 + |min(lambda, -c g)|^2: full steps near the
-                // solution, shorter ones when a large step flips many triangles between
-                // elastic and viscoplastic (stiff k E / lambda) or many contact rows.
-                let trial = |alpha: f64| -> (Vec<f64>, Vec<f64>) {
-                    let mut ut = u.clone();
-                    for (d, &eq) in model.equation.iter().enumerate() {
-                        if eq != FIXED {
-                            ut[d] += alpha * rhs[eq];
-                        }
+            // Backtracking on the merit |r|^2 + |min(lambda, -c g)|^2: full steps near the
+            // solution, shorter ones when a large step flips many triangles between elastic
+            // and viscoplastic (stiff k E / lambda) or many contact rows.
+            let trial = |alpha: f64| -> (Vec<f64>, Vec<f64>) {
+                let mut ut = u.clone();
+                for (d, &eq) in model.equation.iter().enumerate() {
+                    if eq != FIXED {
+                        ut[d] += alpha * rhs[eq];
                     }
-                    let lt: Vec<f64> = (0..m).map(|i| lambda[i] + alpha * rhs[n + i]).collect();
-                    (ut, lt)
-                };
-                let mut alpha = 1.0;
-                let (mut best, mut best_merit) = (trial(1.0), f64::INFINITY);
-                for _ in 0..12 {
-                    let tr = trial(alpha);
-                    let (_, _, rt, gt, _) = residual(&tr.0, &tr.1, false);
-                    let mv = merit_of(&rt, &gt, &tr.1);
-                    if mv < best_merit {
-                        best_merit = mv;
-                        best = tr;
-                    }
-                    if mv <= (1.0 - 1e-4 * alpha) * merit0 {
-                        break;
-                    }
-                    alpha *= 0.5;
                 }
-                (best, best_merit)
+                let lt: Vec<f64> = (0..m).map(|i| lambda[i] + alpha * rhs[n + i]).collect();
+                (ut, lt)
             };
-            (u, lambda) = best;
+            let mut alpha = 1.0;
+            let mut best: Option<(f64, (Vec<f64>, Vec<f64>), Evaluation)> = None;
+            for _ in 0..12 {
+                let tr = trial(alpha);
+                let ev = residual(&tr.0, &tr.1);
+                let mv = merit_of(&ev.2, &ev.3, &tr.1);
+                let done = mv <= (1.0 - 1e-4 * alpha) * merit0;
+                if best.as_ref().is_none_or(|b| mv < b.0) {
+                    best = Some((mv, tr, ev));
+                }
+                if done {
+                    break;
+                }
+                alpha *= 0.5;
+            }
+            let (_, (u_new, lambda_new), ev) = best.expect("at least one trial");
+            (u, lambda, evaluation) = (u_new, lambda_new, ev);
             last_active = Some(active);
             iterations += 1;
         }
@@ -329,6 +458,7 @@ impl StepSolver for Newton<'_> {
             constitutive_s: self.clock.constitutive.get(),
             contact_s: self.clock.contact.get(),
             factorizations: self.system.factorizations,
+            setup_s: self.setup_s,
         }
     }
 }

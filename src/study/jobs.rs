@@ -95,7 +95,7 @@ fn put_f64s(out: &mut Vec<u8>, v: impl IntoIterator<Item = f64>) {
 
 /// Serialize a solution (states, step reports, timings) to bytes.
 pub fn encode(sol: &Solution) -> Vec<u8> {
-    let mut o = b"CRREC1\n".to_vec();
+    let mut o = b"CRREC2\n".to_vec();
     let t = &sol.timings;
     put_f64s(
         &mut o,
@@ -107,6 +107,7 @@ pub fn encode(sol: &Solution) -> Vec<u8> {
             t.constitutive_s,
             t.contact_s,
             t.factorizations as f64,
+            t.setup_s,
         ],
     );
     put_f64s(&mut o, [sol.reports.len() as f64]);
@@ -148,7 +149,7 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Solution> {
             "the record is truncated or not a record; delete it and run the shard again",
         )
     };
-    if !bytes.starts_with(b"CRREC1\n") {
+    if !bytes.starts_with(b"CRREC2\n") {
         return Err(bad());
     }
     let mut pos = 7;
@@ -157,7 +158,7 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Solution> {
         pos += 8;
         Ok(f64::from_le_bytes(b.try_into().unwrap()))
     };
-    let h: Vec<f64> = (0..7).map(|_| next()).collect::<Result<_>>()?;
+    let h: Vec<f64> = (0..8).map(|_| next()).collect::<Result<_>>()?;
     let timings = Timings {
         assembly_s: h[1],
         factor_s: h[2],
@@ -165,6 +166,7 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Solution> {
         constitutive_s: h[4],
         contact_s: h[5],
         factorizations: h[6] as usize,
+        setup_s: h[7],
     };
     let nr = next()? as usize;
     let mut reports = Vec::with_capacity(nr.min(1 << 20));
