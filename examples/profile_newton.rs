@@ -20,13 +20,14 @@ fn main() -> contact_rates::error::Result<()> {
         let floor = solve::floor_time(&case.problem, 4)?;
         let t = sol.timings;
         println!(
-            "wall {:.4} floor {:.4} ratio {:.2} its {} fact {} ({:.4}) solve {:.4} asm {:.4} const {:.4} contact {:.4}",
+            "wall {:.4} floor {:.4} ratio {:.2} its {} fact {} ({:.4}) solves {} solve {:.4} asm {:.4} const {:.4} contact {:.4}",
             sol.wall_s,
             floor,
             sol.wall_s / floor,
             sol.iterations(),
             t.factorizations,
             t.factor_s,
+            t.solves,
             t.solve_s,
             t.assembly_s,
             t.constitutive_s,

@@ -97,6 +97,8 @@ struct Summary {
     contact_s: f64,
     factorizations: usize,
     active_set_changes: usize,
+    time_loop_s: f64,
+    solver_setup_s: f64,
     floor_s: f64,
     ratio_to_floor: f64,
 }
@@ -173,7 +175,8 @@ fn run() -> anyhow::Result<()> {
                 contact_rates::report::write_speed(&res, &dir)?;
                 for r in &res.rows {
                     println!(
-                        "{:7} {:7} level {} {:7} dofs: {:3} iterations, {:2} factorizations, {:8.3} s = {:5.2} x floor ({:.3} s), error {}",
+                        "{:11} {:7} {:7} level {} {:7} dofs: {:3} iterations, {:2} factorizations, {:8.3} s = {:5.2} x floor ({:.3} s), set-up {:.3} s, peak {} GiB, error {}",
+                        r.family,
                         r.method,
                         r.solver,
                         r.level,
@@ -183,6 +186,8 @@ fn run() -> anyhow::Result<()> {
                         r.wall_s,
                         r.ratio_to_floor,
                         r.floor_s,
+                        r.setup_s,
+                        r.peak_rss_gib.map(|g| format!("{g:.1}")).unwrap_or_default(),
                         r.error.map(|e| format!("{e:.3e}")).unwrap_or_default()
                     );
                 }
@@ -353,6 +358,8 @@ fn run() -> anyhow::Result<()> {
                 contact_s: sol.timings.contact_s,
                 factorizations: sol.timings.factorizations,
                 active_set_changes: sol.active_set_changes(),
+                time_loop_s: sol.wall_s,
+                solver_setup_s: sol.timings.setup_s,
                 floor_s,
                 ratio_to_floor: sol.wall_s / floor_s,
             };
@@ -377,9 +384,10 @@ fn run() -> anyhow::Result<()> {
             );
             let t = &sol.timings;
             println!(
-                "  mesh {:.3} s, setup {:.3} s; time loop {:.3} s = {:.2} x the floor ({:.3} s): {} factorizations {:.3} s, solves {:.3} s, assembly {:.3} s, constitutive {:.3} s, contact {:.3} s; {} active-set changes",
+                "  mesh {:.3} s, model {:.3} s, solver set-up (pattern, symbolic) {:.3} s; time loop {:.3} s = {:.2} x the floor ({:.3} s): {} factorizations {:.3} s, solves {:.3} s, assembly {:.3} s, constitutive {:.3} s, contact {:.3} s; {} active-set changes; peak RSS {} GiB",
                 case.mesh_s,
                 case.setup_s,
+                t.setup_s,
                 sol.wall_s,
                 sol.wall_s / floor_s,
                 floor_s,
@@ -389,7 +397,10 @@ fn run() -> anyhow::Result<()> {
                 t.assembly_s,
                 t.constitutive_s,
                 t.contact_s,
-                sol.active_set_changes()
+                sol.active_set_changes(),
+                contact_rates::study::speed::peak_rss_gib()
+                    .map(|g| format!("{g:.1}"))
+                    .unwrap_or_default()
             );
             println!(
                 "wrote {} and {}",

@@ -39,3 +39,20 @@ pub fn plastic_fraction(p: &Problem, s: &State) -> f64 {
         .sum();
     plastic / total
 }
+
+/// Largest aspect ratio over all triangles: longest edge over the altitude onto it,
+/// `2 |T| max_a |grad phi_a|^2` (1.15 for an equilateral triangle; dimensionless).
+pub fn max_aspect_ratio(p: &Problem) -> f64 {
+    p.model
+        .elements
+        .iter()
+        .map(|e| {
+            let g2 = e
+                .grads
+                .iter()
+                .map(|g| g[0] * g[0] + g[1] * g[1])
+                .fold(0.0f64, f64::max);
+            2.0 * e.area * g2
+        })
+        .fold(0.0, f64::max)
+}

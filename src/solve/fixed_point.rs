@@ -387,6 +387,7 @@ impl StepSolver for FixedPoint<'_> {
         super::Timings {
             factor_s: self.system.factor_s + self.clarabel_s,
             factorizations: self.system.factorizations,
+            solves: self.system.solves.get(),
             setup_s: self.pattern_s + self.system.symbolic_s,
             ..Default::default()
         }

@@ -22,6 +22,9 @@ pub struct SparseSystem {
     pub symbolic_s: f64,
     /// Number of numeric factorizations.
     pub factorizations: usize,
+    /// Number of right-hand sides solved with a factorization (forward and back
+    /// substitution each).
+    pub solves: std::cell::Cell<usize>,
 }
 
 impl SparseSystem {
@@ -44,6 +47,7 @@ impl SparseSystem {
             factor_s: 0.0,
             symbolic_s: 0.0,
             factorizations: 0,
+            solves: std::cell::Cell::new(0),
         }
     }
 
@@ -124,6 +128,7 @@ impl SparseSystem {
     pub fn solve_many(&self, rhs: &mut [f64], k: usize) {
         use faer::linalg::solvers::Solve;
         let n = rhs.len() / k;
+        self.solves.set(self.solves.get() + k);
         let m = faer::MatMut::from_column_major_slice_mut(rhs, n, k);
         if let Some(lu) = &self.lu {
             lu.solve_in_place(m);

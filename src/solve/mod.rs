@@ -139,6 +139,8 @@ pub struct Timings {
     pub contact_s: f64,
     /// Number of numeric factorizations.
     pub factorizations: usize,
+    /// Number of right-hand sides solved with a factorization.
+    pub solves: usize,
     /// One-off set-up per mesh: the matrix pattern with its entry-to-slot map and the
     /// symbolic analysis (ordering). Not part of the time loop (`Solution::wall_s`).
     pub setup_s: f64,

@@ -108,6 +108,7 @@ pub fn encode(sol: &Solution) -> Vec<u8> {
             t.contact_s,
             t.factorizations as f64,
             t.setup_s,
+            t.solves as f64,
         ],
     );
     put_f64s(&mut o, [sol.reports.len() as f64]);
@@ -158,7 +159,7 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Solution> {
         pos += 8;
         Ok(f64::from_le_bytes(b.try_into().unwrap()))
     };
-    let h: Vec<f64> = (0..8).map(|_| next()).collect::<Result<_>>()?;
+    let h: Vec<f64> = (0..9).map(|_| next()).collect::<Result<_>>()?;
     let timings = Timings {
         assembly_s: h[1],
         factor_s: h[2],
@@ -167,6 +168,7 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Solution> {
         contact_s: h[5],
         factorizations: h[6] as usize,
         setup_s: h[7],
+        solves: h[8] as usize,
     };
     let nr = next()? as usize;
     let mut reports = Vec::with_capacity(nr.min(1 << 20));

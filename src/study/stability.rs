@@ -60,6 +60,9 @@ struct Variant {
     params: Vec<(String, f64)>,
     steps: usize,
     solvers: Vec<(SolverKind, Settings)>,
+    /// For the units case: the same problem in the original units and the length factor;
+    /// the error is then the difference to the original solution with the same solver.
+    baseline: Option<(Scene, f64)>,
 }
 
 fn default_solvers() -> Vec<(SolverKind, Settings)> {
@@ -95,6 +98,7 @@ fn plan() -> Result<Vec<Variant>> {
         params: Vec::new(),
         steps: 4,
         solvers: default_solvers(),
+        baseline: None,
     };
     // Stiff viscosity: k E / lambda from 1e-2 to 1e4 at k = 0.25, E = 100.
     for exp in [-2, -1, 0, 1, 2, 3, 4] {
@@ -179,6 +183,41 @@ fn plan() -> Result<Vec<Variant>> {
         var.params = vec![("matching".into(), 1.0)];
         v.push(var);
     }
+    // Slivers: a structured strip of the upper block along Gamma_C, one triangle pair per
+    // contact edge, thinner and thinner (the measured aspect ratio is in the parameter).
+    for strip in [2.9e-2, 2.9e-3, 2.9e-4] {
+        let mut var = base("slivers", format!("strip {strip:e}"), 0.0, rates.clone());
+        var.params = vec![("strip".into(), strip)];
+        v.push(var);
+    }
+    // Units rescaled: lengths x 1e3 (gmsh writes the mesh scaled), moduli, stresses,
+    // viscosity and tractions x 1e6; compared with the rates scene, solver by solver.
+    {
+        let mut var = base(
+            "units rescaled",
+            "lengths x 1e3, moduli x 1e6".into(),
+            1.0,
+            Scene::load("rates-units")?,
+        );
+        var.baseline = Some((rates.clone(), 1e3));
+        v.push(var);
+    }
+    // Newton's iterations per step on the rates scene (study rates' family) at every level.
+    for level in 0..=5 {
+        let mut var = base(
+            "newton iterations across levels",
+            format!("level {level}"),
+            level as f64,
+            rates.clone(),
+        );
+        var.level = level;
+        var.params = vec![
+            ("h_upper".into(), 0.3),
+            ("h_lower".into(), 0.3 / 1.4142),
+        ];
+        var.solvers.truncate(1);
+        v.push(var);
+    }
     // One single time step over [0, T].
     {
         let mut var = base("single time step", "steps = 1".into(), 1.0, rates.clone());
@@ -228,6 +267,12 @@ fn omega_auto(scene: &Scene) -> Result<f64> {
 }
 
 fn rel_diff(a: &Solution, b: &Solution) -> f64 {
+    rel_diff_scaled(a, b, 1.0)
+}
+
+/// Largest nodal difference of `factor * a` to `b` over the final states, relative to the
+/// largest displacement of `b`.
+fn rel_diff_scaled(a: &Solution, b: &Solution, factor: f64) -> f64 {
     let (ua, ub) = (&a.last().u, &b.last().u);
     let m = ub
         .iter()
@@ -235,7 +280,7 @@ fn rel_diff(a: &Solution, b: &Solution) -> f64 {
         .max(f64::MIN_POSITIVE);
     ua.iter()
         .zip(ub)
-        .fold(0.0f64, |x, (p, q)| x.max((p - q).abs()))
+        .fold(0.0f64, |x, (p, q)| x.max((factor * p - q).abs()))
         / m
 }
 
@@ -246,6 +291,18 @@ pub fn run() -> Result<StabilityResult> {
     for var in plan()? {
         for method in [Method::Mortar, Method::Nts] {
             let case = Case::build(&var.scene, var.level, method, &var.params)?;
+            let (mut parameter, mut value) = (var.parameter.clone(), var.value);
+            if var.case == "slivers" {
+                value = metrics::max_aspect_ratio(&case.problem);
+                parameter = format!("{parameter}: max aspect ratio {value:.0}");
+            }
+            let baseline = match &var.baseline {
+                Some((scene, unit)) => Some((
+                    Case::build(scene, var.level, method, &var.params)?,
+                    *unit,
+                )),
+                None => None,
+            };
             let mut newton: Option<Solution> = None;
             for (kind, settings) in &var.solvers {
                 let t = std::time::Instant::now();
@@ -253,10 +310,28 @@ pub fn run() -> Result<StabilityResult> {
                 let wall_s = t.elapsed().as_secs_f64();
                 let row = match out {
                     Ok(sol) => {
-                        let error = match &newton {
-                            Some(n) => rel_diff(&sol, n),
-                            None if *kind == SolverKind::Newton => 0.0,
-                            None => f64::NAN,
+                        let mut note = String::new();
+                        let error = match (&baseline, &newton) {
+                            (Some((base_case, unit)), _) => {
+                                match solve::solve(&base_case.problem, settings, var.steps, true) {
+                                    Ok(b) => {
+                                        let per_step = |s: &Solution| -> Vec<usize> {
+                                            s.reports.iter().map(|r| r.iterations).collect()
+                                        };
+                                        let (a, bb) = (per_step(&sol), per_step(&b));
+                                        note = if a == bb {
+                                            format!("; iterations per step {a:?}, identical to the original units")
+                                        } else {
+                                            format!("; iterations per step {a:?} against {bb:?} in the original units")
+                                        };
+                                        rel_diff_scaled(&sol, &b, 1.0 / unit)
+                                    }
+                                    Err(_) => f64::NAN,
+                                }
+                            }
+                            (None, Some(n)) => rel_diff(&sol, n),
+                            (None, None) if *kind == SolverKind::Newton => 0.0,
+                            (None, None) => f64::NAN,
                         };
                         let pen = sol
                             .states
@@ -265,15 +340,15 @@ pub fn run() -> Result<StabilityResult> {
                             .fold(0.0, f64::max);
                         let r = StabilityRow {
                             case: var.case.into(),
-                            parameter: var.parameter.clone(),
-                            value: var.value,
+                            parameter: parameter.clone(),
+                            value,
                             method: method.name().into(),
                             solver: kind.name().into(),
                             converged: true,
                             reason: sol
                                 .reports
                                 .last()
-                                .map(|r| r.reason.clone())
+                                .map(|r| r.reason.clone() + &note)
                                 .unwrap_or_default(),
                             max_step_iterations: sol.max_step_iterations(),
                             mean_step_iterations: sol.iterations() as f64
@@ -289,8 +364,8 @@ pub fn run() -> Result<StabilityResult> {
                     }
                     Err(Error::NotConverged(msg)) => StabilityRow {
                         case: var.case.into(),
-                        parameter: var.parameter.clone(),
-                        value: var.value,
+                        parameter: parameter.clone(),
+                        value,
                         method: method.name().into(),
                         solver: kind.name().into(),
                         converged: false,
