@@ -65,15 +65,28 @@ pub fn parse_toml<T: serde::de::DeserializeOwned>(
     what: &str,
 ) -> Result<T> {
     toml::from_str(text).map_err(|e| {
-        let line = e
-            .span()
-            .map(|s| {
-                format!(
-                    " (line {})",
-                    text[..s.start.min(text.len())].lines().count().max(1)
-                )
-            })
+        let start = e.span().map(|s| s.start.min(text.len()));
+        let line = start
+            .map(|s| format!(" (line {})", text[..s].lines().count().max(1)))
             .unwrap_or_default();
+        // The key the error sits on, with its table: `key = ...` on the error's line and
+        // the last `[table]` header above it.
+        let key = start.and_then(|s| {
+            let line_start = text[..s].rfind('\n').map_or(0, |i| i + 1);
+            let (k, _) = text[line_start..].lines().next()?.split_once('=')?;
+            let k = k.trim();
+            let table = text[..line_start]
+                .lines()
+                .rev()
+                .map(str::trim)
+                .find(|l| l.starts_with('[') && l.ends_with(']'))
+                .map(|l| l.trim_matches(|c| c == '[' || c == ']').to_string());
+            (!k.is_empty()).then(|| match table {
+                Some(t) => format!(" key {t}.{k}"),
+                None => format!(" key {k}"),
+            })
+        });
+        let line = format!("{line}{}", key.unwrap_or_default());
         Error::input(
             file,
             format!("toml{line}"),

@@ -7,7 +7,7 @@ use contact_rates::contact::Method;
 use contact_rates::solve::{self, Settings, SolverKind};
 use contact_rates::{io, metrics, scene::Scene};
 use serde::Serialize;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Parser)]
 #[command(
@@ -138,6 +138,17 @@ fn run() -> anyhow::Result<()> {
                 }
                 return Ok(());
             }
+            // The report folder is checked before any computing.
+            if shard.is_none() {
+                let stem = Path::new(&name)
+                    .file_stem()
+                    .map(|s| s.to_string_lossy().to_string())
+                    .unwrap_or_else(|| name.clone());
+                let dir = out
+                    .clone()
+                    .unwrap_or_else(|| contact_rates::report::reports_dir().join(stem));
+                contact_rates::report::check_writable(&dir)?;
+            }
             if name == "stability" {
                 let res = contact_rates::study::stability::run()?;
                 let dir =
@@ -187,7 +198,9 @@ fn run() -> anyhow::Result<()> {
                         r.ratio_to_floor,
                         r.floor_s,
                         r.setup_s,
-                        r.peak_rss_gib.map(|g| format!("{g:.1}")).unwrap_or_default(),
+                        r.peak_rss_gib
+                            .map(|g| format!("{g:.1}"))
+                            .unwrap_or_default(),
                         r.error.map(|e| format!("{e:.3e}")).unwrap_or_default()
                     );
                 }
@@ -319,6 +332,8 @@ fn run() -> anyhow::Result<()> {
             if steps == 0 {
                 anyhow::bail!("--steps: the number of time steps must be at least 1");
             }
+            // The output folder is checked (and created) before any computing.
+            contact_rates::report::check_writable(&out.join("solution"))?;
             let t0 = std::time::Instant::now();
             let case = Case::build(&scene, level, method, &parse_sets(&set)?)?;
             for w in &case.warnings {

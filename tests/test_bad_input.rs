@@ -301,3 +301,142 @@ fn gmsh_failing_after_writing_a_broken_mesh() {
         );
     }
 }
+
+/// The quick study file with `edit` applied, written into `dir`.
+fn study_file(dir: &Path, edit: impl Fn(String) -> String) -> PathBuf {
+    let text = std::fs::read_to_string(repo().join("studies/rates-quick.toml")).unwrap();
+    let f = dir.join("study.toml");
+    std::fs::write(&f, edit(text)).unwrap();
+    f
+}
+
+#[test]
+fn study_file_errors_through_the_binary() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("report");
+    let cases: Vec<(Box<dyn Fn(String) -> String>, Vec<&str>)> = vec![
+        (
+            Box::new(|t| t.replace("steps = 4", "steps = 4 4")),
+            vec!["study.toml", "line 5", "fix the study file"],
+        ),
+        (
+            Box::new(|t| t.replace("steps = 4", "steps = 4\nspeed = 2")),
+            vec!["study.toml", "unknown field `speed`"],
+        ),
+        (
+            Box::new(|t| t.replace("scene = \"rates\"\n", "")),
+            vec!["study.toml", "missing field `scene`"],
+        ),
+        (
+            Box::new(|t| t.replace("levels = [0, 1, 2]", "levels = []")),
+            vec!["study.toml", "mesh.levels", "at least 3 levels, got 0"],
+        ),
+        (
+            Box::new(|t| t.replace("levels = [0, 1, 2]", "levels = 0")),
+            vec!["study.toml", "key mesh.levels", "sequence"],
+        ),
+        (
+            // k = T / steps <= 0.
+            Box::new(|t| t.replace("steps = 4", "steps = 0")),
+            vec!["study.toml", "steps", "k must be positive"],
+        ),
+        (
+            Box::new(|t| t.replace("scene = \"rates\"", "scene = \"nosuch\"")),
+            vec!["no built-in scene named 'nosuch'"],
+        ),
+        (
+            Box::new(|t| t.replace("methods = [\"mortar\", \"nts\"]", "methods = [\"penalty\"]")),
+            vec!["study.toml", "methods", "unknown method 'penalty'"],
+        ),
+    ];
+    for (edit, needles) in cases {
+        let f = study_file(dir.path(), edit);
+        let o = run(
+            &["study", f.to_str().unwrap(), "--out", out.to_str().unwrap()],
+            &[],
+        );
+        fails_with(&o, &needles);
+        assert!(!out.exists(), "a failed study wrote a report");
+    }
+    fails_with(&run(&["study", "nosuch"], &[]), &["nosuch", "built-in studies", "rates-quick"]);
+}
+
+#[test]
+fn reports_folder_that_cannot_be_written_fails_before_computing() {
+    let dir = tempfile::tempdir().unwrap();
+    // A path whose parent is a regular file: no one can create it.
+    let file = dir.path().join("plain-file");
+    std::fs::write(&file, "x").unwrap();
+    let bad = file.join("report");
+    let t = std::time::Instant::now();
+    let o = run(
+        &["study", "rates-quick", "--out", bad.to_str().unwrap()],
+        &[],
+    );
+    fails_with(&o, &["plain-file", "reports folder", "--out"]);
+    // Checked up front: the study itself takes tens of seconds.
+    assert!(t.elapsed().as_secs_f64() < 5.0);
+    // An existing path that is a file.
+    let o = run(
+        &["study", "rates-quick", "--out", file.to_str().unwrap()],
+        &[],
+    );
+    fails_with(&o, &["plain-file", "exists and is not a folder"]);
+    // A read-only folder. Root ignores permission bits, so as root a read-only file system
+    // (sysfs) stands in for it.
+    let ro = dir.path().join("read-only");
+    std::fs::create_dir(&ro).unwrap();
+    let mut perm = std::fs::metadata(&ro).unwrap().permissions();
+    std::os::unix::fs::PermissionsExt::set_mode(&mut perm, 0o555);
+    std::fs::set_permissions(&ro, perm).unwrap();
+    let target = if std::fs::create_dir(ro.join("probe")).is_ok() {
+        PathBuf::from("/sys/contact-rates-read-only/report")
+    } else {
+        ro.join("report")
+    };
+    for args in [
+        vec!["study", "rates-quick", "--out", target.to_str().unwrap()],
+        vec![
+            "solve",
+            "--scene",
+            "rates",
+            "--out",
+            target.to_str().unwrap(),
+        ],
+    ] {
+        fails_with(&run(&args, &[]), &["reports folder", "writable"]);
+    }
+}
+
+#[test]
+fn failed_study_leaves_the_previous_report_intact() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("report");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("rates.csv"), "previous report\n").unwrap();
+    // The scene's mesh lacks the physical group the scene asks for: found while computing.
+    let scene = scene_file(dir.path(), |t| {
+        t.replace("curve = \"top\"", "curve = \"roof\"")
+    });
+    let f = study_file(dir.path(), |t| {
+        t.replace(
+            "scene = \"rates\"",
+            &format!("scene = {:?}", scene.display().to_string()),
+        )
+    });
+    let o = run(
+        &["study", f.to_str().unwrap(), "--out", out.to_str().unwrap()],
+        &[],
+    );
+    fails_with(&o, &["roof"]);
+    assert_eq!(
+        std::fs::read_to_string(out.join("rates.csv")).unwrap(),
+        "previous report\n"
+    );
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    assert!(left.is_empty(), "temporary folders left behind: {left:?}");
+}

@@ -18,6 +18,40 @@ pub fn reports_dir() -> PathBuf {
 
 /// Write `files` (name, bytes) and `pngs` (drawn by closures into the folder) as the folder
 /// `dir`, replacing it atomically.
+/// Check, before any computing, that the report folder `dir` can be written (its parent is
+/// created when missing): a study that runs for minutes must not fail at the end.
+pub fn check_writable(dir: &Path) -> Result<()> {
+    let parent = dir.parent().unwrap_or(Path::new("."));
+    let fix = "pass --out with a writable folder, or make this one writable";
+    std::fs::create_dir_all(parent).map_err(|e| {
+        Error::input(
+            parent,
+            "reports folder",
+            format!("cannot create it ({e}); {fix}"),
+        )
+    })?;
+    if dir.exists() && !dir.is_dir() {
+        return Err(Error::input(
+            dir,
+            "reports folder",
+            format!("exists and is not a folder; {fix}"),
+        ));
+    }
+    let name = dir.file_name().unwrap_or_default().to_string_lossy();
+    let probe = parent.join(format!(".{name}.probe-{}", std::process::id()));
+    std::fs::create_dir(&probe).map_err(|e| {
+        Error::input(
+            parent,
+            "reports folder",
+            format!("cannot write here ({e}); {fix}"),
+        )
+    })?;
+    let _ = std::fs::remove_dir(&probe);
+    Ok(())
+}
+
+/// Write a report folder atomically: fill a temporary sibling, then swap it in, so a failed
+/// run leaves the previous report intact.
 pub fn write_folder(dir: &Path, fill: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
     let parent = dir.parent().unwrap_or(Path::new("."));
     std::fs::create_dir_all(parent).map_err(|e| Error::io(parent, e))?;
@@ -522,7 +556,9 @@ pub fn write_speed(res: &crate::study::speed::SpeedResult, dir: &Path) -> Result
                 r.solve_s,
                 r.assembly_s,
                 r.constitutive_s,
-                r.peak_rss_gib.map(|g| format!("{g:.1}")).unwrap_or_default(),
+                r.peak_rss_gib
+                    .map(|g| format!("{g:.1}"))
+                    .unwrap_or_default(),
                 r.error.map(|e| format!("{e:.3e}")).unwrap_or_default()
             );
         }
@@ -640,12 +676,20 @@ pub fn write_stability(res: &crate::study::stability::StabilityResult, dir: &Pat
         for c in cases {
             let _ = writeln!(s, "## {c}\n");
             let note = match c {
-                "stiff viscosity" => "k = 0.25, E = 100; lambda set so that k E / lambda sweeps 1e-2..1e4. The paper's fixed point (4.2)-(4.3) is a contraction only while k L < 1.",
+                "stiff viscosity" => {
+                    "k = 0.25, E = 100; lambda set so that k E / lambda sweeps 1e-2..1e4. The paper's fixed point (4.2)-(4.3) is a contraction only while k L < 1."
+                }
                 "modulus contrast" => "E of the lower block = 100 x E2/E1, upper block E = 100.",
                 "mesh-size ratio" => "Level 0 with h_upper = 0.2 sqrt(r), h_lower = 0.2 / sqrt(r).",
-                "slivers" => "The upper block's first layer along Gamma_C is a structured strip (the `strip` parameter of meshes/two_blocks.geo), one triangle pair per contact edge: the thinner the strip, the flatter the triangles that carry the constraint. The largest aspect ratio (longest edge over the altitude onto it) is measured on the mesh.",
-                "units rescaled" => "scenes/rates-units.toml: the rates scene with lengths x 1e3 (gmsh writes the .msh scaled, `unit = 1000`), moduli, yield stress, viscosity and tractions x 1e6. `error` here is the largest nodal difference of u / 1e3 to the same solver's solution in the original units, relative to its largest displacement; the reason says whether the iterations per step are identical.",
-                "newton iterations across levels" => "The study rates family (h_upper = 0.3, h_lower = 0.3 / 1.4142), levels 0-5 (118 to 112,896 dofs): newton's iterations per step do not grow with h.",
+                "slivers" => {
+                    "The upper block's first layer along Gamma_C is a structured strip (the `strip` parameter of meshes/two_blocks.geo), one triangle pair per contact edge: the thinner the strip, the flatter the triangles that carry the constraint. The largest aspect ratio (longest edge over the altitude onto it) is measured on the mesh."
+                }
+                "units rescaled" => {
+                    "scenes/rates-units.toml: the rates scene with lengths x 1e3 (gmsh writes the .msh scaled, `unit = 1000`), moduli, yield stress, viscosity and tractions x 1e6. `error` here is the largest nodal difference of u / 1e3 to the same solver's solution in the original units, relative to its largest displacement; the reason says whether the iterations per step are identical."
+                }
+                "newton iterations across levels" => {
+                    "The study rates family (h_upper = 0.3, h_lower = 0.3 / 1.4142), levels 0-5 (118 to 112,896 dofs): newton's iterations per step do not grow with h."
+                }
                 _ => "",
             };
             if !note.is_empty() {

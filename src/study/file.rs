@@ -162,7 +162,12 @@ impl StudyFile {
     /// Read and validate a study file.
     pub fn load(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        let s: StudyFile = crate::error::parse_toml(&text, path, "study file")?;
+        Self::from_toml(&text, path)
+    }
+
+    /// Parse and validate the text of a study file; `path` names it in errors.
+    pub fn from_toml(text: &str, path: &Path) -> Result<Self> {
+        let s: StudyFile = crate::error::parse_toml(text, path, "study file")?;
         let bad = |field: &str, msg: String| Err(Error::input(path, field, msg));
         for m in &s.methods {
             if crate::contact::Method::parse(m).is_none() {

@@ -177,7 +177,9 @@ pub fn run() -> Result<SpeedResult> {
                 // Errors only where the reference is at least 3 levels finer.
                 let err = (level + 3 <= REFERENCE_LEVEL)
                     .then(|| super::theorem_distance(&case, &sol, &rcase, &rsol));
-                rows.push(row(&scene, &case, kind, &sol, floor_s, repeats, err, family));
+                rows.push(row(
+                    &scene, &case, kind, &sol, floor_s, repeats, err, family,
+                ));
             }
         }
     }

@@ -211,10 +211,7 @@ fn plan() -> Result<Vec<Variant>> {
             rates.clone(),
         );
         var.level = level;
-        var.params = vec![
-            ("h_upper".into(), 0.3),
-            ("h_lower".into(), 0.3 / 1.4142),
-        ];
+        var.params = vec![("h_upper".into(), 0.3), ("h_lower".into(), 0.3 / 1.4142)];
         var.solvers.truncate(1);
         v.push(var);
     }
@@ -297,10 +294,9 @@ pub fn run() -> Result<StabilityResult> {
                 parameter = format!("{parameter}: max aspect ratio {value:.0}");
             }
             let baseline = match &var.baseline {
-                Some((scene, unit)) => Some((
-                    Case::build(scene, var.level, method, &var.params)?,
-                    *unit,
-                )),
+                Some((scene, unit)) => {
+                    Some((Case::build(scene, var.level, method, &var.params)?, *unit))
+                }
                 None => None,
             };
             let mut newton: Option<Solution> = None;
@@ -320,9 +316,13 @@ pub fn run() -> Result<StabilityResult> {
                                         };
                                         let (a, bb) = (per_step(&sol), per_step(&b));
                                         note = if a == bb {
-                                            format!("; iterations per step {a:?}, identical to the original units")
+                                            format!(
+                                                "; iterations per step {a:?}, identical to the original units"
+                                            )
                                         } else {
-                                            format!("; iterations per step {a:?} against {bb:?} in the original units")
+                                            format!(
+                                                "; iterations per step {a:?} against {bb:?} in the original units"
+                                            )
                                         };
                                         rel_diff_scaled(&sol, &b, 1.0 / unit)
                                     }
