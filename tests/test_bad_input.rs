@@ -358,7 +358,10 @@ fn study_file_errors_through_the_binary() {
         fails_with(&o, &needles);
         assert!(!out.exists(), "a failed study wrote a report");
     }
-    fails_with(&run(&["study", "nosuch"], &[]), &["nosuch", "built-in studies", "rates-quick"]);
+    fails_with(
+        &run(&["study", "nosuch"], &[]),
+        &["nosuch", "built-in studies", "rates-quick"],
+    );
 }
 
 #[test]

@@ -1,0 +1,109 @@
+//! Reference: SPEC section 6 (hard cases), issue 6.
+//! Goal: the quick tier of `study stability`: the results do not depend on the units, the
+//! solvers hold on slivers of aspect ratio ~1e3 at the interface, and newton's iterations
+//! per step do not grow with h.
+//! Geometry: meshes/two_blocks.geo (the `rates` scene), level 1 unless stated.
+//! Data: scenes/rates.toml and scenes/rates-units.toml (lengths x 1e3, moduli x 1e6).
+
+use contact_rates::case::Case;
+use contact_rates::contact::Method;
+use contact_rates::metrics;
+use contact_rates::scene::Scene;
+use contact_rates::solve::{self, Settings, Solution, SolverKind};
+
+fn run(
+    scene: &Scene,
+    level: usize,
+    method: Method,
+    params: &[(String, f64)],
+    kind: SolverKind,
+) -> (Case, Solution) {
+    let case = Case::build(scene, level, method, params).unwrap();
+    let settings = Settings {
+        kind,
+        max_iterations: 100,
+        ..Settings::default()
+    };
+    let sol = solve::solve(&case.problem, &settings, 4, false).unwrap();
+    (case, sol)
+}
+
+/// Largest nodal difference of `factor * a` to `b`, relative to the largest |b|.
+fn rel_diff(a: &Solution, b: &Solution, factor: f64) -> f64 {
+    let (ua, ub) = (&a.last().u, &b.last().u);
+    let m = ub.iter().fold(0.0f64, |x, v| x.max(v.abs()));
+    ua.iter()
+        .zip(ub)
+        .fold(0.0f64, |x, (p, q)| x.max((factor * p - q).abs()))
+        / m
+}
+
+fn per_step(s: &Solution) -> Vec<usize> {
+    s.reports.iter().map(|r| r.iterations).collect()
+}
+
+#[test]
+fn units_rescaled_give_the_same_solution_and_iterations() {
+    let rates = Scene::load("rates").unwrap();
+    let units = Scene::load("rates-units").unwrap();
+    for method in [Method::Mortar, Method::Nts] {
+        for kind in [SolverKind::Newton, SolverKind::Paper] {
+            let (_, a) = run(&units, 1, method, &[], kind);
+            let (_, b) = run(&rates, 1, method, &[], kind);
+            let d = rel_diff(&a, &b, 1e-3);
+            println!(
+                "{} {}: difference {d:.2e}, iterations {:?} / {:?}",
+                method.name(),
+                kind.name(),
+                per_step(&a),
+                per_step(&b)
+            );
+            // Same discrete problem up to round-off; the solvers' tolerances are relative.
+            assert!(d <= 1e-10, "{} {}: {d:e}", method.name(), kind.name());
+            assert_eq!(
+                per_step(&a),
+                per_step(&b),
+                "{} {}",
+                method.name(),
+                kind.name()
+            );
+        }
+    }
+}
+
+#[test]
+fn slivers_of_aspect_ratio_1e3_at_the_interface() {
+    let rates = Scene::load("rates").unwrap();
+    let params = vec![("strip".to_string(), 2.9e-4)];
+    for method in [Method::Mortar, Method::Nts] {
+        let (case, newton) = run(&rates, 1, method, &params, SolverKind::Newton);
+        let aspect = metrics::max_aspect_ratio(&case.problem);
+        let (_, qp) = run(&rates, 1, method, &params, SolverKind::Qp);
+        let d = rel_diff(&qp, &newton, 1.0);
+        println!(
+            "{}: aspect {aspect:.0}, newton {:?}, qp vs newton {d:.2e}",
+            method.name(),
+            per_step(&newton)
+        );
+        assert!(aspect >= 900.0, "the strip must make slivers: {aspect}");
+        assert!(newton.max_step_iterations() <= 15);
+        // Two independent solvers of the same equations (bound as in test_solver_agreement).
+        assert!(d <= 1e-7, "{d:e}");
+    }
+}
+
+#[test]
+fn newton_iterations_per_step_do_not_grow_with_h() {
+    let rates = Scene::load("rates").unwrap();
+    let fam = vec![
+        ("h_upper".to_string(), 0.3),
+        ("h_lower".to_string(), 0.3 / 1.4142),
+    ];
+    for method in [Method::Mortar, Method::Nts] {
+        for level in 0..=3 {
+            let (_, sol) = run(&rates, level, method, &fam, SolverKind::Newton);
+            println!("{} level {level}: {:?}", method.name(), per_step(&sol));
+            assert!(sol.max_step_iterations() <= 15, "{:?}", per_step(&sol));
+        }
+    }
+}
