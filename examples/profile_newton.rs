@@ -1,4 +1,5 @@
-//! Repeats one Newton solve to profile it: `cargo run --release --example profile_newton -- LEVEL REPEATS`.
+//! Repeats one Newton solve of the rates scene to profile it:
+//! `cargo run --release --example profile_newton -- LEVEL REPEATS [mortar|nts]`.
 use contact_rates::case::Case;
 use contact_rates::contact::Method;
 use contact_rates::scene::Scene;
@@ -14,7 +15,11 @@ fn main() -> contact_rates::error::Result<()> {
         ("h_upper".to_string(), 0.3),
         ("h_lower".to_string(), 0.3 / 1.4142),
     ];
-    let case = Case::build(&scene, level, Method::Mortar, &fam)?;
+    let method = match args.get(3).map(String::as_str) {
+        Some("nts") => Method::Nts,
+        _ => Method::Mortar,
+    };
+    let case = Case::build(&scene, level, method, &fam)?;
     for _ in 0..repeats {
         let sol = solve::solve(&case.problem, &Settings::default(), 4, false)?;
         let floor = solve::floor_time(&case.problem, 4)?;

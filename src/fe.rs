@@ -481,18 +481,8 @@ impl Model {
         slots: &[[usize; 36]],
         values: &mut [f64],
     ) {
-        let s = Matrix3::from_diagonal(&SVector::<f64, 3>::new(1.0, 1.0, 0.5));
         for ((e, d), sl) in self.elements.iter().zip(tangents).zip(slots) {
-            let b = e.b_matrix();
-            let ke = b.transpose() * (d * s) * b * e.area;
-            for i in 0..6 {
-                for j in 0..6 {
-                    let slot = sl[6 * i + j];
-                    if slot != FIXED {
-                        values[slot] += ke[(i, j)];
-                    }
-                }
-            }
+            scatter_tangent(e, d, sl, values);
         }
     }
 
@@ -505,21 +495,10 @@ impl Model {
         slots: &[[usize; 36]],
         values: &mut [f64],
     ) {
-        let s = Matrix3::from_diagonal(&SVector::<f64, 3>::new(1.0, 1.0, 0.5));
         for ((e, d), sl) in self.elements.iter().zip(tangents).zip(slots) {
             let elastic = self.materials[e.body].elastic.matrix();
-            if *d == elastic {
-                continue;
-            }
-            let b = e.b_matrix();
-            let ke = b.transpose() * ((d - elastic) * s) * b * e.area;
-            for i in 0..6 {
-                for j in 0..6 {
-                    let slot = sl[6 * i + j];
-                    if slot != FIXED {
-                        values[slot] += ke[(i, j)];
-                    }
-                }
+            if *d != elastic {
+                scatter_tangent(e, &(d - elastic), sl, values);
             }
         }
     }
@@ -530,5 +509,21 @@ impl Model {
             .iter()
             .map(|e| self.materials[e.body].elastic.matrix())
             .collect()
+    }
+}
+
+/// Add `|T| B^T D S B` of one element into `values` through its slot map (S halves the
+/// engineering shear).
+fn scatter_tangent(e: &Element, d: &Matrix3<f64>, slots: &[usize; 36], values: &mut [f64]) {
+    let s = Matrix3::from_diagonal(&SVector::<f64, 3>::new(1.0, 1.0, 0.5));
+    let b = e.b_matrix();
+    let ke = b.transpose() * (d * s) * b * e.area;
+    for i in 0..6 {
+        for j in 0..6 {
+            let slot = slots[6 * i + j];
+            if slot != FIXED {
+                values[slot] += ke[(i, j)];
+            }
+        }
     }
 }

@@ -157,9 +157,6 @@ impl<'a> FixedPoint<'a> {
             let un = inf_norm(&u).max(f64::MIN_POSITIVE);
             let qn = inf_norm(&self.q).max(omega * un);
             u_old = u;
-            if std::env::var_os("CR_DEBUG").is_some() && (it < 20 || it % 1000 == 0) {
-                eprintln!("pd it {it}: du/u {:.3e} dq/q {:.3e}", du / un, dq / qn);
-            }
             if !du.is_finite() {
                 return Err(Error::NotConverged(
                     "penalty-duality iterate became non-finite".into(),
@@ -332,9 +329,6 @@ impl StepSolver for FixedPoint<'_> {
                 .max(f64::MIN_POSITIVE);
             let rel = change / size;
             first_change.get_or_insert(rel);
-            if std::env::var_os("CR_DEBUG").is_some() {
-                eprintln!("fixed point {outer}: rel change {rel:.3e}, inner {inner}");
-            }
             eta = eta_new;
             if rel <= self.settings.tol || change == 0.0 {
                 self.eta = Some(eta.clone());
