@@ -244,6 +244,10 @@ pub fn solve(
     solve_times(p, settings, &times, keep_history)
 }
 
+/// States before the last one used by the predictor (HISTORY + 1 points: polynomial
+/// extrapolation of degree HISTORY).
+const HISTORY: usize = 2;
+
 /// Solve the history on the time grid `times` (t_1 < ... < t_N, t_0 = 0).
 pub fn solve_times(
     p: &Problem,
@@ -290,36 +294,38 @@ pub fn solve_times(
         let k = t - prev.time;
         // Warm start: the Lagrange extrapolation through the last three states (two at the
         // second step): the steps' Newton iterations start closer to the solution.
-        let guess = match history.as_slice() {
-            [] => prev.clone(),
-            [b, rest @ ..] => {
-                let (t0, t1) = (prev.time, b.time);
-                let weights = match rest.first() {
-                    Some(c) => {
-                        let t2 = c.time;
-                        [
-                            (t - t1) * (t - t2) / ((t0 - t1) * (t0 - t2)),
-                            (t - t0) * (t - t2) / ((t1 - t0) * (t1 - t2)),
-                            (t - t0) * (t - t1) / ((t2 - t0) * (t2 - t1)),
-                        ]
-                    }
-                    None => [(t - t1) / (t0 - t1), (t - t0) / (t1 - t0), 0.0],
-                };
-                let third = rest.first().unwrap_or(b);
-                let mix = |a: &[f64], bb: &[f64], c: &[f64]| -> Vec<f64> {
-                    (0..a.len())
-                        .map(|i| weights[0] * a[i] + weights[1] * bb[i] + weights[2] * c[i])
-                        .collect()
-                };
-                State {
-                    time: t,
-                    u: mix(&prev.u, &b.u, &third.u),
-                    sigma: prev.sigma.clone(),
-                    lambda: mix(&prev.lambda, &b.lambda, &third.lambda)
-                        .into_iter()
-                        .map(|l| l.max(0.0))
-                        .collect(),
-                }
+        let guess = if history.is_empty() {
+            prev.clone()
+        } else {
+            // Lagrange extrapolation through prev and the history to time t.
+            let points: Vec<&State> = std::iter::once(&prev).chain(history.iter()).collect();
+            let weights: Vec<f64> = (0..points.len())
+                .map(|i| {
+                    (0..points.len())
+                        .filter(|&j| j != i)
+                        .map(|j| (t - points[j].time) / (points[i].time - points[j].time))
+                        .product()
+                })
+                .collect();
+            let mix = |field: &dyn Fn(&State) -> &[f64]| -> Vec<f64> {
+                (0..field(&prev).len())
+                    .map(|d| {
+                        points
+                            .iter()
+                            .zip(&weights)
+                            .map(|(s, w)| w * field(s)[d])
+                            .sum()
+                    })
+                    .collect()
+            };
+            State {
+                time: t,
+                u: mix(&|s: &State| s.u.as_slice()),
+                sigma: prev.sigma.clone(),
+                lambda: mix(&|s: &State| s.lambda.as_slice())
+                    .into_iter()
+                    .map(|l| l.max(0.0))
+                    .collect(),
             }
         };
         let (state, report) = solver.step(&prev, &guess, t, k).map_err(|e| match e {
@@ -335,7 +341,7 @@ pub fn solve_times(
             states.push(state.clone());
         }
         history.insert(0, std::mem::replace(&mut prev, state));
-        history.truncate(2);
+        history.truncate(HISTORY);
     }
     if !keep_history {
         states.push(prev);

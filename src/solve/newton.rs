@@ -394,10 +394,14 @@ impl StepSolver for Newton<'_> {
                     // active set is searched (residual at round-off), the semismooth steps
                     // terminate finitely and want the solve to tolerance: a 1e-2 solve there
                     // left 4e-9 behind and cost one more iteration in other units.
-                    let forcing = res
-                        .max(0.1 * self.settings.tol / res.max(compl))
-                        .min(1e-2)
-                        .max(1e-12);
+                    let tol_term = 0.1 * self.settings.tol / res.max(compl);
+                    let forcing = if tol_term > 1e-2 {
+                        // Within 10x of the tolerance (residual < 1e-9): a loose solve ends it.
+                        tol_term.min(0.5)
+                    } else {
+                        res.max(tol_term).min(1e-2)
+                    }
+                    .max(1e-12);
                     let result = self.system.gmres(&mut rhs, forcing, budget, &|v| {
                         self.precondition(&update, v)
                     });
