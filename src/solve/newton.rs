@@ -63,7 +63,7 @@ pub fn floor_time(p: &Problem, steps: usize) -> Result<f64> {
     p.model.add_tangent(&tangents, &nw.slots, vals);
     for i in 0..m {
         for &(rs, cs, _, v) in &nw.row_slots[i] {
-            vals[cs] = v;
+            vals[cs] = c * v;
             vals[rs] = c * v;
         }
     }
@@ -375,7 +375,7 @@ impl StepSolver for Newton<'_> {
                     rhs[i] = -v;
                 }
                 for i in 0..m {
-                    rhs[n + i] = if active[i] { -c * g[i] } else { -c * lambda[i] };
+                    rhs[n + i] = if active[i] { -c * g[i] } else { -lambda[i] };
                 }
                 rhs
             };
@@ -384,9 +384,12 @@ impl StepSolver for Newton<'_> {
                 let vals = self.system.values_mut();
                 vals.copy_from_slice(&self.elastic_values);
                 model.add_tangent_change(&tangents, &self.slots, vals);
+                // The multiplier unknowns are lambda / c and the contact rows are scaled by
+                // c, so every entry has the size of the stiffness in any units: unscaled, an
+                // LU of [K C^T; C 0] in lengths x 1e3, moduli x 1e6 solved to 1e-9 only.
                 for i in 0..m {
                     for &(rs, cs, _, v) in &self.row_slots[i] {
-                        vals[cs] = v;
+                        vals[cs] = c * v;
                         vals[rs] = if active[i] { c * v } else { 0.0 };
                     }
                     vals[self.diag_slots[i]] = if active[i] { 0.0 } else { c };
@@ -480,7 +483,7 @@ impl StepSolver for Newton<'_> {
                         ut[d] += alpha * rhs[eq];
                     }
                 }
-                let lt: Vec<f64> = (0..m).map(|i| lambda[i] + alpha * rhs[n + i]).collect();
+                let lt: Vec<f64> = (0..m).map(|i| lambda[i] + alpha * c * rhs[n + i]).collect();
                 (ut, lt)
             };
             let mut alpha = 1.0;
