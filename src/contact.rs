@@ -148,37 +148,29 @@ impl Interface {
                 ));
             }
         }
-        let off = model.node_offset;
-        let slave_edges: Vec<[usize; 2]> = model.meshes[0]
-            .curve_edges(raw, &sc.slave_curve)
-            .iter()
-            .map(|e| [e[0] + off[0], e[1] + off[0]])
-            .collect();
-        let master_edges: Vec<[usize; 2]> = model.meshes[1]
-            .curve_edges(raw, &sc.master_curve)
-            .iter()
-            .map(|e| [e[0] + off[1], e[1] + off[1]])
-            .collect();
-        if slave_edges.is_empty() {
-            return Err(Error::input(
-                &sc.file,
-                "contact.slave_curve",
-                format!(
-                    "curve '{}' has no edge on the slave body '{}'",
-                    sc.slave_curve, sc.bodies[0].surface
-                ),
-            ));
-        }
-        if master_edges.is_empty() {
-            return Err(Error::input(
-                &sc.file,
-                "contact.master_curve",
-                format!(
-                    "curve '{}' has no edge on the master body '{}'",
-                    sc.master_curve, sc.bodies[1].surface
-                ),
-            ));
-        }
+        // Body b's edges on its contact curve, in global node numbers.
+        let edges_on =
+            |b: usize, curve: &str, field: &str, role: &str| -> Result<Vec<[usize; 2]>> {
+                let off = model.node_offset[b];
+                let edges: Vec<[usize; 2]> = model.meshes[b]
+                    .curve_edges(raw, curve)
+                    .iter()
+                    .map(|e| [e[0] + off, e[1] + off])
+                    .collect();
+                if edges.is_empty() {
+                    return Err(Error::input(
+                        &sc.file,
+                        field,
+                        format!(
+                            "curve '{curve}' has no edge on the {role} body '{}'",
+                            sc.bodies[b].surface
+                        ),
+                    ));
+                }
+                Ok(edges)
+            };
+        let slave_edges = edges_on(0, &sc.slave_curve, "contact.slave_curve", "slave")?;
+        let master_edges = edges_on(1, &sc.master_curve, "contact.master_curve", "master")?;
         let pos = |g: usize| model.position(g);
         let mut pieces = Vec::new();
         for chain in chains(&slave_edges, "contact.slave_curve", &sc.file)? {

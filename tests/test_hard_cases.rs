@@ -5,6 +5,8 @@
 //! Geometry: meshes/two_blocks.geo (the `rates` scene), level 1 unless stated.
 //! Data: scenes/rates.toml and scenes/rates-units.toml (lengths x 1e3, moduli x 1e6).
 
+mod common;
+
 use contact_rates::case::Case;
 use contact_rates::contact::Method;
 use contact_rates::metrics;
@@ -30,12 +32,8 @@ fn run(
 
 /// Largest nodal difference of `factor * a` to `b`, relative to the largest |b|.
 fn rel_diff(a: &Solution, b: &Solution, factor: f64) -> f64 {
-    let (ua, ub) = (&a.last().u, &b.last().u);
-    let m = ub.iter().fold(0.0f64, |x, v| x.max(v.abs()));
-    ua.iter()
-        .zip(ub)
-        .fold(0.0f64, |x, (p, q)| x.max((factor * p - q).abs()))
-        / m
+    let scaled: Vec<f64> = a.last().u.iter().map(|v| factor * v).collect();
+    common::rel_diff(&b.last().u, &scaled)
 }
 
 fn per_step(s: &Solution) -> Vec<usize> {

@@ -164,11 +164,7 @@ pub struct Solution {
     /// Wall time of the time loop (s): everything the steps do, without the one-off
     /// set-up (`timings.setup_s`).
     pub wall_s: f64,
-    /// Wall time spent in numeric factorizations (s).
-    pub factor_s: f64,
-    /// Number of numeric factorizations.
-    pub factorizations: usize,
-    /// Where the time went.
+    /// Where the time went (factorizations, solves, ...).
     pub timings: Timings,
 }
 
@@ -351,8 +347,6 @@ pub fn solve_times(
         states,
         reports,
         wall_s: start.elapsed().as_secs_f64() - timings.setup_s,
-        factor_s: timings.factor_s,
-        factorizations: timings.factorizations,
         timings,
     })
 }

@@ -51,6 +51,27 @@ struct Clock {
     contact: Cell<f64>,
 }
 
+/// Write the contact rows and columns of the KKT values: column n+i holds c C_i^T; row n+i
+/// holds c C_i and 0 on the diagonal when row i is active, 0 and c when it is inactive.
+/// The multiplier unknowns are lambda / c and the contact rows are scaled by c, so every
+/// entry has the size of the stiffness in any units: unscaled, an LU of [K C^T; C 0] in
+/// lengths x 1e3, moduli x 1e6 solved to 1e-9 only.
+fn fill_contact_rows(
+    vals: &mut [f64],
+    row_slots: &[Vec<(usize, usize, usize, f64)>],
+    diag_slots: &[usize],
+    c: f64,
+    active: &[bool],
+) {
+    for (i, row) in row_slots.iter().enumerate() {
+        for &(rs, cs, _, v) in row {
+            vals[cs] = c * v;
+            vals[rs] = if active[i] { c * v } else { 0.0 };
+        }
+        vals[diag_slots[i]] = if active[i] { 0.0 } else { c };
+    }
+}
+
 /// See [`super::floor_time`].
 pub fn floor_time(p: &Problem, steps: usize) -> Result<f64> {
     let mut nw = Newton::new(p, &super::Settings::default())?;
@@ -61,12 +82,7 @@ pub fn floor_time(p: &Problem, steps: usize) -> Result<f64> {
     let vals = nw.system.values_mut();
     vals.iter_mut().for_each(|v| *v = 0.0);
     p.model.add_tangent(&tangents, &nw.slots, vals);
-    for i in 0..m {
-        for &(rs, cs, _, v) in &nw.row_slots[i] {
-            vals[cs] = c * v;
-            vals[rs] = c * v;
-        }
-    }
+    fill_contact_rows(vals, &nw.row_slots, &nw.diag_slots, c, &vec![true; m]);
     nw.system.factor_lu()?;
     let mut rhs = vec![1.0; nw.n + m];
     for _ in 0..steps {
@@ -384,16 +400,7 @@ impl StepSolver for Newton<'_> {
                 let vals = self.system.values_mut();
                 vals.copy_from_slice(&self.elastic_values);
                 model.add_tangent_change(&tangents, &self.slots, vals);
-                // The multiplier unknowns are lambda / c and the contact rows are scaled by
-                // c, so every entry has the size of the stiffness in any units: unscaled, an
-                // LU of [K C^T; C 0] in lengths x 1e3, moduli x 1e6 solved to 1e-9 only.
-                for i in 0..m {
-                    for &(rs, cs, _, v) in &self.row_slots[i] {
-                        vals[cs] = c * v;
-                        vals[rs] = if active[i] { c * v } else { 0.0 };
-                    }
-                    vals[self.diag_slots[i]] = if active[i] { 0.0 } else { c };
-                }
+                fill_contact_rows(vals, &self.row_slots, &self.diag_slots, c, &active);
             }
             self.clock
                 .assembly

@@ -203,8 +203,6 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Solution> {
         states,
         reports,
         wall_s: h[0],
-        factor_s: timings.factor_s,
-        factorizations: timings.factorizations,
         timings,
     })
 }

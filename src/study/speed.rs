@@ -2,7 +2,7 @@
 //! and compared with the floor measured in the same run on the same matrix (assembly once,
 //! one numeric factorization, two triangular solves per time step).
 
-use super::{error, solve_case};
+use super::solve_case;
 use crate::case::Case;
 use crate::contact::Method;
 use crate::error::Result;
@@ -92,9 +92,10 @@ pub fn peak_rss_gib() -> Option<f64> {
     Some(kb / (1024.0 * 1024.0))
 }
 
-/// Solve `case` with `kind` and measure the floor, `repeats` times alternately; the
-/// solution (deterministic) of the first run and the fastest times.
-fn timed_runs(case: &Case, kind: SolverKind, repeats: usize) -> Result<(Solution, f64, f64)> {
+/// Solve `case` with `kind` and measure the floor, `repeats` times alternately: the
+/// solution (deterministic) of the first run with the fastest run's timings, and the
+/// fastest floor.
+fn timed_runs(case: &Case, kind: SolverKind, repeats: usize) -> Result<(Solution, f64)> {
     let (mut best, _) = solve_case(case, kind, STEPS)?;
     let mut floor_s = solve::floor_time(&case.problem, STEPS)?;
     let mut wall_s = best.wall_s;
@@ -107,7 +108,7 @@ fn timed_runs(case: &Case, kind: SolverKind, repeats: usize) -> Result<(Solution
         }
     }
     best.wall_s = wall_s;
-    Ok((best, floor_s, wall_s))
+    Ok((best, floor_s))
 }
 
 fn row(
@@ -172,7 +173,7 @@ pub fn run() -> Result<SpeedResult> {
                 } else {
                     1
                 };
-                let (sol, floor_s, _) = timed_runs(&case, kind, repeats)?;
+                let (sol, floor_s) = timed_runs(&case, kind, repeats)?;
                 rows.push(row(
                     &scene, &case, kind, &sol, floor_s, repeats, None, family,
                 ));
@@ -202,7 +203,7 @@ pub fn run() -> Result<SpeedResult> {
         ("h_lower".to_string(), h / 1.4142),
     ];
     let case = Case::build(&scene, level, Method::Mortar, &large)?;
-    let (sol, floor_s, _) = timed_runs(&case, SolverKind::Newton, 1)?;
+    let (sol, floor_s) = timed_runs(&case, SolverKind::Newton, 1)?;
     rows.push(row(
         &scene,
         &case,
@@ -213,7 +214,6 @@ pub fn run() -> Result<SpeedResult> {
         None,
         "0.4/0.28284",
     ));
-    let _ = error::norms;
     Ok(SpeedResult {
         rows,
         reference,

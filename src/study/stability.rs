@@ -273,6 +273,30 @@ fn omega_auto(scene: &Scene) -> Result<f64> {
     Ok(d / w)
 }
 
+/// The units case: `sol` against the same solver's solution of `base` (the problem in the
+/// original units, lengths 1 / unit of `sol`'s): the relative nodal difference of u / unit,
+/// and a note comparing the iterations per step (NaN and no note when `base` fails).
+fn against_baseline(
+    sol: &Solution,
+    base: &Case,
+    settings: &Settings,
+    steps: usize,
+    unit: f64,
+) -> (f64, String) {
+    let Ok(b) = solve::solve(&base.problem, settings, steps, true) else {
+        return (f64::NAN, String::new());
+    };
+    let per_step =
+        |s: &Solution| -> Vec<usize> { s.reports.iter().map(|r| r.iterations).collect() };
+    let (a, bb) = (per_step(sol), per_step(&b));
+    let note = if a == bb {
+        format!("; iterations per step {a:?}, identical to the original units")
+    } else {
+        format!("; iterations per step {a:?} against {bb:?} in the original units")
+    };
+    (rel_diff_scaled(sol, &b, 1.0 / unit), note)
+}
+
 fn rel_diff(a: &Solution, b: &Solution) -> f64 {
     rel_diff_scaled(a, b, 1.0)
 }
@@ -316,32 +340,13 @@ pub fn run() -> Result<StabilityResult> {
                 let wall_s = t.elapsed().as_secs_f64();
                 let row = match out {
                     Ok(sol) => {
-                        let mut note = String::new();
-                        let error = match (&baseline, &newton) {
+                        let (error, note) = match (&baseline, &newton) {
                             (Some((base_case, unit)), _) => {
-                                match solve::solve(&base_case.problem, settings, var.steps, true) {
-                                    Ok(b) => {
-                                        let per_step = |s: &Solution| -> Vec<usize> {
-                                            s.reports.iter().map(|r| r.iterations).collect()
-                                        };
-                                        let (a, bb) = (per_step(&sol), per_step(&b));
-                                        note = if a == bb {
-                                            format!(
-                                                "; iterations per step {a:?}, identical to the original units"
-                                            )
-                                        } else {
-                                            format!(
-                                                "; iterations per step {a:?} against {bb:?} in the original units"
-                                            )
-                                        };
-                                        rel_diff_scaled(&sol, &b, 1.0 / unit)
-                                    }
-                                    Err(_) => f64::NAN,
-                                }
+                                against_baseline(&sol, base_case, settings, var.steps, *unit)
                             }
-                            (None, Some(n)) => rel_diff(&sol, n),
-                            (None, None) if *kind == SolverKind::Newton => 0.0,
-                            (None, None) => f64::NAN,
+                            (None, Some(n)) => (rel_diff(&sol, n), String::new()),
+                            (None, None) if *kind == SolverKind::Newton => (0.0, String::new()),
+                            (None, None) => (f64::NAN, String::new()),
                         };
                         let pen = sol
                             .states
