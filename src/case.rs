@@ -5,7 +5,7 @@ use crate::error::Result;
 use crate::fe::Model;
 use crate::mesh::{gmsh, msh};
 use crate::scene::Scene;
-use crate::solve::Problem;
+use crate::solve::{Problem, Solution, SolverKind, Timings};
 use std::time::Instant;
 
 /// A built case with its provenance and set-up costs.
@@ -116,4 +116,90 @@ impl Case {
             warnings,
         })
     }
+}
+
+/// What one solve of a case gave and cost: the run summary that `solve` writes as
+/// summary.csv and `study speed` extends with its own columns.
+#[derive(Debug, Clone)]
+pub struct RunSummary {
+    /// Scene name.
+    pub scene: String,
+    /// Cone.
+    pub method: Method,
+    /// Solver.
+    pub solver: SolverKind,
+    /// Mesh level.
+    pub level: usize,
+    /// Max element diameter over both bodies (length).
+    pub h: f64,
+    /// Free dofs.
+    pub dofs: usize,
+    /// Time steps.
+    pub steps: usize,
+    /// Iterations in total (Newton iterations; inner solves for the fixed-point solvers).
+    pub iterations: usize,
+    /// Largest iteration count of one step.
+    pub max_step_iterations: usize,
+    /// Active-set changes summed over the steps.
+    pub active_set_changes: usize,
+    /// Largest interpenetration at T (length).
+    pub max_penetration: f64,
+    /// Contact fraction at T.
+    pub contact_fraction: f64,
+    /// Plastic fraction at T.
+    pub plastic_fraction: f64,
+    /// Seconds generating (or fetching) and reading the mesh.
+    pub mesh_s: f64,
+    /// Seconds building the model, interface and constraint rows.
+    pub model_s: f64,
+    /// Wall time of the time loop (s), without the solver's one-off set-up.
+    pub time_loop_s: f64,
+    /// Where the solver's time went.
+    pub timings: Timings,
+    /// The floor measured on the same problem (s), when measured.
+    pub floor_s: Option<f64>,
+    /// The process's peak resident memory when the summary was taken (GiB), where known.
+    pub peak_rss_gib: Option<f64>,
+}
+
+impl RunSummary {
+    /// Summarize `sol`, the solution of `case` by `solver`.
+    pub fn new(case: &Case, solver: SolverKind, sol: &Solution, floor_s: Option<f64>) -> Self {
+        let p = &case.problem;
+        let last = sol.last();
+        RunSummary {
+            scene: p.model.scene.name.clone(),
+            method: p.method,
+            solver,
+            level: case.level,
+            h: case.h,
+            dofs: p.model.n_free,
+            steps: sol.reports.len(),
+            iterations: sol.iterations(),
+            max_step_iterations: sol.max_step_iterations(),
+            active_set_changes: sol.active_set_changes(),
+            max_penetration: crate::metrics::max_penetration(p, last),
+            contact_fraction: crate::metrics::contact_fraction(p, last),
+            plastic_fraction: crate::metrics::plastic_fraction(p, last),
+            mesh_s: case.mesh_s,
+            model_s: case.setup_s,
+            time_loop_s: sol.wall_s,
+            timings: sol.timings,
+            floor_s,
+            peak_rss_gib: peak_rss_gib(),
+        }
+    }
+
+    /// Time loop over floor.
+    pub fn ratio_to_floor(&self) -> Option<f64> {
+        self.floor_s.map(|f| self.time_loop_s / f)
+    }
+}
+
+/// The process's peak resident set size (GiB), from /proc/self/status.
+pub fn peak_rss_gib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb / (1024.0 * 1024.0))
 }

@@ -9,8 +9,10 @@ use crate::error::{Error, Result};
 use crate::fe::{FIXED, Model};
 use crate::mesh::RawMesh;
 
-/// Which discrete cone.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+/// Which discrete cone. Written as its [`Method::name`] in files; read from it with an
+/// error that lists the names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase", try_from = "String")]
 pub enum Method {
     /// K_h^pi, the global mortar-type condition.
     Mortar,
@@ -33,6 +35,19 @@ impl Method {
             "nts" => Some(Method::Nts),
             _ => None,
         }
+    }
+}
+
+impl TryFrom<String> for Method {
+    type Error = String;
+    fn try_from(s: String) -> std::result::Result<Self, String> {
+        Method::parse(&s).ok_or_else(|| format!("unknown method '{s}'; use \"mortar\" or \"nts\""))
+    }
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.name())
     }
 }
 

@@ -15,7 +15,7 @@ pub fn max_penetration(p: &Problem, s: &State) -> f64 {
 /// carry a positive multiplier, over the total length.
 pub fn contact_fraction(p: &Problem, s: &State) -> f64 {
     let total: f64 = p.rows.iter().map(|r| r.weight).sum();
-    let scale = s.lambda.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let scale = crate::solve::inf_norm(&s.lambda);
     let on: f64 = p
         .rows
         .iter()

@@ -2,7 +2,7 @@
 //! behind its words.
 
 use super::plot::{self, MeshPanel, Panel, Series};
-use super::write_folder;
+use super::folder::{write, write_folder};
 use crate::error::Result;
 use crate::study::paper::{PaperResult, Run};
 use std::fmt::Write as _;
@@ -301,8 +301,23 @@ pub fn write_paper(res: &PaperResult, dir: &Path) -> Result<()> {
                 );
             }
         }
-        std::fs::write(d.join("README.md"), s)
-            .map_err(|e| crate::error::Error::io(d.join("README.md"), e))?;
-        Ok(())
+        write(d, "README.md", s.as_bytes())
     })
+}
+
+/// What `study paper` prints: Test 2's numbers, Test 3's agreement, and where the report
+/// went.
+pub fn console(res: &PaperResult, dir: &Path) -> String {
+    let mut s = String::new();
+    let t = &res.test2_numbers;
+    let _ = writeln!(
+        s,
+        "Test 2: mortar stress error {:.2e}, nts interpenetration {:.3e} ({:.2e} of max |u|), nts spurious stress {:.3}",
+        t.mortar_stress_error, t.nts_penetration.0, t.nts_penetration.1, t.nts_stress_error.0
+    );
+    for (l, h, d) in &res.test3_agreement {
+        let _ = writeln!(s, "Test 3: level {l} h {h:.4}: non-matching vs matching {d:.3e}");
+    }
+    let _ = writeln!(s, "wrote {} ({:.1} s)", dir.display(), res.wall_s);
+    s
 }

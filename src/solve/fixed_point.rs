@@ -9,7 +9,7 @@
 //! exactly the same discrete problem as the other solvers (multipliers `lambda = W p`).
 
 use super::linear::SparseSystem;
-use super::{Problem, Settings, State, StepReport, StepSolver};
+use super::{Problem, Settings, State, StepReport, StepSolver, inf_norm};
 use crate::contact;
 use crate::error::{Error, Result};
 use crate::fe::Pattern;
@@ -40,10 +40,6 @@ pub struct FixedPoint<'a> {
     clarabel_s: f64,
     /// Seconds building the pattern and slot map (once per mesh).
     pattern_s: f64,
-}
-
-fn inf_norm(v: &[f64]) -> f64 {
-    v.iter().fold(0.0f64, |a, x| a.max(x.abs()))
 }
 
 impl<'a> FixedPoint<'a> {

@@ -12,8 +12,10 @@ use crate::fe::Model;
 use crate::material::Stress;
 use std::time::Instant;
 
-/// Which solver.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+/// Which solver. Written as its [`SolverKind::name`] in files; read from it with an error
+/// that lists the names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase", try_from = "String")]
 pub enum SolverKind {
     /// Implicit return map + consistent tangent + semismooth Newton on the contact rows.
     Newton,
@@ -41,6 +43,24 @@ impl SolverKind {
             _ => None,
         }
     }
+}
+
+impl TryFrom<String> for SolverKind {
+    type Error = String;
+    fn try_from(s: String) -> std::result::Result<Self, String> {
+        SolverKind::parse(&s).ok_or_else(|| format!("unknown solver '{s}'; use newton, paper or qp"))
+    }
+}
+
+impl std::fmt::Display for SolverKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.name())
+    }
+}
+
+/// Largest absolute entry of `v` (0 for an empty slice).
+pub fn inf_norm(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |a, x| a.max(x.abs()))
 }
 
 /// Solver settings.
@@ -97,7 +117,7 @@ impl Problem {
 }
 
 /// The discrete state at one time t_n.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct State {
     /// Time t_n.
     pub time: f64,
@@ -110,7 +130,7 @@ pub struct State {
 }
 
 /// What one time step cost and why it stopped.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct StepReport {
     /// Iterations (Newton iterations; for the fixed-point solvers, inner solves).
     pub iterations: usize,
@@ -125,7 +145,7 @@ pub struct StepReport {
 }
 
 /// Where the time of a solve went (s), and the factorization count.
-#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
+#[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
 pub struct Timings {
     /// Assembling internal forces, tangents and the KKT values.
     pub assembly_s: f64,
@@ -155,7 +175,7 @@ pub fn timed<T>(cell: &std::cell::Cell<f64>, f: impl FnOnce() -> T) -> T {
 }
 
 /// A solved history.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Solution {
     /// States t_0 .. t_N (all of them when `keep_history`, else t_0 and t_N).
     pub states: Vec<State>,
@@ -207,18 +227,13 @@ pub trait StepSolver {
 /// over the free dofs, with scale the larger of |F| and |f_int|.
 pub fn equilibrium_residual(p: &Problem, state: &State, f_ext: &[f64]) -> f64 {
     let mut r = p.model.internal_force(&state.sigma);
-    let scale = p
-        .model
-        .restrict(&r)
-        .iter()
-        .chain(p.model.restrict(f_ext).iter())
-        .fold(0.0f64, |a, v| a.max(v.abs()));
+    let scale = inf_norm(&p.model.restrict(&r)).max(inf_norm(&p.model.restrict(f_ext)));
     for (ri, f) in r.iter_mut().zip(f_ext) {
         *ri -= f;
     }
     contact::add_transpose(&p.rows, &state.lambda, &mut r);
     let rf = p.model.restrict(&r);
-    rf.iter().fold(0.0f64, |a, v| a.max(v.abs())) / scale.max(f64::MIN_POSITIVE)
+    inf_norm(&rf) / scale.max(f64::MIN_POSITIVE)
 }
 
 /// Solve the history on `steps` uniform steps over [0, T]; zero initial state.

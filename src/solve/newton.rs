@@ -7,7 +7,7 @@
 //! needs many iterations (the tangent moved far from the factored one).
 
 use super::linear::SparseSystem;
-use super::{Problem, Settings, State, StepReport, StepSolver};
+use super::{Problem, Settings, State, StepReport, StepSolver, inf_norm};
 use super::{Timings, timed};
 use crate::contact;
 use crate::error::{Error, Result};
@@ -151,10 +151,6 @@ impl<'a> Newton<'a> {
             w_columns: vec![None; m],
         })
     }
-}
-
-fn inf_norm(v: &[f64]) -> f64 {
-    v.iter().fold(0.0f64, |a, x| a.max(x.abs()))
 }
 
 /// An exact correction of the last factorization for the contact rows whose active or

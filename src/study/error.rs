@@ -257,3 +257,14 @@ pub fn pressure_difference(
     }
     (diff, norm)
 }
+
+/// Norms of the difference `a - b` of two states on the same mesh (a time study's error).
+pub fn norms_of_difference(m: &Model, a: &State, b: &State) -> SquaredNorms {
+    let d = State {
+        time: a.time,
+        u: a.u.iter().zip(&b.u).map(|(x, y)| x - y).collect(),
+        sigma: a.sigma.iter().zip(&b.sigma).map(|(x, y)| x - y).collect(),
+        lambda: Vec::new(),
+    };
+    norms(m, &d)
+}

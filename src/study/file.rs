@@ -1,6 +1,9 @@
 //! The TOML layout of a study file (studies/NAME.toml).
 
+use super::quantity::Quantity;
+use crate::contact::Method;
 use crate::error::{Error, Result};
+use crate::solve::SolverKind;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -48,7 +51,7 @@ pub struct ThresholdSpec {
     /// Methods that must reproduce the reference exactly (e.g. mortar on the patch scene):
     /// their `theorem` error must stay below `exact_tolerance` instead of meeting a rate.
     #[serde(default)]
-    pub exact: Vec<String>,
+    pub exact: Vec<Method>,
     /// Largest relative `theorem` error allowed for the `exact` methods.
     #[serde(default = "default_exact_tolerance")]
     pub exact_tolerance: f64,
@@ -56,6 +59,39 @@ pub struct ThresholdSpec {
 
 fn default_exact_tolerance() -> f64 {
     1e-9
+}
+
+/// What a method's `theorem` error must satisfy.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Threshold {
+    /// The fitted rate in h must be at least this (Theorem 3.1's rate minus the tolerance).
+    Rate(f64),
+    /// Every level's relative error must be at most this (a method exact on the scene).
+    Exact(f64),
+}
+
+impl Threshold {
+    /// The number: the required rate or the error bound.
+    pub fn value(self) -> f64 {
+        match self {
+            Threshold::Rate(v) | Threshold::Exact(v) => v,
+        }
+    }
+}
+
+impl ThresholdSpec {
+    /// The threshold of `method`'s `theorem` error.
+    pub fn of(&self, method: Method) -> Threshold {
+        if self.exact.contains(&method) {
+            Threshold::Exact(self.exact_tolerance)
+        } else {
+            let required = match method {
+                Method::Mortar => self.mortar,
+                Method::Nts => self.nts,
+            };
+            Threshold::Rate(required - self.tolerance)
+        }
+    }
 }
 
 /// A time-convergence study on a fixed mesh.
@@ -79,15 +115,15 @@ pub struct StudyFile {
     /// Built-in scene name or a scene file path relative to the study file.
     pub scene: String,
     /// Cones to compare: "mortar", "nts".
-    pub methods: Vec<String>,
-    /// Solver: "newton", "paper" or "qp".
+    pub methods: Vec<Method>,
+    /// Solver: "newton" (default), "paper" or "qp".
     #[serde(default = "default_solver")]
-    pub solver: String,
+    pub solver: SolverKind,
     /// Uniform time steps over [0, T].
     pub steps: usize,
     /// Quantities to report (subset of theorem, h1_u, l2_u, l2_stress, l2_pressure,
     /// max_penetration).
-    pub quantities: Vec<String>,
+    pub quantities: Vec<Quantity>,
     /// The mesh family.
     pub mesh: MeshSpec,
     /// The reference.
@@ -98,19 +134,9 @@ pub struct StudyFile {
     pub time: Option<TimeSpec>,
 }
 
-fn default_solver() -> String {
-    "newton".into()
+fn default_solver() -> SolverKind {
+    SolverKind::Newton
 }
-
-/// The quantities a study can report.
-pub const QUANTITIES: [&str; 6] = [
-    "theorem",
-    "h1_u",
-    "l2_u",
-    "l2_stress",
-    "l2_pressure",
-    "max_penetration",
-];
 
 /// The folder of the built-in studies.
 pub fn builtin_dir() -> PathBuf {
@@ -169,35 +195,10 @@ impl StudyFile {
     pub fn from_toml(text: &str, path: &Path) -> Result<Self> {
         let s: StudyFile = crate::error::parse_toml(text, path, "study file")?;
         let bad = |field: &str, msg: String| Err(Error::input(path, field, msg));
-        for m in &s.methods {
-            if crate::contact::Method::parse(m).is_none() {
-                return bad(
-                    "methods",
-                    format!("unknown method '{m}'; use \"mortar\" or \"nts\""),
-                );
-            }
-        }
         if s.methods.is_empty() {
             return bad("methods", "list at least one method".into());
         }
-        if crate::solve::SolverKind::parse(&s.solver).is_none() {
-            return bad(
-                "solver",
-                format!("unknown solver '{}'; use newton, paper or qp", s.solver),
-            );
-        }
-        for q in &s.quantities {
-            if !QUANTITIES.contains(&q.as_str()) {
-                return bad(
-                    "quantities",
-                    format!(
-                        "unknown quantity '{q}'; use any of {}",
-                        QUANTITIES.join(", ")
-                    ),
-                );
-            }
-        }
-        if !s.quantities.iter().any(|q| q == "theorem") {
+        if !s.quantities.contains(&Quantity::Theorem) {
             return bad(
                 "quantities",
                 "the thresholds apply to 'theorem': include it".into(),
@@ -265,6 +266,15 @@ impl StudyFile {
                 || ts.reference_steps <= *ts.steps.iter().max().unwrap()
             {
                 return bad("time", "give at least 3 positive step counts and reference_steps larger than all of them".into());
+            }
+            if let Some(n) = ts.steps.iter().find(|&&n| ts.reference_steps % n != 0) {
+                return bad(
+                    "time.reference_steps",
+                    format!(
+                        "reference_steps must be a multiple of every step count ({} is not a multiple of {n})",
+                        ts.reference_steps
+                    ),
+                );
             }
         }
         Ok(s)

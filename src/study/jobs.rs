@@ -7,18 +7,20 @@
 use crate::case::Case;
 use crate::contact::Method;
 use crate::error::{Error, Result};
-use crate::material::Stress;
 use crate::mesh::gmsh;
 use crate::scene::Scene;
-use crate::solve::{self, Settings, Solution, SolverKind, State, StepReport, Timings};
+use crate::solve::{self, Settings, Solution, SolverKind};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
+
+/// A job's position in its plan.
+pub type JobId = usize;
 
 /// One solve of a study.
 #[derive(Debug, Clone)]
 pub struct Job {
     /// Position in the plan.
-    pub id: usize,
+    pub id: JobId,
     /// Human-readable label.
     pub label: String,
     /// Cone.
@@ -73,7 +75,7 @@ fn key(job: &Job, scene: &Scene, kind: SolverKind, study_text: &str) -> Result<S
     let scene_text = std::fs::read(&scene.file).map_err(|e| Error::io(&scene.file, e))?;
     let geo = std::fs::read(&scene.geo).map_err(|e| Error::io(&scene.geo, e))?;
     let mut k = format!(
-        "record-v1|{}|{}|{}|{}|{:?}|{}|",
+        "record-v2|{}|{}|{}|{}|{:?}|{}|",
         super::commit(),
         kind.name(),
         job.method.name(),
@@ -87,124 +89,29 @@ fn key(job: &Job, scene: &Scene, kind: SolverKind, study_text: &str) -> Result<S
     Ok(gmsh::sha256_hex(k.as_bytes())[..24].to_string())
 }
 
-fn put_f64s(out: &mut Vec<u8>, v: impl IntoIterator<Item = f64>) {
-    for x in v {
-        out.extend_from_slice(&x.to_le_bytes());
-    }
-}
+/// What a record holds: the solution with its step reports and timings.
+const RECORD_MAGIC: &[u8] = b"CRREC3\n";
 
-/// Serialize a solution (states, step reports, timings) to bytes.
+/// Serialize a solution (states, step reports, timings) to bytes (postcard: f64 as their
+/// exact little-endian bits).
 pub fn encode(sol: &Solution) -> Vec<u8> {
-    let mut o = b"CRREC2\n".to_vec();
-    let t = &sol.timings;
-    put_f64s(
-        &mut o,
-        [
-            sol.wall_s,
-            t.assembly_s,
-            t.factor_s,
-            t.solve_s,
-            t.constitutive_s,
-            t.contact_s,
-            t.factorizations as f64,
-            t.setup_s,
-            t.solves as f64,
-        ],
-    );
-    put_f64s(&mut o, [sol.reports.len() as f64]);
-    for r in &sol.reports {
-        put_f64s(
-            &mut o,
-            [
-                r.iterations as f64,
-                r.outer_iterations as f64,
-                r.residual,
-                r.active_set_changes as f64,
-            ],
-        );
-    }
-    put_f64s(&mut o, [sol.states.len() as f64]);
-    for s in &sol.states {
-        put_f64s(
-            &mut o,
-            [
-                s.time,
-                s.u.len() as f64,
-                s.sigma.len() as f64,
-                s.lambda.len() as f64,
-            ],
-        );
-        put_f64s(&mut o, s.u.iter().copied());
-        put_f64s(&mut o, s.sigma.iter().flat_map(|v| [v[0], v[1], v[2]]));
-        put_f64s(&mut o, s.lambda.iter().copied());
-    }
-    o
+    let mut out = RECORD_MAGIC.to_vec();
+    out.extend(postcard::to_stdvec(sol).expect("a solution serializes"));
+    out
 }
 
 /// Read back what [`encode`] wrote.
 pub fn decode(bytes: &[u8], path: &Path) -> Result<Solution> {
-    let bad = || {
-        Error::input(
-            path,
-            "record",
-            "the record is truncated or not a record; delete it and run the shard again",
-        )
-    };
-    if !bytes.starts_with(b"CRREC2\n") {
-        return Err(bad());
-    }
-    let mut pos = 7;
-    let mut next = || -> Result<f64> {
-        let b = bytes.get(pos..pos + 8).ok_or_else(bad)?;
-        pos += 8;
-        Ok(f64::from_le_bytes(b.try_into().unwrap()))
-    };
-    let h: Vec<f64> = (0..9).map(|_| next()).collect::<Result<_>>()?;
-    let timings = Timings {
-        assembly_s: h[1],
-        factor_s: h[2],
-        solve_s: h[3],
-        constitutive_s: h[4],
-        contact_s: h[5],
-        factorizations: h[6] as usize,
-        setup_s: h[7],
-        solves: h[8] as usize,
-    };
-    let nr = next()? as usize;
-    let mut reports = Vec::with_capacity(nr.min(1 << 20));
-    for _ in 0..nr {
-        let r: Vec<f64> = (0..4).map(|_| next()).collect::<Result<_>>()?;
-        reports.push(StepReport {
-            iterations: r[0] as usize,
-            outer_iterations: r[1] as usize,
-            residual: r[2],
-            active_set_changes: r[3] as usize,
-            reason: "from record".into(),
-        });
-    }
-    let ns = next()? as usize;
-    let mut states = Vec::with_capacity(ns.min(1 << 20));
-    for _ in 0..ns {
-        let head: Vec<f64> = (0..4).map(|_| next()).collect::<Result<_>>()?;
-        let (nu, nsg, nl) = (head[1] as usize, head[2] as usize, head[3] as usize);
-        let u: Vec<f64> = (0..nu).map(|_| next()).collect::<Result<_>>()?;
-        let sigma: Vec<Stress> = (0..nsg)
-            .map(|_| Ok(Stress::new(next()?, next()?, next()?)))
-            .collect::<Result<_>>()?;
-        let lambda: Vec<f64> = (0..nl).map(|_| next()).collect::<Result<_>>()?;
-        states.push(State {
-            time: head[0],
-            u,
-            sigma,
-            lambda,
-        });
-    }
-    Ok(Solution {
-        states,
-        reports,
-        wall_s: h[0],
-        timings,
-    })
+    bytes
+        .strip_prefix(RECORD_MAGIC)
+        .and_then(|body| postcard::from_bytes(body).ok())
+        .ok_or_else(|| {
+            Error::input(
+                path,
+                "record",
+                "the record is truncated or not a record; delete it and run the shard again",
+            )
+        })
 }
 
 /// Build every job's case and obtain its solution according to `mode`. Returns, in plan
@@ -253,4 +160,52 @@ pub fn execute(
         Ok(Some((case, sol)))
     };
     jobs.par_iter().map(run_one).collect()
+}
+
+/// The solved jobs of a plan, taken out by their handles.
+pub struct Solved(Vec<Option<(Case, Solution)>>);
+
+impl Solved {
+    /// All jobs' outputs, or None when some were left to other shards.
+    pub fn complete(outputs: Vec<Option<(Case, Solution)>>) -> Option<Self> {
+        outputs.iter().all(Option::is_some).then_some(Solved(outputs))
+    }
+
+    /// Take job `id`'s case and solution (once).
+    pub fn take(&mut self, id: JobId) -> (Case, Solution) {
+        self.0[id].take().expect("each job is taken once")
+    }
+}
+
+/// Progress reporting: one tick per solve; silent when stderr is not a terminal.
+pub struct Progress(indicatif::ProgressBar);
+
+impl Progress {
+    /// A bar of `n` jobs named `name`.
+    pub fn new(n: u64, name: &str) -> Self {
+        use std::io::IsTerminal;
+        let pb = if std::io::stderr().is_terminal() {
+            indicatif::ProgressBar::new(n)
+        } else {
+            indicatif::ProgressBar::hidden()
+        };
+        pb.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{prefix} [{bar:30}] {pos}/{len} {msg} ({elapsed})",
+            )
+            .unwrap()
+            .progress_chars("=> "),
+        );
+        pb.set_prefix(name.to_string());
+        Progress(pb)
+    }
+    /// One job done.
+    pub fn tick(&self, label: &str) {
+        self.0.set_message(label.to_string());
+        self.0.inc(1);
+    }
+    /// Clear the bar.
+    pub fn finish(&self) {
+        self.0.finish_and_clear();
+    }
 }

@@ -11,6 +11,10 @@ use crate::scene::Scene;
 use crate::solve::{Solution, SolverKind};
 use nalgebra::Vector3;
 
+/// One line for `study list`.
+pub const DESCRIPTION: &str =
+    "The paper's three numerical tests (section 5): figures and the numbers behind its words";
+
 /// Geometry and fields of one solved case, for figures.
 #[derive(Debug, Clone)]
 pub struct MeshData {
@@ -179,7 +183,7 @@ pub fn test2_numbers(mortar: (&Case, &Solution), nts: (&Case, &Solution)) -> Tes
     let umax = |s: &Solution| {
         s.states
             .iter()
-            .map(|st| st.u.iter().fold(0.0f64, |a, v| a.max(v.abs())))
+            .map(|st| crate::solve::inf_norm(&st.u))
             .fold(0.0, f64::max)
     };
     let (mc, ms) = mortar;

@@ -3,65 +3,34 @@
 //! one numeric factorization, two triangular solves per time step).
 
 use super::solve_case;
-use crate::case::Case;
+use crate::case::{Case, RunSummary};
 use crate::contact::Method;
 use crate::error::Result;
 use crate::scene::Scene;
 use crate::solve::{self, Solution, SolverKind};
-use serde::Serialize;
 
-/// One row of speed.csv.
-#[derive(Debug, Clone, Serialize)]
-pub struct SpeedRow {
-    /// Scene.
-    pub scene: String,
-    /// Cone.
-    pub method: String,
-    /// Solver.
-    pub solver: String,
-    /// Mesh level.
-    pub level: usize,
-    /// Free dofs.
-    pub dofs: usize,
-    /// Time steps.
-    pub steps: usize,
-    /// Iterations in total (Newton iterations; inner solves for `paper`).
-    pub iterations: usize,
-    /// Numeric factorizations.
-    pub factorizations: usize,
-    /// Wall time of the time loop (s): the fastest of `repeats` runs.
-    pub wall_s: f64,
-    /// One-off set-up per mesh, not in wall_s: pattern, slot map, symbolic analysis (s).
-    pub setup_s: f64,
+/// One line for `study list`.
+pub const DESCRIPTION: &str = "What each accuracy costs: time split and ratio to the floor, newton against the paper's solver, up to 1.1e6 dofs";
+
+/// One timed run of the speed study.
+#[derive(Debug, Clone)]
+pub struct SpeedRun {
+    /// The run: its time loop is the fastest of `repeats`, with that run's timings.
+    pub run: RunSummary,
     /// Runs timed (solver and floor alternately); times are the fastest of them.
     pub repeats: usize,
-    /// Floor measured in the same run (s), fastest of `repeats`.
-    pub floor_s: f64,
-    /// wall_s / floor_s.
-    pub ratio_to_floor: f64,
-    /// Seconds in factorizations.
-    pub factor_s: f64,
-    /// Seconds in triangular solves (including GMRES).
-    pub solve_s: f64,
-    /// Seconds assembling.
-    pub assembly_s: f64,
-    /// Seconds in constitutive updates.
-    pub constitutive_s: f64,
-    /// Relative theorem-norm error against the reference (empty when the level is too close
+    /// Relative theorem-norm error against the reference (None when the level is too close
     /// to the reference to measure).
     pub error: Option<f64>,
-    /// The process's peak resident memory so far (GiB; /proc/self/status VmHWM, empty where
-    /// unavailable).
-    pub peak_rss_gib: Option<f64>,
     /// gmsh parameters of the mesh family (h_upper/h_lower).
-    pub family: String,
+    pub family: &'static str,
 }
 
 /// What `study speed` measured.
 #[derive(Debug, Clone)]
 pub struct SpeedResult {
     /// All runs.
-    pub rows: Vec<SpeedRow>,
+    pub rows: Vec<SpeedRun>,
     /// Reference level and dofs.
     pub reference: (usize, usize),
     /// Total wall time (s).
@@ -84,14 +53,6 @@ pub const REPEATS: (usize, usize) = (30_000, 7);
 /// (1.11e6 dofs), mortar, newton, 4 steps.
 pub const LARGE: (usize, f64) = (7, 0.4);
 
-/// The process's peak resident set size (GiB), from /proc/self/status.
-pub fn peak_rss_gib() -> Option<f64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb / (1024.0 * 1024.0))
-}
-
 /// Solve `case` with `kind` and measure the floor, `repeats` times alternately: the
 /// solution (deterministic) of the first run with the fastest run's timings, and the
 /// fastest floor.
@@ -109,41 +70,6 @@ fn timed_runs(case: &Case, kind: SolverKind, repeats: usize) -> Result<(Solution
     }
     best.wall_s = wall_s;
     Ok((best, floor_s))
-}
-
-fn row(
-    scene: &Scene,
-    case: &Case,
-    kind: SolverKind,
-    sol: &Solution,
-    floor_s: f64,
-    repeats: usize,
-    error: Option<f64>,
-    family: &str,
-) -> SpeedRow {
-    let t = &sol.timings;
-    SpeedRow {
-        scene: scene.name.clone(),
-        method: case.problem.method.name().into(),
-        solver: kind.name().into(),
-        level: case.level,
-        dofs: case.problem.model.n_free,
-        steps: sol.reports.len(),
-        iterations: sol.iterations(),
-        factorizations: t.factorizations,
-        wall_s: sol.wall_s,
-        setup_s: t.setup_s,
-        repeats,
-        floor_s,
-        ratio_to_floor: sol.wall_s / floor_s,
-        factor_s: t.factor_s,
-        solve_s: t.solve_s,
-        assembly_s: t.assembly_s,
-        constitutive_s: t.constitutive_s,
-        error,
-        peak_rss_gib: peak_rss_gib(),
-        family: family.into(),
-    }
 }
 
 /// Run the speed study on the `rates` scene (h1/h2 = 1.4142 as in `study rates`).
@@ -174,9 +100,12 @@ pub fn run() -> Result<SpeedResult> {
                     1
                 };
                 let (sol, floor_s) = timed_runs(&case, kind, repeats)?;
-                rows.push(row(
-                    &scene, &case, kind, &sol, floor_s, repeats, None, family,
-                ));
+                rows.push(SpeedRun {
+                    run: RunSummary::new(&case, kind, &sol, Some(floor_s)),
+                    repeats,
+                    error: None,
+                    family,
+                });
                 // Errors only where the reference is at least 3 levels finer.
                 if level + 3 <= REFERENCE_LEVEL {
                     kept.push((rows.len() - 1, case.clone(), sol));
@@ -204,16 +133,12 @@ pub fn run() -> Result<SpeedResult> {
     ];
     let case = Case::build(&scene, level, Method::Mortar, &large)?;
     let (sol, floor_s) = timed_runs(&case, SolverKind::Newton, 1)?;
-    rows.push(row(
-        &scene,
-        &case,
-        SolverKind::Newton,
-        &sol,
-        floor_s,
-        1,
-        None,
-        "0.4/0.28284",
-    ));
+    rows.push(SpeedRun {
+        run: RunSummary::new(&case, SolverKind::Newton, &sol, Some(floor_s)),
+        repeats: 1,
+        error: None,
+        family: "0.4/0.28284",
+    });
     Ok(SpeedResult {
         rows,
         reference,

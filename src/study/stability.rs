@@ -9,21 +9,129 @@ use crate::error::{Error, Result};
 use crate::metrics;
 use crate::scene::Scene;
 use crate::solve::{self, Settings, Solution, SolverKind};
-use serde::Serialize;
+use serde::{Serialize, Serializer};
+
+/// One line for `study list`.
+pub const DESCRIPTION: &str = "Hard cases (stiff viscosity, modulus contrast, mesh-size ratio, slivers, units, ...) with every solver and both cones";
+
+/// The hard cases, each with what its report says about it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HardCase {
+    /// k E / lambda swept from 1e-2 to 1e4.
+    StiffViscosity,
+    /// Young's modulus contrast between the bodies.
+    ModulusContrast,
+    /// h1/h2 from 1/16 to 16.
+    MeshSizeRatio,
+    /// The lower block carries the constraint.
+    SwappedSlave,
+    /// The patch scene's upper block, held vertically only by contact.
+    HeldOnlyByContact,
+    /// Interface nodes 1e-11 h apart.
+    NearCoincidentNodes,
+    /// Matching interface meshes.
+    CoincidentNodes,
+    /// Flat triangles along Gamma_C.
+    Slivers,
+    /// Lengths x 1e3, moduli x 1e6.
+    UnitsRescaled,
+    /// Newton's iterations per step at levels 0-5.
+    NewtonAcrossLevels,
+    /// One time step over [0, T].
+    SingleStep,
+    /// The paper's omega over 8 decades.
+    OmegaSweep,
+}
+
+/// A case swept over a numeric parameter, plotted against it.
+#[derive(Debug, Clone, Copy)]
+pub struct Sweep {
+    /// File stem of its plots.
+    pub file: &'static str,
+    /// Label of the swept parameter's axis.
+    pub axis: &'static str,
+}
+
+impl HardCase {
+    /// Name in stability.csv and the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            HardCase::StiffViscosity => "stiff viscosity",
+            HardCase::ModulusContrast => "modulus contrast",
+            HardCase::MeshSizeRatio => "mesh-size ratio",
+            HardCase::SwappedSlave => "slave and master swapped",
+            HardCase::HeldOnlyByContact => "held only by contact",
+            HardCase::NearCoincidentNodes => "near-coincident nodes",
+            HardCase::CoincidentNodes => "coincident nodes",
+            HardCase::Slivers => "slivers",
+            HardCase::UnitsRescaled => "units rescaled",
+            HardCase::NewtonAcrossLevels => "newton iterations across levels",
+            HardCase::SingleStep => "single time step",
+            HardCase::OmegaSweep => "omega sweep",
+        }
+    }
+
+    /// What the report says about the case (empty: its table speaks for itself).
+    pub fn note(self) -> &'static str {
+        match self {
+            HardCase::StiffViscosity => {
+                "k = 0.25, E = 100; lambda set so that k E / lambda sweeps 1e-2..1e4. The paper's fixed point (4.2)-(4.3) is a contraction only while k L < 1."
+            }
+            HardCase::ModulusContrast => "E of the lower block = 100 x E2/E1, upper block E = 100.",
+            HardCase::MeshSizeRatio => "Level 0 with h_upper = 0.2 sqrt(r), h_lower = 0.2 / sqrt(r).",
+            HardCase::Slivers => {
+                "The upper block's first layer along Gamma_C is a structured strip (the `strip` parameter of meshes/two_blocks.geo), one triangle pair per contact edge: the thinner the strip, the flatter the triangles that carry the constraint. The largest aspect ratio (longest edge over the altitude onto it) is measured on the mesh."
+            }
+            HardCase::UnitsRescaled => {
+                "scenes/rates-units.toml: the rates scene with lengths x 1e3 (gmsh writes the .msh scaled, `unit = 1000`), moduli, yield stress, viscosity and tractions x 1e6. `error` here is the largest nodal difference of u / 1e3 to the same solver's solution in the original units, relative to its largest displacement; the reason says whether the iterations per step are identical."
+            }
+            HardCase::NewtonAcrossLevels => {
+                "The study rates family (h_upper = 0.3, h_lower = 0.3 / 1.4142), levels 0-5 (118 to 112,896 dofs): newton's iterations per step do not grow with h."
+            }
+            _ => "",
+        }
+    }
+
+    /// The sweep plotted for this case, if any.
+    pub fn sweep(self) -> Option<Sweep> {
+        let sweep = |file, axis| Some(Sweep { file, axis });
+        match self {
+            HardCase::StiffViscosity => sweep("stiff_viscosity", "k E / lambda"),
+            HardCase::OmegaSweep => sweep("omega_sweep", "omega / automatic omega"),
+            HardCase::ModulusContrast => sweep("modulus_contrast", "E2 / E1"),
+            HardCase::Slivers => sweep("slivers", "largest aspect ratio of a triangle"),
+            _ => None,
+        }
+    }
+
+    /// The swept cases in the order their plots are drawn.
+    pub const SWEEPS: [HardCase; 4] = [
+        HardCase::StiffViscosity,
+        HardCase::OmegaSweep,
+        HardCase::ModulusContrast,
+        HardCase::Slivers,
+    ];
+}
+
+impl Serialize for HardCase {
+    fn serialize<S: Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
 
 /// One row of stability.csv.
 #[derive(Debug, Clone, Serialize)]
 pub struct StabilityRow {
-    /// Case name.
-    pub case: String,
+    /// The case.
+    pub case: HardCase,
     /// Swept parameter and its value, e.g. "k E / lambda = 1e2".
     pub parameter: String,
     /// Numeric value of the parameter (for plots).
     pub value: f64,
     /// Cone.
-    pub method: String,
+    pub method: Method,
     /// Solver.
-    pub solver: String,
+    pub solver: SolverKind,
     /// Whether the solver converged on every step.
     pub converged: bool,
     /// Why it stopped (for a failure, the solver's message).
@@ -52,7 +160,7 @@ pub struct StabilityResult {
 }
 
 struct Variant {
-    case: &'static str,
+    case: HardCase,
     parameter: String,
     value: f64,
     scene: Scene,
@@ -89,7 +197,7 @@ fn plan() -> Result<Vec<Variant>> {
     let rates = Scene::load("rates")?;
     let patch = Scene::load("patch")?;
     let mut v = Vec::new();
-    let base = |case: &'static str, parameter: String, value: f64, scene: Scene| Variant {
+    let base = |case: HardCase, parameter: String, value: f64, scene: Scene| Variant {
         case,
         parameter,
         value,
@@ -120,7 +228,7 @@ fn plan() -> Result<Vec<Variant>> {
             }
         }
         v.push(base(
-            "stiff viscosity",
+            HardCase::StiffViscosity,
             format!("k E / lambda = {label}"),
             ratio,
             s,
@@ -131,7 +239,7 @@ fn plan() -> Result<Vec<Variant>> {
         let mut s = rates.clone();
         set_young(&mut s, 1, 100.0 * 10f64.powi(exp));
         v.push(base(
-            "modulus contrast",
+            HardCase::ModulusContrast,
             format!("E2 / E1 = 1e{exp}"),
             10f64.powi(exp),
             s,
@@ -140,7 +248,7 @@ fn plan() -> Result<Vec<Variant>> {
     // Mesh-size ratio h1/h2 from 1/16 to 16.
     for r in [1.0 / 16.0, 0.25, 1.0, 4.0, 16.0] {
         let mut var = base(
-            "mesh-size ratio",
+            HardCase::MeshSizeRatio,
             format!("h1 / h2 = {r}"),
             r,
             rates.clone(),
@@ -159,7 +267,7 @@ fn plan() -> Result<Vec<Variant>> {
         s.bodies.swap(0, 1);
         std::mem::swap(&mut s.slave_curve, &mut s.master_curve);
         v.push(base(
-            "slave and master swapped",
+            HardCase::SwappedSlave,
             "slave = lower block".into(),
             1.0,
             s,
@@ -168,7 +276,7 @@ fn plan() -> Result<Vec<Variant>> {
     // A body held only by contact (the patch scene's upper block), E = 3e5: the paper's
     // fixed point needs k L < 1, so it is run with 4 steps like the others.
     v.push(base(
-        "held only by contact",
+        HardCase::HeldOnlyByContact,
         "patch, upper block".into(),
         1.0,
         patch.clone(),
@@ -176,7 +284,7 @@ fn plan() -> Result<Vec<Variant>> {
     // Near-coincident (uniform sizing: 1e-11 h apart after splitting) and coincident nodes.
     {
         let mut var = base(
-            "near-coincident nodes",
+            HardCase::NearCoincidentNodes,
             "grading = 1 (nodes 1e-11 h apart)".into(),
             1.0,
             rates.clone(),
@@ -185,7 +293,7 @@ fn plan() -> Result<Vec<Variant>> {
         var.level = 2;
         v.push(var);
         let mut var = base(
-            "coincident nodes",
+            HardCase::CoincidentNodes,
             "matching = 1".into(),
             1.0,
             rates.clone(),
@@ -196,7 +304,7 @@ fn plan() -> Result<Vec<Variant>> {
     // Slivers: a structured strip of the upper block along Gamma_C, one triangle pair per
     // contact edge, thinner and thinner (the measured aspect ratio is in the parameter).
     for strip in [2.9e-2, 2.9e-3, 2.9e-4] {
-        let mut var = base("slivers", format!("strip {strip:e}"), 0.0, rates.clone());
+        let mut var = base(HardCase::Slivers, format!("strip {strip:e}"), 0.0, rates.clone());
         var.params = vec![("strip".into(), strip)];
         v.push(var);
     }
@@ -204,7 +312,7 @@ fn plan() -> Result<Vec<Variant>> {
     // viscosity and tractions x 1e6; compared with the rates scene, solver by solver.
     {
         let mut var = base(
-            "units rescaled",
+            HardCase::UnitsRescaled,
             "lengths x 1e3, moduli x 1e6".into(),
             1.0,
             Scene::load("rates-units")?,
@@ -215,7 +323,7 @@ fn plan() -> Result<Vec<Variant>> {
     // Newton's iterations per step on the rates scene (study rates' family) at every level.
     for level in 0..=5 {
         let mut var = base(
-            "newton iterations across levels",
+            HardCase::NewtonAcrossLevels,
             format!("level {level}"),
             level as f64,
             rates.clone(),
@@ -227,14 +335,14 @@ fn plan() -> Result<Vec<Variant>> {
     }
     // One single time step over [0, T].
     {
-        let mut var = base("single time step", "steps = 1".into(), 1.0, rates.clone());
+        let mut var = base(HardCase::SingleStep, "steps = 1".into(), 1.0, rates.clone());
         var.steps = 1;
         v.push(var);
     }
     // The paper's penalty parameter omega over 8 decades around the automatic value.
     for exp in [-4, -2, 0, 2, 4] {
         let mut var = base(
-            "omega sweep",
+            HardCase::OmegaSweep,
             format!("omega = 1e{exp} x automatic"),
             10f64.powi(exp),
             rates.clone(),
@@ -323,7 +431,7 @@ pub fn run() -> Result<StabilityResult> {
         for method in [Method::Mortar, Method::Nts] {
             let case = Case::build(&var.scene, var.level, method, &var.params)?;
             let (mut parameter, mut value) = (var.parameter.clone(), var.value);
-            if var.case == "slivers" {
+            if var.case == HardCase::Slivers {
                 value = metrics::max_aspect_ratio(&case.problem);
                 parameter = format!("{parameter}: max aspect ratio {value:.0}");
             }
@@ -354,11 +462,11 @@ pub fn run() -> Result<StabilityResult> {
                             .map(|s| metrics::max_penetration(&case.problem, s))
                             .fold(0.0, f64::max);
                         let r = StabilityRow {
-                            case: var.case.into(),
+                            case: var.case,
                             parameter: parameter.clone(),
                             value,
-                            method: method.name().into(),
-                            solver: kind.name().into(),
+                            method,
+                            solver: *kind,
                             converged: true,
                             reason: sol
                                 .reports
@@ -378,11 +486,11 @@ pub fn run() -> Result<StabilityResult> {
                         r
                     }
                     Err(Error::NotConverged(msg)) => StabilityRow {
-                        case: var.case.into(),
+                        case: var.case,
                         parameter: parameter.clone(),
                         value,
-                        method: method.name().into(),
-                        solver: kind.name().into(),
+                        method,
+                        solver: *kind,
                         converged: false,
                         reason: msg,
                         max_step_iterations: 0,

@@ -1,0 +1,129 @@
+//! The output of `solve`: solution.vtu, summary.csv, and the lines printed on the console.
+
+use crate::case::RunSummary;
+use crate::contact::Method;
+use crate::error::Result;
+use crate::fe::Model;
+use crate::io::{self, csv_bytes, write_atomic};
+use crate::solve::{SolverKind, State};
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The one row of summary.csv.
+#[derive(Serialize)]
+struct SummaryCsv<'a> {
+    scene: &'a str,
+    method: Method,
+    solver: SolverKind,
+    level: usize,
+    h: f64,
+    dofs: usize,
+    steps: usize,
+    iterations: usize,
+    max_step_iterations: usize,
+    /// Everything `solve` did, from reading the scene's mesh to the floor (s).
+    wall_s: f64,
+    max_penetration: f64,
+    contact_fraction: f64,
+    plastic_fraction: f64,
+    converged: bool,
+    mesh_s: f64,
+    assembly_s: f64,
+    factor_s: f64,
+    solve_s: f64,
+    constitutive_s: f64,
+    contact_s: f64,
+    factorizations: usize,
+    active_set_changes: usize,
+    time_loop_s: f64,
+    solver_setup_s: f64,
+    floor_s: Option<f64>,
+    ratio_to_floor: Option<f64>,
+}
+
+/// Write `dir/solution.vtu` (the final state) and `dir/summary.csv`; `wall_s` is the whole
+/// run's wall time.
+pub fn write_run(dir: &Path, model: &Model, last: &State, run: &RunSummary, wall_s: f64) -> Result<()> {
+    let t = &run.timings;
+    let row = SummaryCsv {
+        scene: &run.scene,
+        method: run.method,
+        solver: run.solver,
+        level: run.level,
+        h: run.h,
+        dofs: run.dofs,
+        steps: run.steps,
+        iterations: run.iterations,
+        max_step_iterations: run.max_step_iterations,
+        wall_s,
+        max_penetration: run.max_penetration,
+        contact_fraction: run.contact_fraction,
+        plastic_fraction: run.plastic_fraction,
+        converged: true,
+        mesh_s: run.mesh_s,
+        assembly_s: t.assembly_s,
+        factor_s: t.factor_s,
+        solve_s: t.solve_s,
+        constitutive_s: t.constitutive_s,
+        contact_s: t.contact_s,
+        factorizations: t.factorizations,
+        active_set_changes: run.active_set_changes,
+        time_loop_s: run.time_loop_s,
+        solver_setup_s: t.setup_s,
+        floor_s: run.floor_s,
+        ratio_to_floor: run.ratio_to_floor(),
+    };
+    write_atomic(&dir.join("solution.vtu"), io::vtu(model, last).as_bytes())?;
+    write_atomic(&dir.join("summary.csv"), &csv_bytes(&[row])?)
+}
+
+/// What `solve` prints: the run, its cost split, and where the files went.
+pub fn console(run: &RunSummary, wall_s: f64, dir: &Path) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{} {} {} level {}: h = {:.4}, {} dofs, {} steps, {} iterations (max {} per step), {:.3} s; max penetration {:.3e}, contact fraction {:.3}, plastic fraction {:.3}",
+        run.scene,
+        run.method,
+        run.solver,
+        run.level,
+        run.h,
+        run.dofs,
+        run.steps,
+        run.iterations,
+        run.max_step_iterations,
+        wall_s,
+        run.max_penetration,
+        run.contact_fraction,
+        run.plastic_fraction
+    );
+    let t = &run.timings;
+    let floor = match (run.floor_s, run.ratio_to_floor()) {
+        (Some(f), Some(r)) => format!(" = {r:.2} x the floor ({f:.3} s)"),
+        _ => String::new(),
+    };
+    let _ = writeln!(
+        s,
+        "  mesh {:.3} s, model {:.3} s, solver set-up (pattern, symbolic) {:.3} s; time loop {:.3} s{floor}: {} factorizations {:.3} s, solves {:.3} s, assembly {:.3} s, constitutive {:.3} s, contact {:.3} s; {} active-set changes; peak RSS {} GiB",
+        run.mesh_s,
+        run.model_s,
+        t.setup_s,
+        run.time_loop_s,
+        t.factorizations,
+        t.factor_s,
+        t.solve_s,
+        t.assembly_s,
+        t.constitutive_s,
+        t.contact_s,
+        run.active_set_changes,
+        run.peak_rss_gib.map(|g| format!("{g:.1}")).unwrap_or_default()
+    );
+    let _ = writeln!(
+        s,
+        "wrote {} and {}",
+        dir.join("solution.vtu").display(),
+        dir.join("summary.csv").display()
+    );
+    s
+}

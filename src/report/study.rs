@@ -1,0 +1,435 @@
+//! The report of a convergence study: CSV tables, PNG plots and a README.md, and the lines
+//! printed on the console.
+
+use super::folder::{write, write_folder};
+use super::plot::{self, Panel, Series};
+use crate::error::Result;
+use crate::io::{csv_bytes, fmt3};
+use crate::study::convergence::{RateRow, Source, StudyResult, join};
+use crate::study::file::Threshold;
+use crate::study::quantity::Quantity;
+use crate::contact::Method;
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// One row of rates.csv.
+#[derive(Serialize)]
+struct RateCsv {
+    method: Method,
+    quantity: Quantity,
+    #[serde(serialize_with = "crate::io::finite_or_empty")]
+    rate: f64,
+    #[serde(serialize_with = "crate::io::finite_or_empty")]
+    stderr: f64,
+    /// Levels in the fit, space separated.
+    levels_used: String,
+    /// The required rate or the error bound.
+    threshold: Option<f64>,
+    pass: Option<bool>,
+    rate_dofs: Option<f64>,
+    /// Successive rates, space separated.
+    successive: String,
+}
+
+impl RateCsv {
+    fn new(r: &RateRow) -> Self {
+        RateCsv {
+            method: r.method,
+            quantity: r.quantity,
+            rate: r.rate(),
+            stderr: r.stderr(),
+            levels_used: join(&r.levels_used),
+            threshold: r.threshold.map(Threshold::value),
+            pass: r.pass,
+            rate_dofs: r.rate_dofs,
+            successive: successive(r),
+        }
+    }
+}
+
+fn successive(r: &RateRow) -> String {
+    r.successive
+        .iter()
+        .map(|s| format!("{s:.3}"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// "rate >= 0.70" or "error <= 1e-9", with `digits` decimals for a rate.
+fn threshold_text(t: Threshold, digits: usize) -> String {
+    match t {
+        Threshold::Rate(v) => format!("rate >= {v:.digits$}"),
+        Threshold::Exact(v) => format!("error <= {v:.0e}"),
+    }
+}
+
+fn fmt_rate(r: &RateRow) -> String {
+    match r.fit {
+        Some(f) => format!("{:.3} ± {:.3}", f.rate, f.stderr),
+        None => "n/a".into(),
+    }
+}
+
+/// Write the report of a study into `dir` (normally reports/NAME).
+pub fn write_study(res: &StudyResult, dir: &Path) -> Result<()> {
+    write_folder(dir, |d| {
+        write(d, "errors.csv", &csv_bytes(&res.errors)?)?;
+        let rates: Vec<RateCsv> = res.rates.iter().map(RateCsv::new).collect();
+        write(d, "rates.csv", &csv_bytes(&rates)?)?;
+        write(d, "levels.csv", &csv_bytes(&res.levels)?)?;
+        write(d, "pressure.csv", &csv_bytes(&res.pressure)?)?;
+        write(d, "gap.csv", &csv_bytes(&res.gap)?)?;
+        plots(res, d)?;
+        write(d, "README.md", readme(res).as_bytes())
+    })
+}
+
+fn plots(res: &StudyResult, d: &Path) -> Result<()> {
+    // Error against h for the theorem quantity, with fitted lines.
+    let mut series = Vec::new();
+    for (i, &m) in res.file.methods.iter().enumerate() {
+        let rows: Vec<_> = res
+            .errors
+            .iter()
+            .filter(|r| r.method == m && r.quantity == Quantity::Theorem)
+            .collect();
+        let rate = res
+            .rates
+            .iter()
+            .find(|r| r.method == m && r.quantity == Quantity::Theorem)
+            .unwrap();
+        series.push(Series {
+            label: format!("{m} (theorem norm)"),
+            points: rows.iter().map(|r| (r.h, r.error)).collect(),
+            markers: true,
+            line: false,
+            color: i,
+            thin: false,
+        });
+        // The study's fitted line over the levels used.
+        let used: Vec<f64> = rows
+            .iter()
+            .filter(|r| rate.levels_used.contains(&r.level))
+            .map(|r| r.h)
+            .collect();
+        if let Some(fit) = rate.fit.filter(|_| used.len() >= 2) {
+            let hs = [
+                used.iter().copied().fold(f64::INFINITY, f64::min),
+                used.iter().copied().fold(0.0, f64::max),
+            ];
+            series.push(Series {
+                label: format!("{m} fit: slope {:.2} ± {:.2}", fit.rate, fit.stderr),
+                points: hs
+                    .iter()
+                    .map(|&h| (h, (fit.intercept + fit.rate * h.ln()).exp()))
+                    .collect(),
+                markers: false,
+                line: true,
+                color: i,
+                thin: false,
+            });
+        }
+    }
+    for (i, &m) in res.file.methods.iter().enumerate() {
+        let pts: Vec<(f64, f64)> = res
+            .errors
+            .iter()
+            .filter(|r| r.method == m && r.quantity == Quantity::L2Pressure)
+            .map(|r| (r.h, r.error))
+            .collect();
+        if !pts.is_empty() {
+            series.push(Series {
+                label: format!("{m} (contact pressure, L2(Gamma_C))"),
+                points: pts,
+                markers: true,
+                line: true,
+                color: i,
+                thin: true,
+            });
+        }
+    }
+    plot::loglog(
+        &d.join("error_vs_h.png"),
+        &format!("{}: error against h", res.name),
+        "h (max element diameter)",
+        "relative error (theorem norm)",
+        &series,
+        &[(0.5, "1/2"), (0.75, "3/4"), (1.0, "1")],
+    )?;
+    // Error against wall time.
+    let series: Vec<Series> = res
+        .file
+        .methods
+        .iter()
+        .enumerate()
+        .map(|(i, &m)| Series {
+            label: format!("{m}"),
+            points: res
+                .errors
+                .iter()
+                .filter(|r| r.method == m && r.quantity == Quantity::Theorem)
+                .map(|r| (r.wall_s.max(1e-4), r.error))
+                .collect(),
+            markers: true,
+            line: true,
+            color: i,
+            thin: false,
+        })
+        .collect();
+    plot::loglog(
+        &d.join("error_vs_time.png"),
+        &format!(
+            "{}: error against solve time ({} solver)",
+            res.name, res.file.solver
+        ),
+        "wall time of the solve (s)",
+        "relative error (theorem norm)",
+        &series,
+        &[],
+    )?;
+    // Profiles along Gamma_C at T.
+    for (name, data, ylabel) in [
+        ("pressure", &res.pressure, "contact pressure (force/length)"),
+        ("gap", &res.gap, "normal gap -[u.nu] (length)"),
+    ] {
+        let mut sources: Vec<Source> = res.file.methods.iter().map(|&m| Source::Cone(m)).collect();
+        sources.push(Source::Reference);
+        let series: Vec<Series> = sources
+            .iter()
+            .enumerate()
+            .map(|(i, &source)| {
+                let mut pts: Vec<(f64, f64)> = data
+                    .iter()
+                    .filter(|p| p.label == source)
+                    .map(|p| (p.x, p.value))
+                    .collect();
+                pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+                pts.dedup_by(|a, b| a.0 == b.0);
+                let reference = source == Source::Reference;
+                Series {
+                    label: if reference {
+                        format!("reference (level {}, matching)", res.reference.level)
+                    } else {
+                        format!("{} (level {})", source.name(), res.profile_level)
+                    },
+                    points: pts,
+                    markers: !reference,
+                    line: true,
+                    color: if reference { 2 } else { i },
+                    thin: reference,
+                }
+            })
+            .collect();
+        plot::lines(
+            &d.join(format!("{name}.png")),
+            &format!(
+                "{}: {name} along Gamma_C at T = {}",
+                res.name, res.scene.final_time
+            ),
+            "x along Gamma_C",
+            ylabel,
+            &series,
+        )?;
+    }
+    // Deformed meshes coloured by von Mises.
+    let panels: Vec<Panel> = res
+        .deformed
+        .iter()
+        .map(|m| Panel {
+            title: format!("{} (level {})", m.method, res.profile_level),
+            triangles: m.triangles.clone(),
+            values: m.von_mises.clone(),
+            body: m.body.clone(),
+            highlight: Vec::new(),
+        })
+        .collect();
+    if !panels.is_empty() {
+        let mag = res.deformed[0].magnification;
+        plot::field_panels(
+            &d.join("von_mises.png"),
+            &format!(
+                "{}: von Mises stress at T = {}, displacements magnified x{mag:.1}",
+                res.name, res.scene.final_time
+            ),
+            "von Mises stress",
+            &panels,
+        )?;
+    }
+    Ok(())
+}
+
+fn readme(res: &StudyResult) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "# Study `{}`\n\n{}\n", res.name, res.description);
+    let _ = writeln!(s, "Scene `{}`: {}\n", res.scene.name, res.scene.description);
+    let _ = writeln!(
+        s,
+        "Regenerate with `cargo run --release -- study {}` ({:.0} s on this machine, {} cores). Solver `{}`, {} uniform time steps over [0, {}].\n",
+        res.name,
+        res.wall_s,
+        res.provenance.get("cores").cloned().unwrap_or_default(),
+        res.file.solver,
+        res.file.steps,
+        res.scene.final_time
+    );
+    let _ = writeln!(s, "![error against h](error_vs_h.png)\n");
+    let _ = writeln!(
+        s,
+        "## Rates\n\nLeast-squares slope of log(error) against log(h) over the levels used (± standard error), rate against dofs, and successive rates between neighbouring levels. The `theorem` quantity is max_n (||u - u_ref||_H1 + ||sigma - sigma_ref||_L2) over both bodies, relative to the reference's; Theorem 3.1 predicts h^(3/4) for mortar (K_h^pi) and h^(1/2) for nts (K_h^I).\n"
+    );
+    let _ = writeln!(
+        s,
+        "| method | quantity | rate in h | levels used | rate in dofs | successive | threshold | pass |\n|---|---|---|---|---|---|---|---|"
+    );
+    for r in &res.rates {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {} | {} |",
+            r.method,
+            r.quantity,
+            fmt_rate(r),
+            join(&r.levels_used),
+            fmt3(r.rate_dofs.unwrap_or(f64::NAN)),
+            successive(r),
+            r.threshold
+                .map(|t| threshold_text(t, 2))
+                .unwrap_or_default(),
+            r.pass
+                .map(|p| if p { "yes" } else { "**no**" })
+                .unwrap_or("")
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\n## Errors\n\n| method | level | h | dofs | Gamma_C nodes (body 1 / body 2) | theorem | l2_pressure | max_penetration | iterations (max per step) | contact fraction | plastic fraction | solve (s) | fitted |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    );
+    for l in &res.levels {
+        let e = |q: Quantity| {
+            res.errors
+                .iter()
+                .find(|r| r.method == l.method && r.level == l.level && r.quantity == q)
+                .map(|r| format!("{:.3e}", r.error))
+                .unwrap_or_default()
+        };
+        let wall = res
+            .errors
+            .iter()
+            .find(|r| r.method == l.method && r.level == l.level)
+            .map(|r| r.wall_s)
+            .unwrap_or(0.0);
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.4} | {} | {} / {} | {} | {} | {} | {} ({}) | {:.3} | {:.3} | {:.2} | {} |",
+            l.method,
+            l.level,
+            l.h,
+            l.dofs,
+            l.slave_nodes,
+            l.master_nodes,
+            e(Quantity::Theorem),
+            e(Quantity::L2Pressure),
+            e(Quantity::MaxPenetration),
+            l.iterations,
+            l.max_step_iterations,
+            l.contact_fraction,
+            l.plastic_fraction,
+            wall,
+            if l.flagged {
+                "no (within 5x of the reference error)"
+            } else {
+                "yes"
+            }
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\n## Reference\n\nMatching meshes on Gamma_C (where K_h^pi = K_h^I is conforming), level {} (h = {:.4}, {} dofs, solved in {:.1} s). Its own error in the theorem norm, estimated from the two coarser reference levels with the nested-space model d(L, R)^2 = e_L^2 - e_R^2, e_L = C h^p (fitted p = {:.2}): **{:.3e}** relative. Levels whose error is within a factor 5 of it are left out of the fits.\n",
+        res.reference.level,
+        res.reference.h,
+        res.reference.dofs,
+        res.reference.wall_s,
+        res.reference.error_rate,
+        res.reference.error
+    );
+    if let Some(ts) = &res.time_study {
+        let _ = writeln!(
+            s,
+            "## Rate in time\n\nFixed mesh (level {}), k halved, against a reference with {} steps on the same mesh:\n\n| steps | k | theorem error |\n|---|---|---|",
+            ts.level, ts.reference_steps
+        );
+        for r in &ts.runs {
+            let _ = writeln!(s, "| {} | {:.4} | {:.3e} |", r.steps, r.k, r.error);
+        }
+        if let Some(f) = ts.fit {
+            let _ = writeln!(
+                s,
+                "\nRate in k: **{:.3} ± {:.3}** (backward Euler: 1).\n",
+                f.rate, f.stderr
+            );
+        }
+    }
+    let _ = writeln!(
+        s,
+        "## Contact and plasticity at T\n\n![pressure](pressure.png)\n\n![gap](gap.png)\n\n![von Mises](von_mises.png)\n"
+    );
+    let _ = writeln!(s, "## Cost\n\n![error against time](error_vs_time.png)\n");
+    let _ = writeln!(s, "## Provenance\n");
+    for (k, v) in &res.provenance {
+        let _ = writeln!(s, "- {k}: {v}");
+    }
+    let _ = writeln!(
+        s,
+        "- mesh family: {} = {} at level 0, h1/h2 = {}, levels {:?}; reference parameters {:?}",
+        res.file.mesh.size_parameter_1,
+        res.file.mesh.coarsest,
+        res.file.mesh.ratio,
+        res.file.mesh.levels,
+        res.file.reference.parameters
+    );
+    let _ = writeln!(
+        s,
+        "\nData: `errors.csv`, `rates.csv`, `levels.csv`, `pressure.csv`, `gap.csv`."
+    );
+    s
+}
+
+
+/// What `study NAME` prints: the rates with their thresholds, the theorem error per level,
+/// the reference, and where the report went.
+pub fn console(res: &StudyResult, dir: &Path) -> String {
+    let mut s = String::new();
+    for r in &res.rates {
+        let _ = writeln!(
+            s,
+            "{:7} {:16} rate {:>6} +- {} (levels {}){}",
+            r.method.name(),
+            r.quantity.name(),
+            fmt3(r.rate()),
+            fmt3(r.stderr()),
+            join(&r.levels_used),
+            r.threshold
+                .map(|t| format!(
+                    " threshold {}: {}",
+                    threshold_text(t, 3),
+                    if r.pass == Some(true) { "pass" } else { "FAIL" }
+                ))
+                .unwrap_or_default()
+        );
+    }
+    for e in res.errors.iter().filter(|e| e.quantity == Quantity::Theorem) {
+        let _ = writeln!(
+            s,
+            "{} level {} h {:.4} dofs {} error {:.4e} ({:.2} s)",
+            e.method, e.level, e.h, e.dofs, e.error, e.wall_s
+        );
+    }
+    let r = &res.reference;
+    let _ = writeln!(
+        s,
+        "reference level {} ({} dofs, {:.1} s), estimated error {:.3e} (rate {:.2}); study {:.1} s",
+        r.level, r.dofs, r.wall_s, r.error, r.error_rate, res.wall_s
+    );
+    let _ = writeln!(s, "wrote {}", dir.display());
+    s
+}

@@ -1,0 +1,737 @@
+//! Convergence studies: a family of non-matching meshes solved with each cone, errors
+//! against a fine method-neutral reference (matching meshes), fitted rates and thresholds.
+//!
+//! [`run_mode`] reads like the description of a study:
+//! 1. plan the solves (every input check before the first one);
+//! 2. the reference: matching meshes at three levels, the two coarser ones estimating the
+//!    reference's own error;
+//! 3. measure every level of every cone against it, integrated exactly over the
+//!    intersection of the triangulations;
+//! 4. fit rates over the levels whose error is not within 5x of the reference's, and check
+//!    Theorem 3.1's thresholds;
+//! 5. the rate in time on a fixed mesh;
+//! 6. the provenance.
+
+use super::error::{self, Comparison, SquaredNorms};
+use super::file::{StudyFile, Threshold};
+use super::jobs::{self, Job, JobId, Mode, Progress, Solved};
+use super::quantity::{Differences, Quantity};
+use super::rates::{self, Fit};
+use crate::case::Case;
+use crate::contact::Method;
+use crate::error::{Error, Result};
+use crate::metrics;
+use crate::scene::Scene;
+use crate::solve::{Settings, Solution, inf_norm};
+use serde::{Serialize, Serializer};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// One row of errors.csv.
+#[derive(Debug, Clone, Serialize)]
+pub struct ErrorRow {
+    /// Cone.
+    pub method: Method,
+    /// Mesh level.
+    pub level: usize,
+    /// Max element diameter (length).
+    pub h: f64,
+    /// Free dofs.
+    pub dofs: usize,
+    /// Time steps.
+    pub steps: usize,
+    /// Quantity.
+    pub quantity: Quantity,
+    /// Relative error (max over time steps).
+    pub error: f64,
+    /// Wall time of the solve (s).
+    pub wall_s: f64,
+}
+
+/// The fitted rate of one quantity of one cone.
+#[derive(Debug, Clone)]
+pub struct RateRow {
+    /// Cone.
+    pub method: Method,
+    /// Quantity.
+    pub quantity: Quantity,
+    /// Least-squares fit of log(error) against log(h), if the levels used allow one.
+    pub fit: Option<Fit>,
+    /// Levels used in the fit.
+    pub levels_used: Vec<usize>,
+    /// What the error must satisfy (the `theorem` quantity only).
+    pub threshold: Option<Threshold>,
+    /// Whether it does.
+    pub pass: Option<bool>,
+    /// Rate against dofs (error ~ dofs^-rate_dofs).
+    pub rate_dofs: Option<f64>,
+    /// Successive rates between neighbouring levels (all levels).
+    pub successive: Vec<f64>,
+}
+
+impl RateRow {
+    /// The fitted rate in h, NaN when there is none.
+    pub fn rate(&self) -> f64 {
+        self.fit.map_or(f64::NAN, |f| f.rate)
+    }
+    /// Its standard error, NaN when there is none.
+    pub fn stderr(&self) -> f64 {
+        self.fit.map_or(f64::NAN, |f| f.stderr)
+    }
+}
+
+/// Per-level facts of the mesh family.
+#[derive(Debug, Clone, Serialize)]
+pub struct LevelInfo {
+    /// Cone.
+    pub method: Method,
+    /// Level.
+    pub level: usize,
+    /// Max element diameter over both bodies (length).
+    pub h: f64,
+    /// Free dofs.
+    pub dofs: usize,
+    /// Body-1 nodes on Gamma_C.
+    pub slave_nodes: usize,
+    /// Body-2 nodes on Gamma_C.
+    pub master_nodes: usize,
+    /// Newton (or fixed-point) iterations in total.
+    pub iterations: usize,
+    /// Largest iteration count of one step.
+    pub max_step_iterations: usize,
+    /// Contact fraction at T.
+    pub contact_fraction: f64,
+    /// Plastic fraction at T.
+    pub plastic_fraction: f64,
+    /// Whether the level was left out of the fits (error within 5x of the reference's).
+    pub flagged: bool,
+}
+
+/// Which solution a profile point belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Source {
+    /// A study level solved with this cone.
+    Cone(Method),
+    /// The reference.
+    Reference,
+}
+
+impl Source {
+    /// "mortar", "nts" or "reference".
+    pub fn name(self) -> &'static str {
+        match self {
+            Source::Cone(m) => m.name(),
+            Source::Reference => "reference",
+        }
+    }
+}
+
+impl Serialize for Source {
+    fn serialize<S: Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+/// A point of a profile along Gamma_C at T.
+#[derive(Debug, Clone, Serialize)]
+pub struct ProfilePoint {
+    /// Whose profile.
+    pub label: Source,
+    /// Position x.
+    pub x: f64,
+    /// Position y.
+    pub y: f64,
+    /// Contact pressure (force/length) or normal gap (length).
+    pub value: f64,
+}
+
+/// Deformed mesh data for the von Mises plot.
+#[derive(Debug, Clone)]
+pub struct DeformedMesh {
+    /// Cone.
+    pub method: Method,
+    /// Triangles as deformed vertex coordinates.
+    pub triangles: Vec<[[f64; 2]; 3]>,
+    /// Von Mises stress per triangle.
+    pub von_mises: Vec<f64>,
+    /// Body (1 or 2) per triangle.
+    pub body: Vec<u8>,
+    /// Displacement magnification used.
+    pub magnification: f64,
+}
+
+/// The reference solution's facts.
+#[derive(Debug, Clone, Copy)]
+pub struct Reference {
+    /// Mesh level.
+    pub level: usize,
+    /// Max element diameter (length).
+    pub h: f64,
+    /// Free dofs.
+    pub dofs: usize,
+    /// Wall time of its solve (s).
+    pub wall_s: f64,
+    /// Its estimated relative error in the theorem norm.
+    pub error: f64,
+    /// The rate p of the nested-space model used for that estimate.
+    pub error_rate: f64,
+}
+
+/// One run of the time study.
+#[derive(Debug, Clone, Copy)]
+pub struct TimeRun {
+    /// Time steps.
+    pub steps: usize,
+    /// Step length k (time).
+    pub k: f64,
+    /// Relative theorem-norm error against the time reference.
+    pub error: f64,
+}
+
+/// The rate in time on a fixed mesh.
+#[derive(Debug, Clone)]
+pub struct TimeStudy {
+    /// Mesh level.
+    pub level: usize,
+    /// Steps of the reference in time.
+    pub reference_steps: usize,
+    /// The runs, k halved from one to the next.
+    pub runs: Vec<TimeRun>,
+    /// The fitted rate in k.
+    pub fit: Option<Fit>,
+}
+
+/// Everything a study measured.
+#[derive(Debug, Clone)]
+pub struct StudyResult {
+    /// Study name.
+    pub name: String,
+    /// Study description.
+    pub description: String,
+    /// The parsed study file.
+    pub file: StudyFile,
+    /// The scene.
+    pub scene: Scene,
+    /// Errors per method, level and quantity.
+    pub errors: Vec<ErrorRow>,
+    /// Rates per method and quantity.
+    pub rates: Vec<RateRow>,
+    /// Per-level facts.
+    pub levels: Vec<LevelInfo>,
+    /// The reference.
+    pub reference: Reference,
+    /// Pressure profiles at T on the profile level (and the reference's).
+    pub pressure: Vec<ProfilePoint>,
+    /// Gap profiles at T on the profile level (and the reference's).
+    pub gap: Vec<ProfilePoint>,
+    /// Level of the profiles.
+    pub profile_level: usize,
+    /// Deformed meshes on the profile level.
+    pub deformed: Vec<DeformedMesh>,
+    /// The time study, if the study file asks for one.
+    pub time_study: Option<TimeStudy>,
+    /// gmsh version, .geo hash, solver, cores, commit.
+    pub provenance: BTreeMap<String, String>,
+    /// Total wall time (s).
+    pub wall_s: f64,
+    /// Scene warnings (from the reference case).
+    pub warnings: Vec<String>,
+}
+
+impl StudyResult {
+    /// The thresholds the study missed, one sentence each (empty: it passed).
+    pub fn failures(&self) -> Vec<String> {
+        self.rates
+            .iter()
+            .filter(|r| r.pass == Some(false))
+            .filter_map(|r| match r.threshold? {
+                Threshold::Exact(t) => Some(format!(
+                    "{} {} error above the exactness tolerance {t:.1e}",
+                    r.method, r.quantity
+                )),
+                Threshold::Rate(t) => Some(format!(
+                    "{} {} rate {:.3} < {t:.3} (levels {})",
+                    r.method,
+                    r.quantity,
+                    r.rate(),
+                    join(&r.levels_used)
+                )),
+            })
+            .collect()
+    }
+}
+
+/// Levels as "0 1 2".
+pub fn join(levels: &[usize]) -> String {
+    levels
+        .iter()
+        .map(|l| l.to_string())
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// A study file with its scene, read and checked.
+struct Study {
+    name: String,
+    path: PathBuf,
+    text: String,
+    file: StudyFile,
+    scene: Scene,
+}
+
+impl Study {
+    fn load(name: &str) -> Result<Self> {
+        let path = super::file::resolve(name)?;
+        let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+        let file = StudyFile::from_toml(&text, &path)?;
+        // A scene path is relative to the study file; otherwise it is a built-in name.
+        let scene_path = path.parent().unwrap_or(Path::new(".")).join(&file.scene);
+        let scene = if scene_path.exists() {
+            Scene::load(&scene_path.display().to_string())?
+        } else {
+            Scene::load(&file.scene)?
+        };
+        Ok(Study {
+            name: path.file_stem().unwrap().to_string_lossy().to_string(),
+            path,
+            text,
+            file,
+            scene,
+        })
+    }
+
+    /// The reference level: the finest study level plus `levels_above`.
+    fn reference_level(&self) -> usize {
+        self.file.mesh.levels.last().unwrap() + self.file.reference.levels_above
+    }
+}
+
+/// The study's solves, with a named handle for each.
+struct Plan {
+    jobs: Vec<Job>,
+    /// The reference levels, coarsest first (the finest is the reference).
+    reference: [JobId; 3],
+    /// Every cone on every study level, cone by cone.
+    levels: Vec<(Method, usize, JobId)>,
+    /// The time study: its reference, then one run per step count.
+    time: Option<(JobId, Vec<(usize, JobId)>)>,
+}
+
+impl Plan {
+    /// Plan every solve and check what can be checked before the first one: the reference
+    /// meshes must match on Gamma_C. Uniform splitting keeps matching traces matching, so
+    /// the coarsest reference level (a cheap mesh) decides for all three.
+    fn new(study: &Study) -> Result<Self> {
+        let sf = &study.file;
+        let family = sf.family_parameters();
+        let reference_parameters = sf.reference_parameters();
+        let mut jobs = Vec::new();
+        let mut add = |label: String, method: Method, level: usize, params: &[(String, f64)], steps: usize| {
+            jobs.push(Job {
+                id: jobs.len(),
+                label,
+                method,
+                level,
+                params: params.to_vec(),
+                steps,
+            });
+            jobs.len() - 1
+        };
+        let r = study.reference_level();
+        let reference = [r - 2, r - 1, r].map(|l| {
+            add(format!("reference level {l}"), Method::Mortar, l, &reference_parameters, sf.steps)
+        });
+        let mut levels = Vec::new();
+        for &method in &sf.methods {
+            for &level in &sf.mesh.levels {
+                let id = add(format!("{method} level {level}"), method, level, &family, sf.steps);
+                levels.push((method, level, id));
+            }
+        }
+        let time = sf.time.as_ref().map(|ts| {
+            let method = sf.methods[0];
+            let reference = add(
+                format!("time reference ({} steps)", ts.reference_steps),
+                method,
+                ts.level,
+                &family,
+                ts.reference_steps,
+            );
+            let runs = ts
+                .steps
+                .iter()
+                .map(|&n| (n, add(format!("time study ({n} steps)"), method, ts.level, &family, n)))
+                .collect();
+            (reference, runs)
+        });
+        let coarsest = &jobs[reference[0]];
+        let case = Case::build(&study.scene, coarsest.level, coarsest.method, &coarsest.params)?;
+        if case.problem.interface.min_relative_separation() > 1e-9 {
+            return Err(Error::input(
+                &study.path,
+                "reference.parameters",
+                "the reference meshes do not match on Gamma_C; set the .geo parameter that makes them match (e.g. matching = 1)",
+            ));
+        }
+        Ok(Plan {
+            jobs,
+            reference,
+            levels,
+            time,
+        })
+    }
+}
+
+/// The reference solution with what every level is measured against.
+struct ReferenceSolution {
+    case: Case,
+    solution: Solution,
+    /// Squared norms per step t_1..t_N.
+    norms: Vec<SquaredNorms>,
+    /// Largest |u| over the history (length).
+    max_displacement: f64,
+    facts: Reference,
+}
+
+/// Step 2: the reference and the estimate of its own error. The reference levels are nested
+/// conforming spaces, so their errors are close to orthogonal: d(L, R)^2 = e_L^2 - e_R^2 with
+/// e_L = C h_L^p (measured on the rates scene: d(R-2,R)/d(R-1,R) = 2.24 = sqrt(5), i.e.
+/// p = 1). Hence (d(R-2,R)/d(R-1,R))^2 = 4^p + 1 and e_R = d(R-1,R) / sqrt(4^p - 1).
+fn reference(plan: &Plan, solved: &mut Solved, level: usize) -> ReferenceSolution {
+    let [coarser2, coarser1, finest] = plan.reference.map(|id| solved.take(id));
+    let (case, solution) = finest;
+    let d1 = super::theorem_distance(&coarser1.0, &coarser1.1, &case, &solution);
+    let d2 = super::theorem_distance(&coarser2.0, &coarser2.1, &case, &solution);
+    let error_rate = ((d2 / d1).powi(2) - 1.0)
+        .max(1.0 + 1e-12)
+        .log(4.0)
+        .clamp(0.25, 3.0);
+    let error = d1 / (4f64.powf(error_rate) - 1.0).sqrt();
+    let norms = solution
+        .states
+        .iter()
+        .skip(1)
+        .map(|s| error::norms(&case.problem.model, s))
+        .collect();
+    let max_displacement = solution
+        .states
+        .iter()
+        .map(|s| inf_norm(&s.u))
+        .fold(0.0f64, f64::max);
+    let facts = Reference {
+        level,
+        h: case.h,
+        dofs: case.problem.model.n_free,
+        wall_s: solution.wall_s,
+        error,
+        error_rate,
+    };
+    ReferenceSolution {
+        case,
+        solution,
+        norms,
+        max_displacement,
+        facts,
+    }
+}
+
+/// What step 3 measured.
+#[derive(Default)]
+struct Measured {
+    errors: Vec<ErrorRow>,
+    levels: Vec<LevelInfo>,
+    pressure: Vec<ProfilePoint>,
+    gap: Vec<ProfilePoint>,
+    deformed: Vec<DeformedMesh>,
+}
+
+/// Step 3: every level of every cone against the reference; profiles and deformed meshes
+/// on `profile_level`.
+fn measure_levels(
+    sf: &StudyFile,
+    plan: &Plan,
+    solved: &mut Solved,
+    reference: &ReferenceSolution,
+    profile_level: usize,
+) -> Result<Measured> {
+    let (rcase, rsol) = (&reference.case, &reference.solution);
+    let mut out = Measured::default();
+    profiles(rcase, rsol, Source::Reference, &mut out);
+    let magnification = 0.1 / inf_norm(&rsol.last().u).max(f64::MIN_POSITIVE);
+    for &(method, level, id) in &plan.levels {
+        let (case, sol) = solved.take(id);
+        let errors = relative_errors(&case, &sol, reference);
+        for &quantity in &sf.quantities {
+            let error = errors[&quantity];
+            if !error.is_finite() {
+                return Err(Error::NotConverged(format!(
+                    "{method} level {level}: the {quantity} error is not finite"
+                )));
+            }
+            out.errors.push(ErrorRow {
+                method,
+                level,
+                h: case.h,
+                dofs: case.problem.model.n_free,
+                steps: sf.steps,
+                quantity,
+                error,
+                wall_s: sol.wall_s,
+            });
+        }
+        out.levels.push(level_info(
+            &case,
+            &sol,
+            method,
+            errors[&Quantity::Theorem] < 5.0 * reference.facts.error,
+        ));
+        if level == profile_level {
+            profiles(&case, &sol, Source::Cone(method), &mut out);
+            out.deformed.push(deformed(&case, &sol, method, magnification));
+        }
+    }
+    Ok(out)
+}
+
+/// Every quantity's relative error of one solved level against the reference.
+fn relative_errors(case: &Case, sol: &Solution, reference: &ReferenceSolution) -> BTreeMap<Quantity, f64> {
+    let (rcase, rsol) = (&reference.case, &reference.solution);
+    let (model, rmodel) = (&case.problem.model, &rcase.problem.model);
+    let cmp = Comparison::new(model, rmodel);
+    let steps = || sol.states.iter().zip(&rsol.states).skip(1);
+    let fields: Vec<SquaredNorms> = steps().map(|(s, r)| cmp.difference(model, s, rmodel, r)).collect();
+    let pressure: Vec<(f64, f64)> = steps()
+        .map(|(s, r)| error::pressure_difference(&case.problem, s, &rcase.problem, r))
+        .collect();
+    let penetration = sol
+        .states
+        .iter()
+        .map(|s| metrics::max_penetration(&case.problem, s))
+        .fold(0.0f64, f64::max);
+    Differences {
+        fields: &fields,
+        reference: &reference.norms,
+        pressure: &pressure,
+        penetration,
+        reference_displacement: reference.max_displacement,
+    }
+    .relative()
+}
+
+fn level_info(case: &Case, sol: &Solution, method: Method, flagged: bool) -> LevelInfo {
+    let pieces = &case.problem.interface.pieces;
+    let last = sol.last();
+    LevelInfo {
+        method,
+        level: case.level,
+        h: case.h,
+        dofs: case.problem.model.n_free,
+        slave_nodes: pieces.iter().map(|p| p.slave_nodes.len()).sum(),
+        master_nodes: pieces.iter().map(|p| p.master_nodes.len()).sum(),
+        iterations: sol.iterations(),
+        max_step_iterations: sol.max_step_iterations(),
+        contact_fraction: metrics::contact_fraction(&case.problem, last),
+        plastic_fraction: metrics::plastic_fraction(&case.problem, last),
+        flagged,
+    }
+}
+
+/// Pressure at the body-1 trace nodes and gap -[u.nu] at both bodies' trace nodes, at T.
+fn profiles(case: &Case, sol: &Solution, label: Source, out: &mut Measured) {
+    let p = &case.problem;
+    let s = sol.last();
+    for profile in error::pressure_profile(p, s) {
+        for (x, value) in profile {
+            out.pressure.push(ProfilePoint {
+                label,
+                x: x[0],
+                y: x[1],
+                value,
+            });
+        }
+    }
+    for (pi, sv, jump) in crate::contact::normal_jumps(&p.interface, &s.u) {
+        let pc = &p.interface.pieces[pi];
+        // Gap = -[u.nu]: positive where the bodies separate.
+        out.gap.push(ProfilePoint {
+            label,
+            x: pc.a[0] + sv * pc.tangent[0],
+            y: pc.a[1] + sv * pc.tangent[1],
+            value: -jump,
+        });
+    }
+}
+
+fn deformed(case: &Case, sol: &Solution, method: Method, magnification: f64) -> DeformedMesh {
+    let m = &case.problem.model;
+    let s = sol.last();
+    let pos = |n: usize| {
+        let p = m.position(n);
+        [
+            p[0] + magnification * s.u[2 * n],
+            p[1] + magnification * s.u[2 * n + 1],
+        ]
+    };
+    DeformedMesh {
+        method,
+        triangles: m.elements.iter().map(|e| e.nodes.map(pos)).collect(),
+        von_mises: s.sigma.iter().map(crate::material::von_mises).collect(),
+        body: m.elements.iter().map(|e| e.body as u8 + 1).collect(),
+        magnification,
+    }
+}
+
+/// Step 4: rates of every quantity of every cone over its unflagged levels (all levels for
+/// a method that must be exact), and the thresholds of the `theorem` quantity.
+fn fit_rates(sf: &StudyFile, measured: &Measured) -> Vec<RateRow> {
+    let flagged = |method: Method, level: usize| {
+        measured
+            .levels
+            .iter()
+            .any(|l| l.method == method && l.level == level && l.flagged)
+    };
+    let mut out = Vec::new();
+    for &method in &sf.methods {
+        let threshold = sf.thresholds.of(method);
+        for &quantity in &sf.quantities {
+            let rows: Vec<&ErrorRow> = measured
+                .errors
+                .iter()
+                .filter(|r| r.method == method && r.quantity == quantity)
+                .collect();
+            let exact = matches!(threshold, Threshold::Exact(_));
+            let used: Vec<&ErrorRow> = rows
+                .iter()
+                .copied()
+                .filter(|r| exact || !flagged(method, r.level))
+                .collect();
+            let column = |rows: &[&ErrorRow], f: fn(&ErrorRow) -> f64| -> Vec<f64> {
+                rows.iter().map(|r| f(r)).collect()
+            };
+            let errors = column(&used, |r| r.error);
+            let fit = rates::fit(&column(&used, |r| r.h), &errors);
+            let fit_dofs = rates::fit(&column(&used, |r| r.dofs as f64), &errors);
+            let threshold = (quantity == Quantity::Theorem).then_some(threshold);
+            let pass = threshold.map(|t| match t {
+                Threshold::Exact(bound) => column(&rows, |r| r.error).into_iter().fold(0.0f64, f64::max) <= bound,
+                Threshold::Rate(rate) => used.len() >= 3 && fit.is_some_and(|f| f.rate >= rate),
+            });
+            out.push(RateRow {
+                method,
+                quantity,
+                fit,
+                levels_used: used.iter().map(|r| r.level).collect(),
+                threshold,
+                pass,
+                rate_dofs: fit_dofs.map(|f| -f.rate),
+                successive: rates::successive(&column(&rows, |r| r.h), &column(&rows, |r| r.error)),
+            });
+        }
+    }
+    out
+}
+
+/// Step 5: the rate in time on a fixed mesh, each run against the reference in time at the
+/// common time points.
+fn time_study(sf: &StudyFile, plan: &Plan, solved: &mut Solved) -> Option<TimeStudy> {
+    let ts = sf.time.as_ref()?;
+    let (reference_id, run_ids) = plan.time.as_ref()?;
+    let (case, reference) = solved.take(*reference_id);
+    let model = &case.problem.model;
+    let runs: Vec<TimeRun> = run_ids
+        .iter()
+        .map(|&(steps, id)| {
+            let (_, sol) = solved.take(id);
+            let stride = ts.reference_steps / steps;
+            let (mut error, mut norm) = (0.0f64, 0.0f64);
+            for (i, state) in sol.states.iter().enumerate().skip(1) {
+                let r = &reference.states[i * stride];
+                error = error.max(error::norms_of_difference(model, state, r).theorem());
+                norm = norm.max(error::norms(model, r).theorem());
+            }
+            TimeRun {
+                steps,
+                k: model.scene.final_time / steps as f64,
+                error: error / norm,
+            }
+        })
+        .collect();
+    let ks: Vec<f64> = runs.iter().map(|r| r.k).collect();
+    let es: Vec<f64> = runs.iter().map(|r| r.error).collect();
+    Some(TimeStudy {
+        level: ts.level,
+        reference_steps: ts.reference_steps,
+        fit: rates::fit(&ks, &es),
+        runs,
+    })
+}
+
+/// Step 6: where the numbers come from.
+fn provenance(study: &Study, reference: &Case) -> BTreeMap<String, String> {
+    let geo = study.scene.geo.file_name().unwrap().to_string_lossy();
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    BTreeMap::from([
+        ("gmsh".into(), reference.mesh.gmsh_version.clone()),
+        ("geo".into(), format!("{geo} (sha256 {})", reference.mesh.geo_hash)),
+        (
+            "solver".into(),
+            format!("{} (tolerance {:.0e})", study.file.solver, Settings::default().tol),
+        ),
+        ("cores".into(), cores.to_string()),
+        ("commit".into(), super::commit()),
+    ])
+}
+
+/// Run the convergence study `name` (built-in name or path).
+pub fn run(name: &str) -> Result<StudyResult> {
+    run_mode(name, Mode::All).map(|r| r.expect("a full run gives a result"))
+}
+
+/// Run the convergence study `name` in `mode`: all jobs here, one shard of them (records
+/// only, no result), or a merge of the records of all shards.
+pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
+    let t0 = Instant::now();
+    let study = Study::load(name)?;
+    let sf = &study.file;
+    let plan = Plan::new(&study)?;
+    let progress = Progress::new(plan.jobs.len() as u64, &study.name);
+    let outputs = jobs::execute(&plan.jobs, &study.scene, sf.solver, &study.text, mode, &|label| {
+        progress.tick(label)
+    })?;
+    progress.finish();
+    if let Mode::Shard(i, n) = mode {
+        eprintln!(
+            "shard {i}/{n}: {} of {} jobs solved, records in {}",
+            outputs.iter().filter(|o| o.is_some()).count(),
+            plan.jobs.len(),
+            jobs::records_dir().display()
+        );
+        return Ok(None);
+    }
+    let mut solved = Solved::complete(outputs).expect("every job ran or was loaded");
+    let reference = reference(&plan, &mut solved, study.reference_level());
+    let profile_level = sf.mesh.levels[sf.mesh.levels.len() / 2];
+    let measured = measure_levels(sf, &plan, &mut solved, &reference, profile_level)?;
+    let rates = fit_rates(sf, &measured);
+    let time_study = time_study(sf, &plan, &mut solved);
+    let provenance = provenance(&study, &reference.case);
+    Ok(Some(StudyResult {
+        name: study.name,
+        description: sf.description.clone(),
+        scene: study.scene,
+        errors: measured.errors,
+        rates,
+        levels: measured.levels,
+        reference: reference.facts,
+        pressure: measured.pressure,
+        gap: measured.gap,
+        profile_level,
+        deformed: measured.deformed,
+        time_study,
+        provenance,
+        wall_s: t0.elapsed().as_secs_f64(),
+        warnings: reference.case.warnings.clone(),
+        file: study.file,
+    }))
+}
