@@ -151,18 +151,8 @@ impl Interface {
     pub fn new(model: &Model, raw: &RawMesh) -> Result<Self> {
         let file = &model.mesh_file;
         let sc = &model.scene;
-        for c in [&sc.slave_curve, &sc.master_curve] {
-            if raw.physical_tag(1, c).is_none() {
-                return Err(Error::input(
-                    file,
-                    c.as_str(),
-                    format!(
-                        "the mesh has no physical curve named '{c}' (it has: {}); fix contact.*_curve in the scene or the .geo",
-                        raw.names_of_dim(1).join(", ")
-                    ),
-                ));
-            }
-        }
+        raw.require_curve(&sc.slave_curve, file, "contact.slave_curve")?;
+        raw.require_curve(&sc.master_curve, file, "contact.master_curve")?;
         // Body b's edges on its contact curve, in global node numbers.
         let edges_on =
             |b: usize, curve: &str, field: &str, role: &str| -> Result<Vec<[usize; 2]>> {
@@ -345,25 +335,37 @@ impl Piece {
             .collect()
     }
 
+    /// pi_h^1 as the matrix M^{-1} D: the interior rows solve the tridiagonal system of
+    /// the test functions psi_j against the body-1 hats; the end rows keep the end values.
     fn mortar(&self) -> Vec<Vec<f64>> {
-        let (ss, ms) = (&self.slave_s, &self.master_s);
-        let m = ss.len() - 1; // body-1 elements
-        let nm = ms.len();
+        let m = self.slave_s.len() - 1; // body-1 elements
+        let nm = self.master_s.len();
         let mut p = vec![vec![0.0; nm]; m + 1];
         p[0][0] = 1.0;
         p[m][nm - 1] = 1.0;
         if m < 2 {
             return p;
         }
-        // Merged breakpoints.
+        let integrals = self.trace_integrals();
+        let system = MortarSystem::new(&integrals, m, nm);
+        for (r, row) in system.solve().into_iter().enumerate() {
+            p[r + 1] = row;
+        }
+        p
+    }
+
+    /// The products of the trace hats, integrated exactly over the merged breakpoints of
+    /// both trace meshes: on each sub-interval the integrands are products of two linear
+    /// functions, which Simpson's rule integrates exactly.
+    fn trace_integrals(&self) -> TraceIntegrals {
+        let (ss, ms) = (&self.slave_s, &self.master_s);
+        let m = ss.len() - 1;
+        let nm = ms.len();
         let mut br: Vec<f64> = ss.iter().chain(ms.iter()).copied().collect();
         br.sort_by(f64::total_cmp);
         br.dedup_by(|x, y| (*x - *y).abs() <= 1e-14 * self.length);
-        // Integrals I[j][k] = int lambda_j lambda_k (slave-slave, tridiagonal, k in j-1..=j+1)
-        // and J[j][q] = int lambda_j mu_q, exact by Simpson on each sub-interval (the
-        // integrands are products of two linear functions there).
-        let mut ss_int = vec![[0.0f64; 3]; m + 1]; // [k=j-1, k=j, k=j+1]
-        let mut sm_int: Vec<Vec<(usize, f64)>> = vec![Vec::new(); m + 1];
+        let mut slave_slave = vec![[0.0f64; 3]; m + 1];
+        let mut slave_master: Vec<Vec<(usize, f64)>> = vec![Vec::new(); m + 1];
         let hat = |nodes: &Vec<f64>, e: usize, x: f64| -> [f64; 2] {
             let t = (x - nodes[e]) / (nodes[e + 1] - nodes[e]);
             [1.0 - t, t]
@@ -385,8 +387,8 @@ impl Piece {
                 for a in 0..2 {
                     for b in 0..2 {
                         // slave j = e + a, k = e + b => offset k - j + 1
-                        ss_int[e + a][1 + b - a] += wt * l[a] * l[b];
-                        let entry = &mut sm_int[e + a];
+                        slave_slave[e + a][1 + b - a] += wt * l[a] * l[b];
+                        let entry = &mut slave_master[e + a];
                         let q = f + b;
                         match entry.iter_mut().find(|(qq, _)| *qq == q) {
                             Some(v) => v.1 += wt * l[a] * mu[b],
@@ -396,16 +398,41 @@ impl Piece {
                 }
             }
         }
-        // Test functions psi_j (j = 1..m-1): lambda_j, plus lambda_0 for j = 1 and lambda_m
-        // for j = m-1 (the end elements' functions made constant).
-        // M[j][k] = int psi_j lambda_k for k = 1..m-1; R[j][q] = int psi_j mu_q minus the
-        // end-value contributions int psi_j (lambda_0 phi(c_a) + lambda_m phi(c_b)).
+        TraceIntegrals {
+            slave_slave,
+            slave_master,
+        }
+    }
+}
+
+/// Integrals of products of trace hats on one piece.
+struct TraceIntegrals {
+    /// int lambda_j lambda_k for k = j-1, j, j+1 (body-1 hats; tridiagonal).
+    slave_slave: Vec<[f64; 3]>,
+    /// int lambda_j mu_q, sparse over the body-2 hats q.
+    slave_master: Vec<Vec<(usize, f64)>>,
+}
+
+/// The tridiagonal system M X = R of the mortar projection's interior rows: test functions
+/// psi_j (j = 1..m-1) are lambda_j, plus lambda_0 for j = 1 and lambda_m for j = m-1 (the
+/// end elements' functions made constant); M[j][k] = int psi_j lambda_k for k = 1..m-1,
+/// R[j][q] = int psi_j mu_q minus the end-value contributions
+/// int psi_j (lambda_0 phi(c_a) + lambda_m phi(c_b)).
+struct MortarSystem {
+    lower: Vec<f64>,
+    diag: Vec<f64>,
+    upper: Vec<f64>,
+    rhs: Vec<Vec<f64>>,
+}
+
+impl MortarSystem {
+    fn new(integrals: &TraceIntegrals, m: usize, nm: usize) -> Self {
         let n = m - 1;
         let get = |j: usize, k: usize| -> f64 {
             if k + 1 < j || k > j + 1 {
                 0.0
             } else {
-                ss_int[j][k + 1 - j]
+                integrals.slave_slave[j][k + 1 - j]
             }
         };
         let psi_lambda = |j: usize, k: usize| -> f64 {
@@ -432,7 +459,7 @@ impl Piece {
                 upper[r] = psi_lambda(j, j + 1);
             }
             let mut add_row = |jj: usize| {
-                for &(q, v) in &sm_int[jj] {
+                for &(q, v) in &integrals.slave_master[jj] {
                     rhs[r][q] += v;
                 }
             };
@@ -446,10 +473,22 @@ impl Piece {
             rhs[r][0] -= psi_lambda(j, 0);
             rhs[r][nm - 1] -= psi_lambda(j, m);
         }
-        // Thomas algorithm: M is diagonally dominant (a mass matrix with lumped ends).
+        MortarSystem {
+            lower,
+            diag,
+            upper,
+            rhs,
+        }
+    }
+
+    /// X = M^{-1} R by the Thomas algorithm: M is diagonally dominant (a mass matrix with
+    /// lumped ends), so no pivoting is needed.
+    fn solve(mut self) -> Vec<Vec<f64>> {
+        let n = self.diag.len();
+        let (diag, rhs) = (&mut self.diag, &mut self.rhs);
         for r in 1..n {
-            let factor = lower[r] / diag[r - 1];
-            diag[r] -= factor * upper[r - 1];
+            let factor = self.lower[r] / diag[r - 1];
+            diag[r] -= factor * self.upper[r - 1];
             let (prev, cur) = rhs.split_at_mut(r);
             for (c, pv) in cur[0].iter_mut().zip(&prev[r - 1]) {
                 *c -= factor * pv;
@@ -459,7 +498,7 @@ impl Piece {
             if r + 1 < n {
                 let (cur, next) = rhs.split_at_mut(r + 1);
                 for (c, nv) in cur[r].iter_mut().zip(&next[0]) {
-                    *c -= upper[r] * nv;
+                    *c -= self.upper[r] * nv;
                 }
             }
             let d = diag[r];
@@ -467,10 +506,7 @@ impl Piece {
                 *c /= d;
             }
         }
-        for r in 0..n {
-            p[r + 1] = std::mem::take(&mut rhs[r]);
-        }
-        p
+        self.rhs
     }
 }
 

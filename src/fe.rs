@@ -152,17 +152,9 @@ fn edges_of(
     offsets: [usize; 2],
     curve: &str,
     mesh_file: &Path,
+    scene_key: &str,
 ) -> Result<Vec<(usize, [usize; 2])>> {
-    if raw.physical_tag(1, curve).is_none() {
-        return Err(Error::input(
-            mesh_file,
-            curve,
-            format!(
-                "the mesh has no physical curve named '{curve}' (it has: {}); fix the scene's curve name or add `Physical Curve(\"{curve}\")` to the .geo",
-                raw.names_of_dim(1).join(", ")
-            ),
-        ));
-    }
+    raw.require_curve(curve, mesh_file, scene_key)?;
     let mut out = Vec::new();
     for b in 0..2 {
         for e in meshes[b].curve_edges(raw, curve) {
@@ -202,7 +194,7 @@ impl Model {
         }
         let mut fixed = vec![false; 2 * n_nodes];
         for c in &scene.clamps {
-            for (_, e) in edges_of(raw, &meshes, node_offset, c, mesh_file)? {
+            for (_, e) in edges_of(raw, &meshes, node_offset, c, mesh_file, "clamp.curve")? {
                 for n in e {
                     fixed[2 * n] = true;
                     fixed[2 * n + 1] = true;
@@ -217,7 +209,7 @@ impl Model {
             }
         };
         for r in &scene.rollers {
-            for (_, e) in edges_of(raw, &meshes, node_offset, &r.curve, mesh_file)? {
+            for (_, e) in edges_of(raw, &meshes, node_offset, &r.curve, mesh_file, "roller.curve")? {
                 let (a, b) = (model_pos(e[0]), model_pos(e[1]));
                 let d = [b[0] - a[0], b[1] - a[1]];
                 let len = d[0].hypot(d[1]);
@@ -248,7 +240,7 @@ impl Model {
         }
         let mut traction_edges = Vec::new();
         for (i, t) in scene.tractions.iter().enumerate() {
-            for (_, e) in edges_of(raw, &meshes, node_offset, &t.curve, mesh_file)? {
+            for (_, e) in edges_of(raw, &meshes, node_offset, &t.curve, mesh_file, "traction.curve")? {
                 traction_edges.push((i, e));
             }
         }

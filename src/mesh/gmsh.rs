@@ -92,6 +92,18 @@ fn run_gmsh(args: &[String], out: &Path, what: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Run gmsh with `args` writing the temporary file `tmp`, check that what it wrote parses
+/// (a failed run can leave a broken file), and only then publish it as `path`. Errors name
+/// `geo`; `what` and `fix` say what went wrong and how to fix it.
+fn produce(args: &[String], tmp: &Path, path: &Path, geo: &Path, what: &str, fix: &str) -> Result<()> {
+    run_gmsh(args, tmp, geo)?;
+    super::msh::read_msh(tmp).map_err(|e| {
+        let _ = std::fs::remove_file(tmp);
+        Error::input(geo, "gmsh", format!("{what} ({e}){fix}"))
+    })?;
+    std::fs::rename(tmp, path).map_err(|e| Error::io(path, e))
+}
+
 /// A generated mesh file with its provenance.
 #[derive(Debug, Clone)]
 pub struct GeneratedMesh {
@@ -146,17 +158,7 @@ pub fn generate(geo: &Path, params: &[(String, f64)], level: usize) -> Result<Ge
             args.extend(["-format".into(), "msh41".into(), "-o".into()]);
             let t = tmp(0);
             args.push(t.display().to_string());
-            run_gmsh(&args, &t, geo)?;
-            // Validate before publishing: a failed gmsh run can leave a broken file.
-            super::msh::read_msh(&t).map_err(|e| {
-                let _ = std::fs::remove_file(&t);
-                Error::input(
-                    geo,
-                    "gmsh",
-                    format!("gmsh wrote an unusable mesh ({e}); fix the .geo"),
-                )
-            })?;
-            std::fs::rename(&t, path_of(0)).map_err(|e| Error::io(path_of(0), e))?;
+            produce(&args, &t, &path_of(0), geo, "gmsh wrote an unusable mesh", "; fix the .geo")?;
             1
         }
     };
@@ -170,16 +172,7 @@ pub fn generate(geo: &Path, params: &[(String, f64)], level: usize) -> Result<Ge
             "-o".into(),
             t.display().to_string(),
         ];
-        run_gmsh(&args, &t, geo)?;
-        super::msh::read_msh(&t).map_err(|e| {
-            let _ = std::fs::remove_file(&t);
-            Error::input(
-                geo,
-                "gmsh",
-                format!("gmsh -refine wrote an unusable mesh ({e})"),
-            )
-        })?;
-        std::fs::rename(&t, path_of(l)).map_err(|e| Error::io(path_of(l), e))?;
+        produce(&args, &t, &path_of(l), geo, "gmsh -refine wrote an unusable mesh", "")?;
     }
     Ok(GeneratedMesh {
         path: path_of(level),

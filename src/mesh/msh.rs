@@ -30,6 +30,22 @@ impl RawMesh {
             .map(|((_, t), _)| *t)
     }
 
+    /// The tag of the physical curve `name`, or an error naming the mesh file, the curves
+    /// the mesh has, and the fix: `scene_key` (the scene's field that names the curve) or
+    /// the .geo.
+    pub fn require_curve(&self, name: &str, mesh_file: &Path, scene_key: &str) -> Result<i32> {
+        self.physical_tag(1, name).ok_or_else(|| {
+            Error::input(
+                mesh_file,
+                name,
+                format!(
+                    "the mesh has no physical curve named '{name}' (it has: {}); fix {scene_key} in the scene or add `Physical Curve(\"{name}\")` to the .geo",
+                    self.names_of_dim(1).join(", ")
+                ),
+            )
+        })
+    }
+
     /// Sorted names of the physical groups of dimension `dim`.
     pub fn names_of_dim(&self, dim: usize) -> Vec<String> {
         let mut v: Vec<String> = self
@@ -108,227 +124,37 @@ pub fn read_msh(path: &Path) -> Result<RawMesh> {
     parse_msh(&text, path)
 }
 
+/// Physical tags of each (dimension, entity tag), from `$Entities`.
+type EntityPhysicals = HashMap<(usize, i32), Vec<i32>>;
+
 /// Parse the text of a MSH 4.1 ASCII file; `path` is used in error messages only.
 pub fn parse_msh(text: &str, path: &Path) -> Result<RawMesh> {
     let mut mesh = RawMesh::default();
-    // Physical tags of each (dim, entity tag).
-    let mut entity_phys: HashMap<(usize, i32), Vec<i32>> = HashMap::new();
+    let rest = take_physical_names(text, path, &mut mesh.physical_names)?;
+    let mut entity_physicals = EntityPhysicals::new();
     let mut node_index: HashMap<usize, usize> = HashMap::new();
-    let mut have_format = false;
-    let mut have_nodes = false;
-    let mut have_elements = false;
-    // $PhysicalNames has quoted names that may contain spaces: handle it by lines first.
-    let mut rest = text;
-    let mut out_text = String::new();
-    while let Some(start) = rest.find("$PhysicalNames") {
-        out_text.push_str(&rest[..start]);
-        let after = &rest[start + "$PhysicalNames".len()..];
-        let end = after.find("$EndPhysicalNames").ok_or_else(|| {
-            Error::input(
-                path,
-                "$PhysicalNames",
-                "section is not closed by $EndPhysicalNames; delete the file and regenerate it",
-            )
-        })?;
-        let block = &after[..end];
-        let mut lines = block.lines().map(str::trim).filter(|l| !l.is_empty());
-        let n: usize = lines.next().and_then(|l| l.parse().ok()).ok_or_else(|| {
-            Error::input(
-                path,
-                "$PhysicalNames",
-                "missing count; delete the file and regenerate it",
-            )
-        })?;
-        for _ in 0..n {
-            let l = lines.next().ok_or_else(|| {
-                Error::input(
-                    path,
-                    "$PhysicalNames",
-                    "fewer names than announced; delete the file and regenerate it",
-                )
-            })?;
-            let mut parts = l.splitn(3, char::is_whitespace);
-            let dim: Option<usize> = parts.next().and_then(|s| s.parse().ok());
-            let tag: Option<i32> = parts.next().and_then(|s| s.parse().ok());
-            let name = parts.next().map(|s| s.trim().trim_matches('"').to_string());
-            match (dim, tag, name) {
-                (Some(d), Some(t), Some(nm)) if d <= 3 => {
-                    mesh.physical_names.insert((d, t), nm);
-                }
-                _ => {
-                    return Err(Error::input(
-                        path,
-                        "$PhysicalNames",
-                        format!("malformed line '{l}'; delete the file and regenerate it"),
-                    ));
-                }
-            }
-        }
-        rest = &after[end + "$EndPhysicalNames".len()..];
-    }
-    out_text.push_str(rest);
-
+    let (mut have_format, mut have_nodes, mut have_elements) = (false, false, false);
     let mut t = Tokens {
-        it: out_text.split_whitespace().peekable(),
+        it: rest.split_whitespace().peekable(),
         path,
         section: "$MeshFormat",
     };
     while let Some(tok) = t.it.next() {
         match tok {
             "$MeshFormat" => {
-                t.section = "$MeshFormat";
-                let version = t.next_str()?;
-                if version != "4.1" {
-                    return Err(t.err(format!(
-                        "version {version} is not supported (need 4.1: run gmsh with -format msh41)"
-                    )));
-                }
-                let file_type = t.usize()?;
-                if file_type != 0 {
-                    return Err(
-                        t.err("binary MSH is not supported (need ASCII: run gmsh with -bin 0)")
-                    );
-                }
-                let _data_size = t.usize()?;
-                t.expect("$EndMeshFormat")?;
+                read_format(&mut t)?;
                 have_format = true;
             }
-            "$Entities" => {
-                t.section = "$Entities";
-                let np = t.usize()?;
-                let nc = t.usize()?;
-                let ns = t.usize()?;
-                let nv = t.usize()?;
-                for _ in 0..np {
-                    let tag = t.i32()?;
-                    for _ in 0..3 {
-                        t.f64()?;
-                    }
-                    let nphys = t.usize()?;
-                    check_count(&t, nphys, "physical tag")?;
-                    let mut tags = Vec::new();
-                    for _ in 0..nphys {
-                        tags.push(t.i32()?);
-                    }
-                    entity_phys.insert((0, tag), tags);
-                }
-                for (dim, n) in [(1usize, nc), (2, ns), (3, nv)] {
-                    for _ in 0..n {
-                        let tag = t.i32()?;
-                        for _ in 0..6 {
-                            t.f64()?;
-                        }
-                        let nphys = t.usize()?;
-                        check_count(&t, nphys, "physical tag")?;
-                        let mut tags = Vec::new();
-                        for _ in 0..nphys {
-                            tags.push(t.i32()?);
-                        }
-                        entity_phys.insert((dim, tag), tags);
-                        let nb = t.usize()?;
-                        check_count(&t, nb, "bounding entity")?;
-                        for _ in 0..nb {
-                            t.i32()?;
-                        }
-                    }
-                }
-                t.expect("$EndEntities")?;
-            }
+            "$Entities" => read_entities(&mut t, &mut entity_physicals)?,
             "$Nodes" => {
-                t.section = "$Nodes";
-                let nblocks = t.usize()?;
-                let nnodes = t.usize()?;
-                check_count(&t, nnodes, "node")?;
-                let _min = t.usize()?;
-                let _max = t.usize()?;
-                mesh.nodes.reserve(nnodes);
-                for _ in 0..nblocks {
-                    let _dim = t.usize()?;
-                    let _etag = t.i32()?;
-                    let parametric = t.usize()?;
-                    let n = t.usize()?;
-                    check_count(&t, n, "node")?;
-                    let mut tags = Vec::with_capacity(n);
-                    for _ in 0..n {
-                        tags.push(t.usize()?);
-                    }
-                    for tag in tags {
-                        let x = t.f64()?;
-                        let y = t.f64()?;
-                        let _z = t.f64()?;
-                        if parametric != 0 {
-                            return Err(t.err("parametric node coordinates are not supported (Mesh.SaveParametric = 0)"));
-                        }
-                        if node_index.insert(tag, mesh.nodes.len()).is_some() {
-                            return Err(t.err(format!("node tag {tag} appears twice")));
-                        }
-                        mesh.nodes.push([x, y]);
-                    }
-                }
-                if mesh.nodes.len() != nnodes {
-                    return Err(t.err(format!(
-                        "header announces {nnodes} nodes, blocks hold {}",
-                        mesh.nodes.len()
-                    )));
-                }
-                t.expect("$EndNodes")?;
+                read_nodes(&mut t, &mut mesh, &mut node_index)?;
                 have_nodes = true;
             }
             "$Elements" => {
-                t.section = "$Elements";
-                let nblocks = t.usize()?;
-                let _nel = t.usize()?;
-                let _min = t.usize()?;
-                let _max = t.usize()?;
-                for _ in 0..nblocks {
-                    let dim = t.usize()?;
-                    let etag = t.i32()?;
-                    let etype = t.usize()?;
-                    let n = t.usize()?;
-                    check_count(&t, n, "element")?;
-                    let nper = match etype {
-                        15 => 1,
-                        1 => 2,
-                        2 => 3,
-                        other => {
-                            return Err(t.err(format!(
-                                "element type {other} is not supported (only points, 2-node lines and 3-node triangles: use first-order meshes)"
-                            )));
-                        }
-                    };
-                    let phys = entity_phys.get(&(dim, etag)).cloned().unwrap_or_default();
-                    for _ in 0..n {
-                        let _tag = t.usize()?;
-                        let mut ids = [0usize; 3];
-                        for id in ids.iter_mut().take(nper) {
-                            let tag = t.usize()?;
-                            *id = *node_index.get(&tag).ok_or_else(|| {
-                                t.err(format!("element refers to unknown node {tag}"))
-                            })?;
-                        }
-                        for &p in &phys {
-                            match etype {
-                                1 => mesh.lines.push(([ids[0], ids[1]], p)),
-                                2 => mesh.triangles.push(([ids[0], ids[1], ids[2]], p)),
-                                _ => {}
-                            }
-                        }
-                    }
-                }
-                t.expect("$EndElements")?;
+                read_elements(&mut t, &mut mesh, &entity_physicals, &node_index)?;
                 have_elements = true;
             }
-            s if s.starts_with("$") && !s.starts_with("$End") => {
-                // Skip unknown sections ($Periodic, $NodeData, ...).
-                let end = format!("$End{}", &s[1..]);
-                loop {
-                    match t.it.next() {
-                        Some(x) if x == end => break,
-                        Some(_) => {}
-                        None => return Err(t.err(format!("section {s} is not closed"))),
-                    }
-                }
-            }
+            s if s.starts_with("$") && !s.starts_with("$End") => skip_section(&mut t, s)?,
             other => return Err(t.err(format!("unexpected token '{other}'"))),
         }
     }
@@ -347,4 +173,207 @@ pub fn parse_msh(text: &str, path: &Path) -> Result<RawMesh> {
         ));
     }
     Ok(mesh)
+}
+
+/// `$PhysicalNames` has quoted names that may contain spaces: read it by lines into
+/// `names`, and return the text without it for the token reader.
+fn take_physical_names(
+    text: &str,
+    path: &Path,
+    names: &mut HashMap<(usize, i32), String>,
+) -> Result<String> {
+    let bad = |msg: String| Error::input(path, "$PhysicalNames", msg);
+    let mut rest = text;
+    let mut out = String::new();
+    while let Some(start) = rest.find("$PhysicalNames") {
+        out.push_str(&rest[..start]);
+        let after = &rest[start + "$PhysicalNames".len()..];
+        let end = after.find("$EndPhysicalNames").ok_or_else(|| {
+            bad("section is not closed by $EndPhysicalNames; delete the file and regenerate it".into())
+        })?;
+        let mut lines = after[..end].lines().map(str::trim).filter(|l| !l.is_empty());
+        let n: usize = lines
+            .next()
+            .and_then(|l| l.parse().ok())
+            .ok_or_else(|| bad("missing count; delete the file and regenerate it".into()))?;
+        for _ in 0..n {
+            let l = lines.next().ok_or_else(|| {
+                bad("fewer names than announced; delete the file and regenerate it".into())
+            })?;
+            let mut parts = l.splitn(3, char::is_whitespace);
+            let dim: Option<usize> = parts.next().and_then(|s| s.parse().ok());
+            let tag: Option<i32> = parts.next().and_then(|s| s.parse().ok());
+            let name = parts.next().map(|s| s.trim().trim_matches('"').to_string());
+            match (dim, tag, name) {
+                (Some(d), Some(t), Some(nm)) if d <= 3 => {
+                    names.insert((d, t), nm);
+                }
+                _ => {
+                    return Err(bad(format!(
+                        "malformed line '{l}'; delete the file and regenerate it"
+                    )));
+                }
+            }
+        }
+        rest = &after[end + "$EndPhysicalNames".len()..];
+    }
+    out.push_str(rest);
+    Ok(out)
+}
+
+fn read_format(t: &mut Tokens) -> Result<()> {
+    t.section = "$MeshFormat";
+    let version = t.next_str()?;
+    if version != "4.1" {
+        return Err(t.err(format!(
+            "version {version} is not supported (need 4.1: run gmsh with -format msh41)"
+        )));
+    }
+    let file_type = t.usize()?;
+    if file_type != 0 {
+        return Err(t.err("binary MSH is not supported (need ASCII: run gmsh with -bin 0)"));
+    }
+    let _data_size = t.usize()?;
+    t.expect("$EndMeshFormat")
+}
+
+/// A count of physical tags followed by the tags.
+fn read_physical_tags(t: &mut Tokens) -> Result<Vec<i32>> {
+    let n = t.usize()?;
+    check_count(t, n, "physical tag")?;
+    (0..n).map(|_| t.i32()).collect()
+}
+
+fn read_entities(t: &mut Tokens, physicals: &mut EntityPhysicals) -> Result<()> {
+    t.section = "$Entities";
+    let np = t.usize()?;
+    let nc = t.usize()?;
+    let ns = t.usize()?;
+    let nv = t.usize()?;
+    for _ in 0..np {
+        let tag = t.i32()?;
+        for _ in 0..3 {
+            t.f64()?;
+        }
+        physicals.insert((0, tag), read_physical_tags(t)?);
+    }
+    for (dim, n) in [(1usize, nc), (2, ns), (3, nv)] {
+        for _ in 0..n {
+            let tag = t.i32()?;
+            for _ in 0..6 {
+                t.f64()?;
+            }
+            physicals.insert((dim, tag), read_physical_tags(t)?);
+            let nb = t.usize()?;
+            check_count(t, nb, "bounding entity")?;
+            for _ in 0..nb {
+                t.i32()?;
+            }
+        }
+    }
+    t.expect("$EndEntities")
+}
+
+fn read_nodes(
+    t: &mut Tokens,
+    mesh: &mut RawMesh,
+    node_index: &mut HashMap<usize, usize>,
+) -> Result<()> {
+    t.section = "$Nodes";
+    let nblocks = t.usize()?;
+    let nnodes = t.usize()?;
+    check_count(t, nnodes, "node")?;
+    let _min = t.usize()?;
+    let _max = t.usize()?;
+    mesh.nodes.reserve(nnodes);
+    for _ in 0..nblocks {
+        let _dim = t.usize()?;
+        let _etag = t.i32()?;
+        let parametric = t.usize()?;
+        let n = t.usize()?;
+        check_count(t, n, "node")?;
+        let tags: Vec<usize> = (0..n).map(|_| t.usize()).collect::<Result<_>>()?;
+        for tag in tags {
+            let x = t.f64()?;
+            let y = t.f64()?;
+            let _z = t.f64()?;
+            if parametric != 0 {
+                return Err(t.err(
+                    "parametric node coordinates are not supported (Mesh.SaveParametric = 0)",
+                ));
+            }
+            if node_index.insert(tag, mesh.nodes.len()).is_some() {
+                return Err(t.err(format!("node tag {tag} appears twice")));
+            }
+            mesh.nodes.push([x, y]);
+        }
+    }
+    if mesh.nodes.len() != nnodes {
+        return Err(t.err(format!(
+            "header announces {nnodes} nodes, blocks hold {}",
+            mesh.nodes.len()
+        )));
+    }
+    t.expect("$EndNodes")
+}
+
+fn read_elements(
+    t: &mut Tokens,
+    mesh: &mut RawMesh,
+    physicals: &EntityPhysicals,
+    node_index: &HashMap<usize, usize>,
+) -> Result<()> {
+    t.section = "$Elements";
+    let nblocks = t.usize()?;
+    let _nel = t.usize()?;
+    let _min = t.usize()?;
+    let _max = t.usize()?;
+    for _ in 0..nblocks {
+        let dim = t.usize()?;
+        let etag = t.i32()?;
+        let etype = t.usize()?;
+        let n = t.usize()?;
+        check_count(t, n, "element")?;
+        let nper = match etype {
+            15 => 1,
+            1 => 2,
+            2 => 3,
+            other => {
+                return Err(t.err(format!(
+                    "element type {other} is not supported (only points, 2-node lines and 3-node triangles: use first-order meshes)"
+                )));
+            }
+        };
+        let phys = physicals.get(&(dim, etag)).cloned().unwrap_or_default();
+        for _ in 0..n {
+            let _tag = t.usize()?;
+            let mut ids = [0usize; 3];
+            for id in ids.iter_mut().take(nper) {
+                let tag = t.usize()?;
+                *id = *node_index
+                    .get(&tag)
+                    .ok_or_else(|| t.err(format!("element refers to unknown node {tag}")))?;
+            }
+            for &p in &phys {
+                match etype {
+                    1 => mesh.lines.push(([ids[0], ids[1]], p)),
+                    2 => mesh.triangles.push(([ids[0], ids[1], ids[2]], p)),
+                    _ => {}
+                }
+            }
+        }
+    }
+    t.expect("$EndElements")
+}
+
+/// Skip an unknown section ($Periodic, $NodeData, ...) up to its end marker.
+fn skip_section(t: &mut Tokens, start: &str) -> Result<()> {
+    let end = format!("$End{}", &start[1..]);
+    loop {
+        match t.it.next() {
+            Some(x) if x == end => return Ok(()),
+            Some(_) => {}
+            None => return Err(t.err(format!("section {start} is not closed"))),
+        }
+    }
 }

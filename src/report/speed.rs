@@ -167,8 +167,8 @@ pub fn write_speed(res: &SpeedResult, dir: &Path) -> Result<()> {
             crate::study::speed::STEPS,
             crate::study::speed::REPEATS.0,
             crate::study::speed::REPEATS.1,
-            res.reference.0,
-            res.reference.1,
+            crate::study::speed::REFERENCE_LEVEL,
+            res.reference_dofs,
             res.wall_s
         );
         let _ = writeln!(

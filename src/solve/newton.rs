@@ -12,6 +12,8 @@ use super::{Timings, timed};
 use crate::contact;
 use crate::error::{Error, Result};
 use crate::fe::{FIXED, Pattern};
+use crate::material::Stress;
+use nalgebra::Matrix3;
 use std::cell::Cell;
 
 /// Newton solver state (pattern, slots, factorization) for one problem.
@@ -204,18 +206,16 @@ impl Newton<'_> {
             .filter(|&i| self.w_columns[i].is_none())
             .collect();
         if !missing.is_empty() {
-            let t = std::time::Instant::now();
             let mut block = vec![0.0; big_n * missing.len()];
             for (j, &i) in missing.iter().enumerate() {
                 block[j * big_n + self.n + i] = 1.0;
             }
-            self.system.solve_many(&mut block, missing.len());
+            timed(&self.clock.solve, || {
+                self.system.solve_many(&mut block, missing.len())
+            });
             for (j, &i) in missing.iter().enumerate() {
                 self.w_columns[i] = Some(block[j * big_n..(j + 1) * big_n].to_vec());
             }
-            self.clock
-                .solve
-                .set(self.clock.solve.get() + t.elapsed().as_secs_f64());
         }
         let signs: Vec<f64> = rows
             .iter()
@@ -266,70 +266,251 @@ impl Newton<'_> {
     }
 }
 
+/// The residual of (2.1) with the return map at one iterate (u, lambda).
+struct Evaluation {
+    /// Stresses from the return map.
+    sigma: Vec<Stress>,
+    /// Consistent tangents per triangle.
+    tangents: Vec<Matrix3<f64>>,
+    /// Equilibrium residual f_int - F + C^T lambda over the free dofs (force).
+    residual: Vec<f64>,
+    /// Constraint values C u per row (length).
+    gaps: Vec<f64>,
+    /// Scale of the forces: the larger of |F| and |f_int| over the free dofs.
+    scale: f64,
+}
+
+/// What one time step's iterations share.
+struct StepData<'s> {
+    prev: &'s State,
+    k: f64,
+    f_ext: Vec<f64>,
+    f_free: Vec<f64>,
+}
+
+/// How far an iterate is from solving the step, relative to the force scale.
+struct Distance {
+    /// Equilibrium residual.
+    residual: f64,
+    /// Complementarity |min(lambda, -c g)|.
+    complementarity: f64,
+}
+
+impl Newton<'_> {
+    /// Return map, internal forces and constraint values at (u, lambda).
+    fn evaluate(&self, data: &StepData, u: &[f64], lambda: &[f64]) -> Evaluation {
+        let (model, clock) = (&self.p.model, &self.clock);
+        let (sigma, tangents) = timed(&clock.constitutive, || {
+            model.update_stresses(u, &data.prev.u, &data.prev.sigma, data.k, true)
+        });
+        let f_int = timed(&clock.assembly, || model.internal_force(&sigma));
+        let mut r = f_int.clone();
+        for (ri, f) in r.iter_mut().zip(&data.f_ext) {
+            *ri -= f;
+        }
+        let gaps = timed(&clock.contact, || {
+            contact::add_transpose(&self.p.rows, lambda, &mut r);
+            contact::apply_rows(&self.p.rows, u)
+        });
+        let scale = inf_norm(&data.f_free)
+            .max(inf_norm(&model.restrict(&f_int)))
+            .max(f64::MIN_POSITIVE);
+        Evaluation {
+            sigma,
+            tangents,
+            residual: model.restrict(&r),
+            gaps,
+            scale,
+        }
+    }
+
+    /// The line search's merit |r|^2 + |min(lambda, -c g)|^2.
+    fn merit(&self, ev: &Evaluation, lambda: &[f64]) -> f64 {
+        let c = self.c_scale;
+        ev.residual.iter().map(|v| v * v).sum::<f64>()
+            + (0..lambda.len())
+                .map(|i| lambda[i].min(-c * ev.gaps[i]).powi(2))
+                .sum::<f64>()
+    }
+
+    /// Write the KKT values of the current tangents and active set into the system: the
+    /// elastic stiffness (assembled once) plus the viscoplastic triangles' changes, and
+    /// the contact rows.
+    fn assemble_kkt(&mut self, tangents: &[Matrix3<f64>], active: &[bool]) {
+        let clock = std::rc::Rc::clone(&self.clock);
+        timed(&clock.assembly, || {
+            let vals = self.system.values_mut();
+            vals.copy_from_slice(&self.elastic_values);
+            self.p.model.add_tangent_change(tangents, &self.slots, vals);
+            fill_contact_rows(vals, &self.row_slots, &self.diag_slots, self.c_scale, active);
+        });
+    }
+
+    /// Solve the Newton system in place (`rhs` in, step out). Every iteration is a full
+    /// semismooth Newton step with the current consistent tangent and active set. Its
+    /// linear system is solved by GMRES preconditioned with the last factorization (of an
+    /// older matrix: the tangent changes little between iterations and steps), corrected
+    /// exactly for the contact rows whose active set changed since; the matrix is
+    /// refactorized only when GMRES needs many iterations. Returns whether it factorized.
+    fn solve_newton_system(
+        &mut self,
+        rhs: &mut Vec<f64>,
+        active: &[bool],
+        elastic_now: bool,
+        distance: &Distance,
+    ) -> Result<bool> {
+        let clock = std::rc::Rc::clone(&self.clock);
+        let (n, m) = (self.n, self.p.rows.len());
+        let reusable = self.system.is_factored() && !self.stale;
+        // While only the active set is searched on an unchanged (elastic) stiffness, the
+        // residual is at round-off and the right-hand side lives on the contact rows:
+        // A0^{-1} b = W b_c with all columns W = A0^{-1} e_{n+i} (one blocked solve), and
+        // the Woodbury correction makes it exact: no sparse solve per iteration.
+        let exact = self.factored_elastic
+            && elastic_now
+            && distance.residual <= 1e-2 * self.settings.tol;
+        if reusable && exact {
+            if let Some(update) = self.row_update(active, true) {
+                timed(&clock.solve, || {
+                    let mut x = vec![0.0; n + m];
+                    for i in 0..m {
+                        let w = self.w_columns[i].as_ref().expect("all columns computed");
+                        for (xj, wj) in x.iter_mut().zip(w) {
+                            *xj += rhs[n + i] * wj;
+                        }
+                    }
+                    self.correct(&update, &mut x);
+                    *rhs = x;
+                });
+                return Ok(false);
+            }
+        }
+        if reusable {
+            if let Some(update) = self.row_update(active, false) {
+                // GMRES is worth it while its solves cost less than a fresh factorization
+                // (about 10-25 solves here, measured from 7e3 to 1e5 dofs): cap it at 10
+                // iterations and refactor next time when it used more than 5. The rule
+                // counts iterations, not seconds, so the results do not depend on the
+                // machine's load.
+                let budget = 10;
+                let forcing = self.forcing_term(distance);
+                let rhs0 = rhs.clone();
+                let result = timed(&clock.solve, || {
+                    self.system
+                        .gmres(rhs, forcing, budget, &|v| self.precondition(&update, v))
+                });
+                if let Some(its) = result {
+                    self.stale = 2 * its > budget;
+                    return Ok(false);
+                }
+                rhs.copy_from_slice(&rhs0);
+            }
+        }
+        self.system.factor_lu()?;
+        self.stale = false;
+        self.factored_elastic = elastic_now;
+        self.factored_active = active.to_vec();
+        self.w_columns.iter_mut().for_each(|w| *w = None);
+        timed(&clock.solve, || self.system.solve(rhs));
+        Ok(true)
+    }
+
+    /// Inexact Newton: the linear solve needs only to beat the equilibrium residual
+    /// (forcing term min(1e-2, residual): quadratic convergence), and never more than the
+    /// tolerance asks for (0.3 tol / the larger of residual and complementarity, for the
+    /// last iteration of a step). While only the active set is searched (residual at
+    /// round-off), the semismooth steps terminate finitely and want the solve to tolerance:
+    /// a 1e-2 solve there left 4e-9 behind and cost one more iteration in other units.
+    fn forcing_term(&self, distance: &Distance) -> f64 {
+        let res = distance.residual;
+        let tol_term = 0.3 * self.settings.tol / res.max(distance.complementarity);
+        if tol_term > 1e-2 {
+            // Within 30x of the tolerance: a loose solve ends it (the quadratic term is far
+            // below the tolerance there).
+            tol_term.min(0.5)
+        } else {
+            res.max(tol_term).min(1e-2)
+        }
+        .max(1e-12)
+    }
+
+    /// Backtracking along `step` on the merit |r|^2 + |min(lambda, -c g)|^2: full steps near
+    /// the solution, shorter ones when a large step flips many triangles between elastic
+    /// and viscoplastic (stiff k E / lambda) or many contact rows. Returns the best trial
+    /// with its evaluation (the next iteration's residual).
+    fn line_search(
+        &self,
+        data: &StepData,
+        u: &[f64],
+        lambda: &[f64],
+        step: &[f64],
+        merit0: f64,
+    ) -> (Vec<f64>, Vec<f64>, Evaluation) {
+        let (n, c) = (self.n, self.c_scale);
+        let trial = |alpha: f64| -> (Vec<f64>, Vec<f64>) {
+            let mut ut = u.to_vec();
+            for (d, &eq) in self.p.model.equation.iter().enumerate() {
+                if eq != FIXED {
+                    ut[d] += alpha * step[eq];
+                }
+            }
+            let lt: Vec<f64> = (0..lambda.len())
+                .map(|i| lambda[i] + alpha * c * step[n + i])
+                .collect();
+            (ut, lt)
+        };
+        let mut alpha = 1.0;
+        let mut best: Option<(f64, (Vec<f64>, Vec<f64>), Evaluation)> = None;
+        for _ in 0..12 {
+            let (ut, lt) = trial(alpha);
+            let ev = self.evaluate(data, &ut, &lt);
+            let merit = self.merit(&ev, &lt);
+            let done = merit <= (1.0 - 1e-4 * alpha) * merit0;
+            if best.as_ref().is_none_or(|b| merit < b.0) {
+                best = Some((merit, (ut, lt), ev));
+            }
+            if done {
+                break;
+            }
+            alpha *= 0.5;
+        }
+        let (_, (u, lambda), ev) = best.expect("at least one trial");
+        (u, lambda, ev)
+    }
+}
+
 impl StepSolver for Newton<'_> {
     fn step(&mut self, prev: &State, guess: &State, t: f64, k: f64) -> Result<(State, StepReport)> {
-        let p = self.p;
-        let model = &p.model;
-        let n = self.n;
-        let m = p.rows.len();
+        let model = &self.p.model;
+        let (n, m, c) = (self.n, self.p.rows.len(), self.c_scale);
         let f_ext = model.load(t)?;
-        let f_free = model.restrict(&f_ext);
-        let c = self.c_scale;
+        let data = StepData {
+            prev,
+            k,
+            f_free: model.restrict(&f_ext),
+            f_ext,
+        };
         let mut u = guess.u.clone();
         let mut lambda = guess.lambda.clone();
         let mut last_active: Option<Vec<bool>> = None;
-        let mut changes = 0;
-        let mut iterations = 0;
-        let mut factorizations = 0;
-        // Residual of (2.1) with the return map at (u, lambda): (stresses, consistent
-        // tangents, r over free dofs, gaps, scale of the forces).
-        type Evaluation = (
-            Vec<crate::material::Stress>,
-            Vec<nalgebra::Matrix3<f64>>,
-            Vec<f64>,
-            Vec<f64>,
-            f64,
-        );
-        let clock = std::rc::Rc::clone(&self.clock);
-        let residual = |u: &[f64], lambda: &[f64]| -> Evaluation {
-            let (sigma, tangents) = timed(&clock.constitutive, || {
-                model.update_stresses(u, &prev.u, &prev.sigma, k, true)
-            });
-            let f_int = timed(&clock.assembly, || model.internal_force(&sigma));
-            let mut r = f_int.clone();
-            for (ri, f) in r.iter_mut().zip(&f_ext) {
-                *ri -= f;
-            }
-            let g = timed(&clock.contact, || {
-                contact::add_transpose(&p.rows, lambda, &mut r);
-                contact::apply_rows(&p.rows, u)
-            });
-            let scale = inf_norm(&f_free)
-                .max(inf_norm(&model.restrict(&f_int)))
-                .max(f64::MIN_POSITIVE);
-            (sigma, tangents, model.restrict(&r), g, scale)
-        };
-        let merit_of = |r: &[f64], g: &[f64], lambda: &[f64]| -> f64 {
-            r.iter().map(|v| v * v).sum::<f64>()
-                + (0..m)
-                    .map(|i| lambda[i].min(-c * g[i]).powi(2))
-                    .sum::<f64>()
-        };
-        // The line search's accepted evaluation is the next iteration's residual.
-        let mut evaluation = residual(&u, &lambda);
+        let (mut changes, mut iterations, mut factorizations) = (0, 0, 0);
+        let mut evaluation = self.evaluate(&data, &u, &lambda);
         loop {
-            let (sigma, tangents, r_free, g, scale) = evaluation;
-            let active: Vec<bool> = (0..m).map(|i| lambda[i] + c * g[i] >= 0.0).collect();
+            let ev = &evaluation;
+            let active: Vec<bool> = (0..m).map(|i| lambda[i] + c * ev.gaps[i] >= 0.0).collect();
             let elastic_now = model
                 .elements
                 .iter()
-                .zip(&tangents)
+                .zip(&ev.tangents)
                 .all(|(e, d)| *d == model.materials[e.body].elastic.matrix());
-            let compl = (0..m)
-                .map(|i| lambda[i].min(-c * g[i]).abs())
-                .fold(0.0f64, f64::max)
-                / scale;
-            let res = inf_norm(&r_free) / scale;
+            let distance = Distance {
+                residual: inf_norm(&ev.residual) / ev.scale,
+                complementarity: (0..m)
+                    .map(|i| lambda[i].min(-c * ev.gaps[i]).abs())
+                    .fold(0.0f64, f64::max)
+                    / ev.scale,
+            };
+            let (res, compl) = (distance.residual, distance.complementarity);
             let same_set = last_active.as_ref().is_some_and(|a| *a == active);
             if let Some(a) = &last_active {
                 changes += a.iter().zip(&active).filter(|(x, y)| x != y).count();
@@ -342,26 +523,24 @@ impl StepSolver for Newton<'_> {
                         lambda[i] = 0.0;
                     }
                 }
-                let state = State {
-                    time: t,
-                    u,
-                    sigma,
-                    lambda,
-                };
                 let reason = format!(
                     "residual {res:.2e} and complementarity {compl:.2e} below {:.0e}, active set settled ({factorizations} factorizations)",
                     self.settings.tol
                 );
-                return Ok((
-                    state,
-                    StepReport {
-                        iterations,
-                        outer_iterations: iterations,
-                        residual: res,
-                        active_set_changes: changes,
-                        reason,
-                    },
-                ));
+                let state = State {
+                    time: t,
+                    u,
+                    sigma: evaluation.sigma,
+                    lambda,
+                };
+                let report = StepReport {
+                    iterations,
+                    outer_iterations: iterations,
+                    residual: res,
+                    active_set_changes: changes,
+                    reason,
+                };
+                return Ok((state, report));
             }
             if !res.is_finite() {
                 return Err(Error::NotConverged(format!(
@@ -374,138 +553,19 @@ impl StepSolver for Newton<'_> {
                     self.settings.tol
                 )));
             }
-            let merit0 = merit_of(&r_free, &g, &lambda);
-            // Every iteration is a full semismooth Newton step with the current consistent
-            // tangent and active set. Its linear system is solved by GMRES preconditioned
-            // with the last factorization (of an older matrix: the tangent changes little
-            // between iterations and steps), corrected exactly for the contact rows whose
-            // active set changed since; the matrix is refactorized only when GMRES needs
-            // many iterations.
-            let rhs0: Vec<f64> = {
-                let mut rhs = vec![0.0; n + m];
-                for (i, v) in r_free.iter().enumerate() {
-                    rhs[i] = -v;
-                }
-                for i in 0..m {
-                    rhs[n + i] = if active[i] { -c * g[i] } else { -lambda[i] };
-                }
-                rhs
-            };
-            let t_asm = std::time::Instant::now();
-            {
-                let vals = self.system.values_mut();
-                vals.copy_from_slice(&self.elastic_values);
-                model.add_tangent_change(&tangents, &self.slots, vals);
-                fill_contact_rows(vals, &self.row_slots, &self.diag_slots, c, &active);
-            }
-            self.clock
-                .assembly
-                .set(self.clock.assembly.get() + t_asm.elapsed().as_secs_f64());
-            let mut rhs = rhs0.clone();
-            let mut solved = false;
-            // GMRES is worth it while its solves cost less than a fresh factorization (about
-            // 10-25 solves here, measured from 7e3 to 1e5 dofs): cap it at 10 iterations and
-            // refactor next time when it used more than 5. The rule counts iterations, not
-            // seconds, so the results do not depend on the machine's load.
-            let budget = 10;
-            // While only the active set is searched on an unchanged (elastic) stiffness, the
-            // residual is at round-off and the right-hand side lives on the contact rows:
-            // A0^{-1} b = W b_c with all columns W = A0^{-1} e_{n+i} (one blocked solve), and
-            // the Woodbury correction makes it exact: no sparse solve per iteration.
-            let stiffness_unchanged = self.factored_elastic && elastic_now;
-            let exact = stiffness_unchanged && res <= 1e-2 * self.settings.tol;
-            if self.system.is_factored() && !self.stale && exact {
-                if let Some(update) = self.row_update(&active, true) {
-                    let t = std::time::Instant::now();
-                    let mut x = vec![0.0; n + m];
-                    for i in 0..m {
-                        let w = self.w_columns[i].as_ref().expect("all columns computed");
-                        for (xj, wj) in x.iter_mut().zip(w) {
-                            *xj += rhs[n + i] * wj;
-                        }
-                    }
-                    self.correct(&update, &mut x);
-                    rhs = x;
-                    solved = true;
-                    self.clock
-                        .solve
-                        .set(self.clock.solve.get() + t.elapsed().as_secs_f64());
-                }
-            }
-            if !solved && self.system.is_factored() && !self.stale {
-                if let Some(update) = self.row_update(&active, false) {
-                    let t = std::time::Instant::now();
-                    // Inexact Newton: the linear solve needs only to beat the equilibrium
-                    // residual (forcing term min(1e-2, residual): quadratic convergence), and
-                    // never more than the tolerance asks for (0.3 tol / the larger of residual
-                    // and complementarity, for the last iteration of a step). While only the
-                    // active set is searched (residual at round-off), the semismooth steps
-                    // terminate finitely and want the solve to tolerance: a 1e-2 solve there
-                    // left 4e-9 behind and cost one more iteration in other units.
-                    let tol_term = 0.3 * self.settings.tol / res.max(compl);
-                    let forcing = if tol_term > 1e-2 {
-                        // Within 30x of the tolerance: a loose solve ends it (the quadratic
-                        // term is far below the tolerance there).
-                        tol_term.min(0.5)
-                    } else {
-                        res.max(tol_term).min(1e-2)
-                    }
-                    .max(1e-12);
-                    let result = self.system.gmres(&mut rhs, forcing, budget, &|v| {
-                        self.precondition(&update, v)
-                    });
-                    let dt = t.elapsed().as_secs_f64();
-                    self.clock.solve.set(self.clock.solve.get() + dt);
-                    if let Some(its) = result {
-                        solved = true;
-                        self.stale = 2 * its > budget;
-                    } else {
-                        rhs.copy_from_slice(&rhs0);
-                    }
-                }
-            }
-            if !solved {
-                self.system.factor_lu()?;
+            let merit0 = self.merit(ev, &lambda);
+            let mut step: Vec<f64> = ev
+                .residual
+                .iter()
+                .map(|v| -v)
+                .chain((0..m).map(|i| if active[i] { -c * ev.gaps[i] } else { -lambda[i] }))
+                .collect();
+            debug_assert_eq!(step.len(), n + m);
+            self.assemble_kkt(&ev.tangents, &active);
+            if self.solve_newton_system(&mut step, &active, elastic_now, &distance)? {
                 factorizations += 1;
-                self.stale = false;
-                self.factored_elastic = elastic_now;
-                self.factored_active.clone_from(&active);
-                self.w_columns.iter_mut().for_each(|w| *w = None);
-                let t = std::time::Instant::now();
-                self.system.solve(&mut rhs);
-                let dt = t.elapsed().as_secs_f64();
-                self.clock.solve.set(self.clock.solve.get() + dt);
             }
-            // Backtracking on the merit |r|^2 + |min(lambda, -c g)|^2: full steps near the
-            // solution, shorter ones when a large step flips many triangles between elastic
-            // and viscoplastic (stiff k E / lambda) or many contact rows.
-            let trial = |alpha: f64| -> (Vec<f64>, Vec<f64>) {
-                let mut ut = u.clone();
-                for (d, &eq) in model.equation.iter().enumerate() {
-                    if eq != FIXED {
-                        ut[d] += alpha * rhs[eq];
-                    }
-                }
-                let lt: Vec<f64> = (0..m).map(|i| lambda[i] + alpha * c * rhs[n + i]).collect();
-                (ut, lt)
-            };
-            let mut alpha = 1.0;
-            let mut best: Option<(f64, (Vec<f64>, Vec<f64>), Evaluation)> = None;
-            for _ in 0..12 {
-                let tr = trial(alpha);
-                let ev = residual(&tr.0, &tr.1);
-                let mv = merit_of(&ev.2, &ev.3, &tr.1);
-                let done = mv <= (1.0 - 1e-4 * alpha) * merit0;
-                if best.as_ref().is_none_or(|b| mv < b.0) {
-                    best = Some((mv, tr, ev));
-                }
-                if done {
-                    break;
-                }
-                alpha *= 0.5;
-            }
-            let (_, (u_new, lambda_new), ev) = best.expect("at least one trial");
-            (u, lambda, evaluation) = (u_new, lambda_new, ev);
+            (u, lambda, evaluation) = self.line_search(&data, &u, &lambda, &step, merit0);
             last_active = Some(active);
             iterations += 1;
         }
