@@ -11,7 +11,9 @@ use crate::mesh::RawMesh;
 
 /// Which discrete cone. Written as its [`Method::name`] in files; read from it with an
 /// error that lists the names.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "lowercase", try_from = "String")]
 pub enum Method {
     /// K_h^pi, the global mortar-type condition.

@@ -209,7 +209,14 @@ impl Model {
             }
         };
         for r in &scene.rollers {
-            for (_, e) in edges_of(raw, &meshes, node_offset, &r.curve, mesh_file, "roller.curve")? {
+            for (_, e) in edges_of(
+                raw,
+                &meshes,
+                node_offset,
+                &r.curve,
+                mesh_file,
+                "roller.curve",
+            )? {
                 let (a, b) = (model_pos(e[0]), model_pos(e[1]));
                 let d = [b[0] - a[0], b[1] - a[1]];
                 let len = d[0].hypot(d[1]);
@@ -240,7 +247,14 @@ impl Model {
         }
         let mut traction_edges = Vec::new();
         for (i, t) in scene.tractions.iter().enumerate() {
-            for (_, e) in edges_of(raw, &meshes, node_offset, &t.curve, mesh_file, "traction.curve")? {
+            for (_, e) in edges_of(
+                raw,
+                &meshes,
+                node_offset,
+                &t.curve,
+                mesh_file,
+                "traction.curve",
+            )? {
                 traction_edges.push((i, e));
             }
         }

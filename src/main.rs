@@ -125,7 +125,15 @@ fn run() -> anyhow::Result<()> {
                 rho,
                 ..Settings::default()
             };
-            solve_one(&scene, method, settings, level, steps, &out, &parse_sets(&set)?)
+            solve_one(
+                &scene,
+                method,
+                settings,
+                level,
+                steps,
+                &out,
+                &parse_sets(&set)?,
+            )
         }
     }
 }

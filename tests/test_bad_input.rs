@@ -348,6 +348,15 @@ fn study_file_errors_through_the_binary() {
             Box::new(|t| t.replace("methods = [\"mortar\", \"nts\"]", "methods = [\"penalty\"]")),
             vec!["study.toml", "methods", "unknown method 'penalty'"],
         ),
+        (
+            // Found while planning, before the first solve.
+            Box::new(|t| t.replace("matching = 1", "matching = 0")),
+            vec![
+                "study.toml",
+                "reference.parameters",
+                "do not match on Gamma_C",
+            ],
+        ),
     ];
     for (edit, needles) in cases {
         let f = study_file(dir.path(), edit);

@@ -85,8 +85,18 @@ fn quick_rates_study_meets_the_theorem_thresholds() {
     }
     for (a, b) in res.rates.iter().zip(&merged.rates) {
         assert_eq!(
-            (a.rate().to_bits(), a.stderr().to_bits(), &a.levels_used, a.pass),
-            (b.rate().to_bits(), b.stderr().to_bits(), &b.levels_used, b.pass)
+            (
+                a.rate().to_bits(),
+                a.stderr().to_bits(),
+                &a.levels_used,
+                a.pass
+            ),
+            (
+                b.rate().to_bits(),
+                b.stderr().to_bits(),
+                &b.levels_used,
+                b.pass
+            )
         );
     }
 }
@@ -132,6 +142,22 @@ fn study_file_errors_name_the_file_and_key() {
             "mesh.levels",
         ),
         (base.replace("steps = 4", "steps = 0"), "steps"),
+        // Checked when the file is read, not after the solves.
+        (
+            base.replace("reference_steps = 512", "reference_steps = 500"),
+            "time.reference_steps",
+        ),
+        (
+            base.replace(
+                "quantities = [\"theorem\"",
+                "quantities = [\"theorem\", \"energy\"",
+            ),
+            "unknown quantity 'energy'",
+        ),
+        (
+            base.replace("solver = \"newton\"", "solver = \"cg\""),
+            "unknown solver 'cg'",
+        ),
     ];
     for (text, needle) in cases {
         let f = dir.path().join("bad.toml");
@@ -151,4 +177,27 @@ fn shard_argument_is_checked() {
         let e = Mode::shard(bad).unwrap_err().to_string();
         assert!(e.contains("--shard") && e.contains(bad), "{e}");
     }
+}
+
+#[test]
+fn study_list_names_every_kind() {
+    let names: Vec<String> = study::Kind::list().into_iter().map(|(n, _)| n).collect();
+    for kind in [
+        "paper",
+        "patch",
+        "rates",
+        "rates-quick",
+        "speed",
+        "stability",
+    ] {
+        assert!(
+            names.iter().any(|n| n == kind),
+            "{kind} missing from {names:?}"
+        );
+    }
+    assert_eq!(study::Kind::resolve("speed").unwrap(), study::Kind::Speed);
+    assert!(matches!(
+        study::Kind::resolve("rates").unwrap(),
+        study::Kind::Convergence(_)
+    ));
 }

@@ -95,7 +95,14 @@ fn run_gmsh(args: &[String], out: &Path, what: &Path) -> Result<()> {
 /// Run gmsh with `args` writing the temporary file `tmp`, check that what it wrote parses
 /// (a failed run can leave a broken file), and only then publish it as `path`. Errors name
 /// `geo`; `what` and `fix` say what went wrong and how to fix it.
-fn produce(args: &[String], tmp: &Path, path: &Path, geo: &Path, what: &str, fix: &str) -> Result<()> {
+fn produce(
+    args: &[String],
+    tmp: &Path,
+    path: &Path,
+    geo: &Path,
+    what: &str,
+    fix: &str,
+) -> Result<()> {
     run_gmsh(args, tmp, geo)?;
     super::msh::read_msh(tmp).map_err(|e| {
         let _ = std::fs::remove_file(tmp);
@@ -158,7 +165,14 @@ pub fn generate(geo: &Path, params: &[(String, f64)], level: usize) -> Result<Ge
             args.extend(["-format".into(), "msh41".into(), "-o".into()]);
             let t = tmp(0);
             args.push(t.display().to_string());
-            produce(&args, &t, &path_of(0), geo, "gmsh wrote an unusable mesh", "; fix the .geo")?;
+            produce(
+                &args,
+                &t,
+                &path_of(0),
+                geo,
+                "gmsh wrote an unusable mesh",
+                "; fix the .geo",
+            )?;
             1
         }
     };
@@ -172,7 +186,14 @@ pub fn generate(geo: &Path, params: &[(String, f64)], level: usize) -> Result<Ge
             "-o".into(),
             t.display().to_string(),
         ];
-        produce(&args, &t, &path_of(l), geo, "gmsh -refine wrote an unusable mesh", "")?;
+        produce(
+            &args,
+            &t,
+            &path_of(l),
+            geo,
+            "gmsh -refine wrote an unusable mesh",
+            "",
+        )?;
     }
     Ok(GeneratedMesh {
         path: path_of(level),

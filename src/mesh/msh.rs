@@ -189,9 +189,15 @@ fn take_physical_names(
         out.push_str(&rest[..start]);
         let after = &rest[start + "$PhysicalNames".len()..];
         let end = after.find("$EndPhysicalNames").ok_or_else(|| {
-            bad("section is not closed by $EndPhysicalNames; delete the file and regenerate it".into())
+            bad(
+                "section is not closed by $EndPhysicalNames; delete the file and regenerate it"
+                    .into(),
+            )
         })?;
-        let mut lines = after[..end].lines().map(str::trim).filter(|l| !l.is_empty());
+        let mut lines = after[..end]
+            .lines()
+            .map(str::trim)
+            .filter(|l| !l.is_empty());
         let n: usize = lines
             .next()
             .and_then(|l| l.parse().ok())

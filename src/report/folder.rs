@@ -76,4 +76,3 @@ pub fn write(dir: &Path, name: &str, bytes: &[u8]) -> Result<()> {
     let p = dir.join(name);
     std::fs::write(&p, bytes).map_err(|e| Error::io(p, e))
 }
-

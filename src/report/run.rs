@@ -44,7 +44,13 @@ struct SummaryCsv<'a> {
 
 /// Write `dir/solution.vtu` (the final state) and `dir/summary.csv`; `wall_s` is the whole
 /// run's wall time.
-pub fn write_run(dir: &Path, model: &Model, last: &State, run: &RunSummary, wall_s: f64) -> Result<()> {
+pub fn write_run(
+    dir: &Path,
+    model: &Model,
+    last: &State,
+    run: &RunSummary,
+    wall_s: f64,
+) -> Result<()> {
     let t = &run.timings;
     let row = SummaryCsv {
         scene: &run.scene,
@@ -117,7 +123,9 @@ pub fn console(run: &RunSummary, wall_s: f64, dir: &Path) -> String {
         t.constitutive_s,
         t.contact_s,
         run.active_set_changes,
-        run.peak_rss_gib.map(|g| format!("{g:.1}")).unwrap_or_default()
+        run.peak_rss_gib
+            .map(|g| format!("{g:.1}"))
+            .unwrap_or_default()
     );
     let _ = writeln!(
         s,

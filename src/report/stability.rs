@@ -15,127 +15,138 @@ use std::path::Path;
 pub fn write_stability(res: &StabilityResult, dir: &Path) -> Result<()> {
     write_folder(dir, |d| {
         write(d, "stability.csv", &csv_bytes(&res.rows)?)?;
-        let mut s = String::new();
-        let _ = writeln!(
-            s,
-            "# Study `stability`\n\nHard cases, each run with every solver and both cones (level 1 of the `rates` scene with 4 steps unless stated). A failure is a result: `converged = no` with the solver's reason. `error` is the largest nodal difference to newton's solution of the same discrete problem, relative to the largest displacement. Regenerate with `cargo run --release -- study stability` ({:.0} s).\n",
-            res.wall_s
-        );
-        for case in HardCase::SWEEPS {
-            let sweep = case.sweep().expect("a swept case");
-            let (name, file) = (case.name(), sweep.file);
-            let rows: Vec<_> = res
-                .rows
+        sweep_plots(res, d)?;
+        write(d, "README.md", readme(res, d).as_bytes())
+    })
+}
+
+/// Iterations and difference to newton against each swept parameter (mortar).
+fn sweep_plots(res: &StabilityResult, d: &Path) -> Result<()> {
+    for case in HardCase::SWEEPS {
+        let sweep = case.sweep().expect("a swept case");
+        let (name, file) = (case.name(), sweep.file);
+        let rows: Vec<_> = res
+            .rows
+            .iter()
+            .filter(|r| r.case == case && r.method == Method::Mortar)
+            .collect();
+        let mut its = Vec::new();
+        let mut errs = Vec::new();
+        for (i, so) in [SolverKind::Newton, SolverKind::Paper, SolverKind::Qp]
+            .iter()
+            .enumerate()
+        {
+            let pts: Vec<(f64, f64)> = rows
                 .iter()
-                .filter(|r| r.case == case && r.method == Method::Mortar)
+                .filter(|r| r.solver == *so && r.converged)
+                .map(|r| (r.value, r.mean_step_iterations.max(1e-3)))
                 .collect();
-            let mut its = Vec::new();
-            let mut errs = Vec::new();
-            for (i, so) in [SolverKind::Newton, SolverKind::Paper, SolverKind::Qp]
-                .iter()
-                .enumerate()
-            {
-                let pts: Vec<(f64, f64)> = rows
-                    .iter()
-                    .filter(|r| r.solver == *so && r.converged)
-                    .map(|r| (r.value, r.mean_step_iterations.max(1e-3)))
-                    .collect();
-                if !pts.is_empty() {
-                    its.push(Series {
-                        label: format!("{so} (converged runs)"),
-                        points: pts,
-                        markers: true,
-                        line: true,
-                        color: i,
-                        thin: false,
-                    });
-                }
-                let pe: Vec<(f64, f64)> = rows
-                    .iter()
-                    .filter(|r| r.solver == *so && r.converged && r.error > 0.0)
-                    .map(|r| (r.value, r.error))
-                    .collect();
-                if !pe.is_empty() {
-                    errs.push(Series {
-                        label: format!("{so}: difference to newton"),
-                        points: pe,
-                        markers: true,
-                        line: true,
-                        color: i,
-                        thin: false,
-                    });
-                }
+            if !pts.is_empty() {
+                its.push(Series {
+                    label: format!("{so} (converged runs)"),
+                    points: pts,
+                    markers: true,
+                    line: true,
+                    color: i,
+                    thin: false,
+                });
             }
-            let xlabel = sweep.axis;
+            let pe: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.solver == *so && r.converged && r.error > 0.0)
+                .map(|r| (r.value, r.error))
+                .collect();
+            if !pe.is_empty() {
+                errs.push(Series {
+                    label: format!("{so}: difference to newton"),
+                    points: pe,
+                    markers: true,
+                    line: true,
+                    color: i,
+                    thin: false,
+                });
+            }
+        }
+        let xlabel = sweep.axis;
+        plot::loglog(
+            &d.join(format!("{file}_iterations.png")),
+            &format!("{name}: mean iterations per step (mortar)"),
+            xlabel,
+            "iterations per step",
+            &its,
+            &[],
+        )?;
+        if !errs.is_empty() {
             plot::loglog(
-                &d.join(format!("{file}_iterations.png")),
-                &format!("{name}: mean iterations per step (mortar)"),
+                &d.join(format!("{file}_error.png")),
+                &format!("{name}: difference to newton (mortar)"),
                 xlabel,
-                "iterations per step",
-                &its,
+                "relative nodal difference",
+                &errs,
                 &[],
             )?;
-            if !errs.is_empty() {
-                plot::loglog(
-                    &d.join(format!("{file}_error.png")),
-                    &format!("{name}: difference to newton (mortar)"),
-                    xlabel,
-                    "relative nodal difference",
-                    &errs,
-                    &[],
-                )?;
+        }
+    }
+    Ok(())
+}
+
+/// The README: one section per case with its note, plots and table.
+fn readme(res: &StabilityResult, d: &Path) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "# Study `stability`\n\nHard cases, each run with every solver and both cones (level 1 of the `rates` scene with 4 steps unless stated). A failure is a result: `converged = no` with the solver's reason. `error` is the largest nodal difference to newton's solution of the same discrete problem, relative to the largest displacement. Regenerate with `cargo run --release -- study stability` ({:.0} s).\n",
+        res.wall_s
+    );
+    let mut cases: Vec<HardCase> = Vec::new();
+    for r in &res.rows {
+        if !cases.contains(&r.case) {
+            cases.push(r.case);
+        }
+    }
+    for c in cases {
+        let _ = writeln!(s, "## {}\n", c.name());
+        if !c.note().is_empty() {
+            let _ = writeln!(s, "{}\n", c.note());
+        }
+        if let Some(sweep) = c.sweep() {
+            let file = sweep.file;
+            let _ = writeln!(s, "![iterations]({file}_iterations.png)\n");
+            if d.join(format!("{file}_error.png")).exists() {
+                let _ = writeln!(s, "![error]({file}_error.png)\n");
             }
         }
-        let mut cases: Vec<HardCase> = Vec::new();
-        for r in &res.rows {
-            if !cases.contains(&r.case) {
-                cases.push(r.case);
-            }
-        }
-        for c in cases {
-            let _ = writeln!(s, "## {}\n", c.name());
-            if !c.note().is_empty() {
-                let _ = writeln!(s, "{}\n", c.note());
-            }
-            if let Some(sweep) = c.sweep() {
-                let file = sweep.file;
-                let _ = writeln!(s, "![iterations]({file}_iterations.png)\n");
-                if d.join(format!("{file}_error.png")).exists() {
-                    let _ = writeln!(s, "![error]({file}_error.png)\n");
-                }
-            }
+        let _ = writeln!(
+            s,
+            "| parameter | method | solver | converged | max / mean iterations per step | error | max penetration | wall (s) | reason |\n|---|---|---|---|---|---|---|---|---|"
+        );
+        for r in res.rows.iter().filter(|r| r.case == c) {
             let _ = writeln!(
                 s,
-                "| parameter | method | solver | converged | max / mean iterations per step | error | max penetration | wall (s) | reason |\n|---|---|---|---|---|---|---|---|---|"
+                "| {} | {} | {} | {} | {} / {:.1} | {} | {} | {:.3} | {} |",
+                r.parameter,
+                r.method,
+                r.solver,
+                if r.converged { "yes" } else { "**no**" },
+                r.max_step_iterations,
+                r.mean_step_iterations,
+                if r.error.is_finite() {
+                    format!("{:.2e}", r.error)
+                } else {
+                    String::new()
+                },
+                if r.max_penetration.is_finite() {
+                    format!("{:.2e}", r.max_penetration)
+                } else {
+                    String::new()
+                },
+                r.wall_s,
+                r.reason.replace('|', "/")
             );
-            for r in res.rows.iter().filter(|r| r.case == c) {
-                let _ = writeln!(
-                    s,
-                    "| {} | {} | {} | {} | {} / {:.1} | {} | {} | {:.3} | {} |",
-                    r.parameter,
-                    r.method,
-                    r.solver,
-                    if r.converged { "yes" } else { "**no**" },
-                    r.max_step_iterations,
-                    r.mean_step_iterations,
-                    if r.error.is_finite() {
-                        format!("{:.2e}", r.error)
-                    } else {
-                        String::new()
-                    },
-                    if r.max_penetration.is_finite() {
-                        format!("{:.2e}", r.max_penetration)
-                    } else {
-                        String::new()
-                    },
-                    r.wall_s,
-                    r.reason.replace('|', "/")
-                );
-            }
-            let _ = writeln!(s);
         }
-        write(d, "README.md", s.as_bytes())
-    })
+        let _ = writeln!(s);
+    }
+    s
 }
 
 /// What `study stability` prints: one line per run, and where the report went.

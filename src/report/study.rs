@@ -3,12 +3,12 @@
 
 use super::folder::{write, write_folder};
 use super::plot::{self, Panel, Series};
+use crate::contact::Method;
 use crate::error::Result;
 use crate::io::{csv_bytes, fmt3};
 use crate::study::convergence::{RateRow, Source, StudyResult, join};
 use crate::study::file::Threshold;
 use crate::study::quantity::Quantity;
-use crate::contact::Method;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -86,7 +86,14 @@ pub fn write_study(res: &StudyResult, dir: &Path) -> Result<()> {
 }
 
 fn plots(res: &StudyResult, d: &Path) -> Result<()> {
-    // Error against h for the theorem quantity, with fitted lines.
+    error_vs_h(res, d)?;
+    error_vs_time(res, d)?;
+    profiles(res, d)?;
+    von_mises(res, d)
+}
+
+/// Error against h for the theorem quantity with the fitted lines, and the pressure error.
+fn error_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
     let mut series = Vec::new();
     for (i, &m) in res.file.methods.iter().enumerate() {
         let rows: Vec<_> = res
@@ -156,8 +163,11 @@ fn plots(res: &StudyResult, d: &Path) -> Result<()> {
         "relative error (theorem norm)",
         &series,
         &[(0.5, "1/2"), (0.75, "3/4"), (1.0, "1")],
-    )?;
-    // Error against wall time.
+    )
+}
+
+/// Error against the wall time of each solve (theorem quantity).
+fn error_vs_time(res: &StudyResult, d: &Path) -> Result<()> {
     let series: Vec<Series> = res
         .file
         .methods
@@ -187,8 +197,11 @@ fn plots(res: &StudyResult, d: &Path) -> Result<()> {
         "relative error (theorem norm)",
         &series,
         &[],
-    )?;
-    // Profiles along Gamma_C at T.
+    )
+}
+
+/// Pressure and gap along Gamma_C at T, both cones and the reference.
+fn profiles(res: &StudyResult, d: &Path) -> Result<()> {
     for (name, data, ylabel) in [
         ("pressure", &res.pressure, "contact pressure (force/length)"),
         ("gap", &res.gap, "normal gap -[u.nu] (length)"),
@@ -232,7 +245,11 @@ fn plots(res: &StudyResult, d: &Path) -> Result<()> {
             &series,
         )?;
     }
-    // Deformed meshes coloured by von Mises.
+    Ok(())
+}
+
+/// Deformed meshes coloured by von Mises stress.
+fn von_mises(res: &StudyResult, d: &Path) -> Result<()> {
     let panels: Vec<Panel> = res
         .deformed
         .iter()
@@ -394,7 +411,6 @@ fn readme(res: &StudyResult) -> String {
     s
 }
 
-
 /// What `study NAME` prints: the rates with their thresholds, the theorem error per level,
 /// the reference, and where the report went.
 pub fn console(res: &StudyResult, dir: &Path) -> String {
@@ -417,7 +433,11 @@ pub fn console(res: &StudyResult, dir: &Path) -> String {
                 .unwrap_or_default()
         );
     }
-    for e in res.errors.iter().filter(|e| e.quantity == Quantity::Theorem) {
+    for e in res
+        .errors
+        .iter()
+        .filter(|e| e.quantity == Quantity::Theorem)
+    {
         let _ = writeln!(
             s,
             "{} level {} h {:.4} dofs {} error {:.4e} ({:.2} s)",

@@ -48,7 +48,8 @@ impl SolverKind {
 impl TryFrom<String> for SolverKind {
     type Error = String;
     fn try_from(s: String) -> std::result::Result<Self, String> {
-        SolverKind::parse(&s).ok_or_else(|| format!("unknown solver '{s}'; use newton, paper or qp"))
+        SolverKind::parse(&s)
+            .ok_or_else(|| format!("unknown solver '{s}'; use newton, paper or qp"))
     }
 }
 

@@ -342,7 +342,13 @@ impl Newton<'_> {
             let vals = self.system.values_mut();
             vals.copy_from_slice(&self.elastic_values);
             self.p.model.add_tangent_change(tangents, &self.slots, vals);
-            fill_contact_rows(vals, &self.row_slots, &self.diag_slots, self.c_scale, active);
+            fill_contact_rows(
+                vals,
+                &self.row_slots,
+                &self.diag_slots,
+                self.c_scale,
+                active,
+            );
         });
     }
 
@@ -366,9 +372,8 @@ impl Newton<'_> {
         // residual is at round-off and the right-hand side lives on the contact rows:
         // A0^{-1} b = W b_c with all columns W = A0^{-1} e_{n+i} (one blocked solve), and
         // the Woodbury correction makes it exact: no sparse solve per iteration.
-        let exact = self.factored_elastic
-            && elastic_now
-            && distance.residual <= 1e-2 * self.settings.tol;
+        let exact =
+            self.factored_elastic && elastic_now && distance.residual <= 1e-2 * self.settings.tol;
         if reusable && exact {
             if let Some(update) = self.row_update(active, true) {
                 timed(&clock.solve, || {
@@ -558,7 +563,13 @@ impl StepSolver for Newton<'_> {
                 .residual
                 .iter()
                 .map(|v| -v)
-                .chain((0..m).map(|i| if active[i] { -c * ev.gaps[i] } else { -lambda[i] }))
+                .chain((0..m).map(|i| {
+                    if active[i] {
+                        -c * ev.gaps[i]
+                    } else {
+                        -lambda[i]
+                    }
+                }))
                 .collect();
             debug_assert_eq!(step.len(), n + m);
             self.assemble_kkt(&ev.tangents, &active);

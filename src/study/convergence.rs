@@ -282,7 +282,7 @@ struct Study {
 
 impl Study {
     fn load(name: &str) -> Result<Self> {
-        let path = super::file::resolve(name)?;
+        let path = super::file::resolve(name).ok_or_else(|| super::unknown_study(name))?;
         let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
         let file = StudyFile::from_toml(&text, &path)?;
         // A scene path is relative to the study file; otherwise it is a built-in name.
@@ -327,7 +327,11 @@ impl Plan {
         let family = sf.family_parameters();
         let reference_parameters = sf.reference_parameters();
         let mut jobs = Vec::new();
-        let mut add = |label: String, method: Method, level: usize, params: &[(String, f64)], steps: usize| {
+        let mut add = |label: String,
+                       method: Method,
+                       level: usize,
+                       params: &[(String, f64)],
+                       steps: usize| {
             jobs.push(Job {
                 id: jobs.len(),
                 label,
@@ -340,12 +344,24 @@ impl Plan {
         };
         let r = study.reference_level();
         let reference = [r - 2, r - 1, r].map(|l| {
-            add(format!("reference level {l}"), Method::Mortar, l, &reference_parameters, sf.steps)
+            add(
+                format!("reference level {l}"),
+                Method::Mortar,
+                l,
+                &reference_parameters,
+                sf.steps,
+            )
         });
         let mut levels = Vec::new();
         for &method in &sf.methods {
             for &level in &sf.mesh.levels {
-                let id = add(format!("{method} level {level}"), method, level, &family, sf.steps);
+                let id = add(
+                    format!("{method} level {level}"),
+                    method,
+                    level,
+                    &family,
+                    sf.steps,
+                );
                 levels.push((method, level, id));
             }
         }
@@ -361,12 +377,28 @@ impl Plan {
             let runs = ts
                 .steps
                 .iter()
-                .map(|&n| (n, add(format!("time study ({n} steps)"), method, ts.level, &family, n)))
+                .map(|&n| {
+                    (
+                        n,
+                        add(
+                            format!("time study ({n} steps)"),
+                            method,
+                            ts.level,
+                            &family,
+                            n,
+                        ),
+                    )
+                })
                 .collect();
             (reference, runs)
         });
         let coarsest = &jobs[reference[0]];
-        let case = Case::build(&study.scene, coarsest.level, coarsest.method, &coarsest.params)?;
+        let case = Case::build(
+            &study.scene,
+            coarsest.level,
+            coarsest.method,
+            &coarsest.params,
+        )?;
         if case.problem.interface.min_relative_separation() > 1e-9 {
             return Err(Error::input(
                 &study.path,
@@ -488,19 +520,26 @@ fn measure_levels(
         ));
         if level == profile_level {
             profiles(&case, &sol, Source::Cone(method), &mut out);
-            out.deformed.push(deformed(&case, &sol, method, magnification));
+            out.deformed
+                .push(deformed(&case, &sol, method, magnification));
         }
     }
     Ok(out)
 }
 
 /// Every quantity's relative error of one solved level against the reference.
-fn relative_errors(case: &Case, sol: &Solution, reference: &ReferenceSolution) -> BTreeMap<Quantity, f64> {
+fn relative_errors(
+    case: &Case,
+    sol: &Solution,
+    reference: &ReferenceSolution,
+) -> BTreeMap<Quantity, f64> {
     let (rcase, rsol) = (&reference.case, &reference.solution);
     let (model, rmodel) = (&case.problem.model, &rcase.problem.model);
     let cmp = Comparison::new(model, rmodel);
     let steps = || sol.states.iter().zip(&rsol.states).skip(1);
-    let fields: Vec<SquaredNorms> = steps().map(|(s, r)| cmp.difference(model, s, rmodel, r)).collect();
+    let fields: Vec<SquaredNorms> = steps()
+        .map(|(s, r)| cmp.difference(model, s, rmodel, r))
+        .collect();
     let pressure: Vec<(f64, f64)> = steps()
         .map(|(s, r)| error::pressure_difference(&case.problem, s, &rcase.problem, r))
         .collect();
@@ -614,7 +653,12 @@ fn fit_rates(sf: &StudyFile, measured: &Measured) -> Vec<RateRow> {
             let fit_dofs = rates::fit(&column(&used, |r| r.dofs as f64), &errors);
             let threshold = (quantity == Quantity::Theorem).then_some(threshold);
             let pass = threshold.map(|t| match t {
-                Threshold::Exact(bound) => column(&rows, |r| r.error).into_iter().fold(0.0f64, f64::max) <= bound,
+                Threshold::Exact(bound) => {
+                    column(&rows, |r| r.error)
+                        .into_iter()
+                        .fold(0.0f64, f64::max)
+                        <= bound
+                }
                 Threshold::Rate(rate) => used.len() >= 3 && fit.is_some_and(|f| f.rate >= rate),
             });
             out.push(RateRow {
@@ -673,10 +717,17 @@ fn provenance(study: &Study, reference: &Case) -> BTreeMap<String, String> {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     BTreeMap::from([
         ("gmsh".into(), reference.mesh.gmsh_version.clone()),
-        ("geo".into(), format!("{geo} (sha256 {})", reference.mesh.geo_hash)),
+        (
+            "geo".into(),
+            format!("{geo} (sha256 {})", reference.mesh.geo_hash),
+        ),
         (
             "solver".into(),
-            format!("{} (tolerance {:.0e})", study.file.solver, Settings::default().tol),
+            format!(
+                "{} (tolerance {:.0e})",
+                study.file.solver,
+                Settings::default().tol
+            ),
         ),
         ("cores".into(), cores.to_string()),
         ("commit".into(), super::commit()),
@@ -696,9 +747,14 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
     let sf = &study.file;
     let plan = Plan::new(&study)?;
     let progress = Progress::new(plan.jobs.len() as u64, &study.name);
-    let outputs = jobs::execute(&plan.jobs, &study.scene, sf.solver, &study.text, mode, &|label| {
-        progress.tick(label)
-    })?;
+    let outputs = jobs::execute(
+        &plan.jobs,
+        &study.scene,
+        sf.solver,
+        &study.text,
+        mode,
+        &|label| progress.tick(label),
+    )?;
     progress.finish();
     if let Mode::Shard(i, n) = mode {
         eprintln!(

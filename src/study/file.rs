@@ -162,26 +162,14 @@ pub fn list() -> Vec<(String, String)> {
     out
 }
 
-/// Resolve a study name or path to its file.
-pub fn resolve(name_or_path: &str) -> Result<PathBuf> {
+/// The study file of a built-in study name or a path, if there is one.
+pub fn resolve(name_or_path: &str) -> Option<PathBuf> {
     let p = Path::new(name_or_path);
     if p.extension().is_some_and(|e| e == "toml") || p.exists() {
-        return Ok(p.to_path_buf());
+        return Some(p.to_path_buf());
     }
     let f = builtin_dir().join(format!("{name_or_path}.toml"));
-    if f.exists() {
-        Ok(f)
-    } else {
-        let names: Vec<String> = list().into_iter().map(|(n, _)| n).collect();
-        Err(Error::input(
-            name_or_path,
-            "study",
-            format!(
-                "no built-in study named '{name_or_path}' and no such file; built-in studies: {}",
-                names.join(", ")
-            ),
-        ))
-    }
+    f.exists().then_some(f)
 }
 
 impl StudyFile {

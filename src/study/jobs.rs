@@ -168,7 +168,10 @@ pub struct Solved(Vec<Option<(Case, Solution)>>);
 impl Solved {
     /// All jobs' outputs, or None when some were left to other shards.
     pub fn complete(outputs: Vec<Option<(Case, Solution)>>) -> Option<Self> {
-        outputs.iter().all(Option::is_some).then_some(Solved(outputs))
+        outputs
+            .iter()
+            .all(Option::is_some)
+            .then_some(Solved(outputs))
     }
 
     /// Take job `id`'s case and solution (once).

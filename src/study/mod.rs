@@ -24,8 +24,8 @@ pub use convergence::{ErrorRow, LevelInfo, RateRow, StudyResult, run, run_mode};
 
 use crate::case::Case;
 use crate::error::{Error, Result};
-use error::Comparison;
 use crate::solve::{self, Settings, Solution, SolverKind};
+use error::Comparison;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -67,7 +67,9 @@ impl Kind {
     pub fn resolve(name: &str) -> Result<Kind> {
         match Self::BUILT_IN.iter().find(|(n, _, _)| *n == name) {
             Some((_, kind, _)) => Ok(kind.clone()),
-            None => Ok(Kind::Convergence(file::resolve(name)?)),
+            None => file::resolve(name)
+                .map(Kind::Convergence)
+                .ok_or_else(|| unknown_study(name)),
         }
     }
 
@@ -86,9 +88,10 @@ impl Kind {
     /// The study's name: its report folder under reports/.
     pub fn name(&self) -> String {
         match self {
-            Kind::Convergence(path) => path
-                .file_stem()
-                .map_or_else(|| path.display().to_string(), |s| s.to_string_lossy().to_string()),
+            Kind::Convergence(path) => path.file_stem().map_or_else(
+                || path.display().to_string(),
+                |s| s.to_string_lossy().to_string(),
+            ),
             other => Self::BUILT_IN
                 .iter()
                 .find(|(_, k, _)| k == other)
@@ -116,6 +119,19 @@ impl Kind {
             Kind::Stability => Some(Outcome::Stability(stability::run()?)),
         })
     }
+}
+
+/// The error for a study name that is neither built in nor a file.
+pub fn unknown_study(name: &str) -> Error {
+    let names: Vec<String> = Kind::list().into_iter().map(|(n, _)| n).collect();
+    Error::input(
+        name,
+        "study",
+        format!(
+            "no built-in study named '{name}' and no such file; built-in studies: {}",
+            names.join(", ")
+        ),
+    )
 }
 
 impl Outcome {

@@ -96,8 +96,16 @@ impl Differences<'_> {
         let rel = |f: &dyn Fn(&SquaredNorms) -> f64| {
             max_over(f, self.fields) / max_over(f, self.reference).max(f64::MIN_POSITIVE)
         };
-        let pressure_diff = self.pressure.iter().map(|p| p.0.sqrt()).fold(0.0f64, f64::max);
-        let pressure_ref = self.pressure.iter().map(|p| p.1.sqrt()).fold(0.0f64, f64::max);
+        let pressure_diff = self
+            .pressure
+            .iter()
+            .map(|p| p.0.sqrt())
+            .fold(0.0f64, f64::max);
+        let pressure_ref = self
+            .pressure
+            .iter()
+            .map(|p| p.1.sqrt())
+            .fold(0.0f64, f64::max);
         BTreeMap::from([
             (Quantity::Theorem, rel(&|n| n.theorem())),
             (Quantity::H1U, rel(&|n| n.h1())),

@@ -78,7 +78,9 @@ impl HardCase {
                 "k = 0.25, E = 100; lambda set so that k E / lambda sweeps 1e-2..1e4. The paper's fixed point (4.2)-(4.3) is a contraction only while k L < 1."
             }
             HardCase::ModulusContrast => "E of the lower block = 100 x E2/E1, upper block E = 100.",
-            HardCase::MeshSizeRatio => "Level 0 with h_upper = 0.2 sqrt(r), h_lower = 0.2 / sqrt(r).",
+            HardCase::MeshSizeRatio => {
+                "Level 0 with h_upper = 0.2 sqrt(r), h_lower = 0.2 / sqrt(r)."
+            }
             HardCase::Slivers => {
                 "The upper block's first layer along Gamma_C is a structured strip (the `strip` parameter of meshes/two_blocks.geo), one triangle pair per contact edge: the thinner the strip, the flatter the triangles that carry the constraint. The largest aspect ratio (longest edge over the altitude onto it) is measured on the mesh."
             }
@@ -304,7 +306,12 @@ fn plan() -> Result<Vec<Variant>> {
     // Slivers: a structured strip of the upper block along Gamma_C, one triangle pair per
     // contact edge, thinner and thinner (the measured aspect ratio is in the parameter).
     for strip in [2.9e-2, 2.9e-3, 2.9e-4] {
-        let mut var = base(HardCase::Slivers, format!("strip {strip:e}"), 0.0, rates.clone());
+        let mut var = base(
+            HardCase::Slivers,
+            format!("strip {strip:e}"),
+            0.0,
+            rates.clone(),
+        );
         var.params = vec![("strip".into(), strip)];
         v.push(var);
     }
