@@ -2,8 +2,9 @@
 //! mortar-type K_h^pi and the node-on-segment K_h^I) for quasistatic frictionless contact
 //! of two elastic-viscoplastic bodies on non-matching meshes.
 //!
-//! The modules follow the pipeline: [`mesh`] -> [`fe`] -> [`material`] -> [`contact`] ->
-//! [`solve`] -> [`case`] / [`metrics`] -> [`io`]. Scenes are data ([`scene`]).
+//! The modules follow the pipeline: [`mesh`] -> [`scene`] -> [`material`] -> [`fe`] ->
+//! [`contact`] -> [`solve`] -> [`case`] / [`metrics`] / [`io`] -> [`study`] -> [`report`];
+//! the binary is a thin CLI over them. Scenes are data ([`scene`]).
 
 pub mod case;
 pub mod contact;

@@ -195,6 +195,31 @@ fn readme(res: &SpeedResult) -> String {
         s,
         "![work precision](work_precision.png)\n\n![time against dofs](time_vs_dofs.png)\n"
     );
+    s.push_str(&table(res));
+    for m in [Method::Mortar, Method::Nts] {
+        let finest = crate::study::speed::PAPER_LEVELS.iter().max().unwrap();
+        let at_finest = |so| runs_of(res, m, so).find(|r| r.run.level == *finest);
+        if let (Some(a), Some(b)) = (at_finest(SolverKind::Newton), at_finest(SolverKind::Paper)) {
+            let _ = writeln!(
+                s,
+                "\n{m}, level {finest}: newton {:.3} s ({:.2} x the floor), paper {:.3} s at the same final tolerance: newton is {:.1} x faster.",
+                a.run.time_loop_s,
+                a.run.time_loop_s / floor_of(a),
+                b.run.time_loop_s,
+                b.run.time_loop_s / a.run.time_loop_s
+            );
+        }
+    }
+    s
+}
+
+fn gib(v: Option<f64>) -> String {
+    v.map(|g| format!("{g:.1}")).unwrap_or_default()
+}
+
+/// The table of every run: cost split, floor, memory and error.
+fn table(res: &SpeedResult) -> String {
+    let mut s = String::new();
     let _ = writeln!(
         s,
         "| family | method | solver | level | dofs | iterations | factorizations | time loop (s) | floor (s) | ratio to floor | set-up (s) | factorizations (s) | solves (s) | assembly (s) | constitutive (s) | peak RSS (GiB) | error |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
@@ -223,50 +248,10 @@ fn readme(res: &SpeedResult) -> String {
             r.error.map(|e| format!("{e:.3e}")).unwrap_or_default()
         );
     }
-    for m in [Method::Mortar, Method::Nts] {
-        let finest = crate::study::speed::PAPER_LEVELS.iter().max().unwrap();
-        let at_finest = |so| runs_of(res, m, so).find(|r| r.run.level == *finest);
-        if let (Some(a), Some(b)) = (at_finest(SolverKind::Newton), at_finest(SolverKind::Paper)) {
-            let _ = writeln!(
-                s,
-                "\n{m}, level {finest}: newton {:.3} s ({:.2} x the floor), paper {:.3} s at the same final tolerance: newton is {:.1} x faster.",
-                a.run.time_loop_s,
-                a.run.time_loop_s / floor_of(a),
-                b.run.time_loop_s,
-                b.run.time_loop_s / a.run.time_loop_s
-            );
-        }
-    }
     s
 }
 
-fn gib(v: Option<f64>) -> String {
-    v.map(|g| format!("{g:.1}")).unwrap_or_default()
-}
-
-/// What `study speed` prints: one line per run, and where the report went.
+/// What `study speed` prints: the table of the runs, and where the report went.
 pub fn console(res: &SpeedResult, dir: &Path) -> String {
-    let mut s = String::new();
-    for r in &res.rows {
-        let run = &r.run;
-        let _ = writeln!(
-            s,
-            "{:11} {:7} {:7} level {} {:7} dofs: {:3} iterations, {:2} factorizations, {:8.3} s = {:5.2} x floor ({:.3} s), set-up {:.3} s, peak {} GiB, error {}",
-            r.family,
-            run.method,
-            run.solver,
-            run.level,
-            run.dofs,
-            run.iterations,
-            run.timings.factorizations,
-            run.time_loop_s,
-            run.time_loop_s / floor_of(r),
-            floor_of(r),
-            run.timings.setup_s,
-            gib(run.peak_rss_gib),
-            r.error.map(|e| format!("{e:.3e}")).unwrap_or_default()
-        );
-    }
-    let _ = writeln!(s, "wrote {} ({:.1} s)", dir.display(), res.wall_s);
-    s
+    format!("{}wrote {} ({:.1} s)\n", table(res), dir.display(), res.wall_s)
 }
