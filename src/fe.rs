@@ -140,10 +140,52 @@ pub struct Model {
     pub n_free: usize,
     /// Traction edges: (curve index in scene.tractions, global node pair).
     pub traction_edges: Vec<(usize, [usize; 2])>,
+    /// For each traction edge: its body and outward unit normal (what a derived traction
+    /// sigma(u) n needs).
+    pub traction_normals: Vec<(usize, [f64; 2])>,
     /// The scene it was built from.
     pub scene: Scene,
     /// The mesh file (for messages).
     pub mesh_file: std::path::PathBuf,
+}
+
+/// The body and outward unit normal of each boundary edge: away from the third vertex of
+/// the edge's triangle.
+fn outward_normals(
+    elements: &[Element],
+    edges: &[(usize, [usize; 2])],
+    position: impl Fn(usize) -> [f64; 2],
+) -> Vec<(usize, [f64; 2])> {
+    let key = |a: usize, b: usize| (a.min(b), a.max(b));
+    let mut third: std::collections::HashMap<(usize, usize), (usize, usize)> = edges
+        .iter()
+        .map(|&(_, [a, b])| (key(a, b), (usize::MAX, 0)))
+        .collect();
+    for el in elements {
+        let n = el.nodes;
+        for k in 0..3 {
+            if let Some(v) = third.get_mut(&key(n[k], n[(k + 1) % 3])) {
+                *v = (n[(k + 2) % 3], el.body);
+            }
+        }
+    }
+    edges
+        .iter()
+        .map(|&(_, [a, b])| {
+            let (c, body) = third[&key(a, b)];
+            let (pa, pb) = (position(a), position(b));
+            let d = [pb[0] - pa[0], pb[1] - pa[1]];
+            let len = d[0].hypot(d[1]);
+            let mut n = [d[1] / len, -d[0] / len];
+            if c != usize::MAX {
+                let pc = position(c);
+                if (pc[0] - pa[0]) * n[0] + (pc[1] - pa[1]) * n[1] > 0.0 {
+                    n = [-n[0], -n[1]];
+                }
+            }
+            (body, n)
+        })
+        .collect()
 }
 
 fn edges_of(
@@ -258,6 +300,12 @@ impl Model {
                 traction_edges.push((i, e));
             }
         }
+        // Only derived tractions need the normals.
+        let traction_normals = if scene.tractions.iter().any(|t| t.g.is_none()) {
+            outward_normals(&elements, &traction_edges, model_pos)
+        } else {
+            Vec::new()
+        };
         Ok(Model {
             materials: [scene.bodies[0].material, scene.bodies[1].material],
             meshes,
@@ -266,10 +314,31 @@ impl Model {
             elements,
             equation,
             n_free,
+            traction_normals,
             traction_edges,
             scene: scene.clone(),
             mesh_file: mesh_file.to_path_buf(),
         })
+    }
+
+    /// The traction sigma(u) n of the manufactured solution on traction edge `e`.
+    fn derived_traction(&self, e: usize, x: f64, y: f64, t: f64, field: &str) -> Result<[f64; 2]> {
+        let (body, n) = self.traction_normals[e];
+        let s = self
+            .scene
+            .exact
+            .as_ref()
+            .and_then(|ex| ex.stress_at(body, x, y, t))
+            .expect("a scene without g on a traction is manufactured, with a stress");
+        let g = crate::analytical::traction(s, n);
+        if g.iter().any(|v| !v.is_finite()) {
+            return Err(Error::input(
+                &self.scene.file,
+                field,
+                format!("the traction derived from exact.displacement is not finite at x = {x}, y = {y}, t = {t}; fix the displacement"),
+            ));
+        }
+        Ok(g)
     }
 
     /// Coordinates of global node `g`.
@@ -341,20 +410,18 @@ impl Model {
             0.652_145_154_862_546_1,
             0.347_854_845_137_453_9,
         ];
-        for &(i, [a, b]) in &self.traction_edges {
+        for (e, &(i, [a, b])) in self.traction_edges.iter().enumerate() {
             let (pa, pb) = (self.position(a), self.position(b));
             let len = (pb[0] - pa[0]).hypot(pb[1] - pa[1]);
             for q in 0..4 {
                 let s = 0.5 * (1.0 + GX[q]);
                 let x = pa[0] + s * (pb[0] - pa[0]);
                 let y = pa[1] + s * (pb[1] - pa[1]);
-                let g = self.scene.tractions[i].g.eval(
-                    x,
-                    y,
-                    t,
-                    &self.scene.file,
-                    &format!("traction '{}'.g", self.scene.tractions[i].curve),
-                )?;
+                let field = || format!("traction '{}'.g", self.scene.tractions[i].curve);
+                let g = match &self.scene.tractions[i].g {
+                    Some(g) => g.eval(x, y, t, &self.scene.file, &field())?,
+                    None => self.derived_traction(e, x, y, t, &field())?,
+                };
                 let w = 0.5 * GW[q] * len;
                 for c in 0..2 {
                     f[2 * a + c] += w * (1.0 - s) * g[c];

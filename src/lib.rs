@@ -6,14 +6,17 @@
 //! [`contact`] -> [`solve`] -> [`case`] / [`metrics`] / [`io`] -> [`study`] -> [`report`];
 //! the binary is a thin CLI over them. Scenes are data ([`scene`]).
 
+pub mod analytical;
 pub mod case;
 pub mod contact;
 pub mod error;
+pub mod expr;
 pub mod fe;
 pub mod io;
 pub mod material;
 pub mod mesh;
 pub mod metrics;
+pub mod quadrature;
 pub mod report;
 pub mod scene;
 pub mod solve;

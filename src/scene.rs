@@ -2,9 +2,10 @@
 //! their materials, the boundary parts by physical-curve name, loads as expressions in
 //! x, y, t, the contact lines, the time interval, and optionally an exact solution.
 
+use crate::analytical::{Exact, Field};
 use crate::error::{Error, Result};
+pub use crate::expr::{Expr, VectorExpr};
 use crate::material::{Elasticity, Material, Viscoplasticity};
-use exmex::prelude::*;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -51,8 +52,9 @@ pub struct RollerSpec {
 pub struct TractionSpec {
     /// Physical-curve name.
     pub curve: String,
-    /// The traction components.
-    pub g: [String; 2],
+    /// The traction components; omitted in a manufactured scene, where g = sigma(u) n is
+    /// derived from the manufactured displacement.
+    pub g: Option<[String; 2]>,
 }
 
 /// The contact lines.
@@ -67,12 +69,30 @@ pub struct ContactSpec {
     pub master_curve: String,
 }
 
-/// Optional exact solution (used by tests and reports).
+/// Exact stress: one [s11, s22, s12] for both bodies, or one per body.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum StressSpec {
+    /// The same stress in both bodies.
+    Both([String; 3]),
+    /// One stress per body, in [[bodies]] order.
+    PerBody([[String; 3]; 2]),
+}
+
+/// Optional exact solution: what a study with `[reference] exact = true` measures against.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ExactSpec {
-    /// Exact stress [s11, s22, s12] as expressions in x, y, t, the same in both bodies.
-    pub stress: Option<[String; 3]>,
+    /// Displacement [u_x, u_y] of each body, in [[bodies]] order (length).
+    pub displacement: Option<[[String; 2]; 2]>,
+    /// Stress [s11, s22, s12] (derived from the displacement of elastic bodies when omitted).
+    pub stress: Option<StressSpec>,
+    /// Contact pressure on Gamma_C (force/length; -sigma_nn of the slave when omitted).
+    pub pressure: Option<String>,
+    /// The displacement is manufactured: the body forces and the tractions on the Neumann
+    /// curves are derived from it (elastic bodies only).
+    #[serde(default)]
+    pub manufactured: bool,
 }
 
 /// The TOML layout of a scene file.
@@ -107,86 +127,6 @@ pub struct SceneFile {
     pub exact: Option<ExactSpec>,
 }
 
-/// A parsed expression in x, y, t (and the constant `pi`), evaluated without re-parsing.
-#[derive(Debug, Clone)]
-pub struct Expr {
-    /// The source text.
-    pub text: String,
-    // Boxed: a FlatEx keeps its nodes inline and is several kilobytes, which overflowed
-    // the 2 MiB stack of test threads once a Scene (seven expressions) was moved around.
-    flat: Box<FlatEx<f64>>,
-    /// For each variable of the expression (alphabetical order), which input it reads.
-    slots: Vec<u8>,
-}
-
-impl Expr {
-    /// Parse `text`; `file` and `field` name the place for error messages.
-    pub fn parse(text: &str, file: &Path, field: &str) -> Result<Self> {
-        let flat = FlatEx::<f64>::parse(text).map_err(|e| {
-            Error::input(file, field, format!("cannot parse expression '{text}' ({e}); use x, y, t, numbers, + - * / ^ and functions such as sin, cos, exp, sqrt, abs"))
-        })?;
-        let mut slots = Vec::new();
-        for v in flat.var_names() {
-            slots.push(match v.as_str() {
-                "x" => 0,
-                "y" => 1,
-                "t" => 2,
-                "pi" => 3,
-                other => {
-                    return Err(Error::input(file, field, format!("expression '{text}' uses unknown variable '{other}'; only x, y, t and pi are defined")));
-                }
-            });
-        }
-        Ok(Expr {
-            text: text.to_string(),
-            flat: Box::new(flat),
-            slots,
-        })
-    }
-
-    /// Evaluate at (x, y, t). Non-finite values are returned as they are; callers check.
-    pub fn eval(&self, x: f64, y: f64, t: f64) -> f64 {
-        let inputs = [x, y, t, std::f64::consts::PI];
-        let mut vals = [0.0; 4];
-        for (k, &s) in self.slots.iter().enumerate() {
-            vals[k] = inputs[s as usize];
-        }
-        self.flat
-            .eval(&vals[..self.slots.len()])
-            .unwrap_or(f64::NAN)
-    }
-}
-
-/// A vector field given by two expressions.
-#[derive(Debug, Clone)]
-pub struct VectorExpr(pub [Expr; 2]);
-
-impl VectorExpr {
-    fn parse(e: &[String; 2], file: &Path, field: &str) -> Result<Self> {
-        Ok(VectorExpr([
-            Expr::parse(&e[0], file, &format!("{field}[0]"))?,
-            Expr::parse(&e[1], file, &format!("{field}[1]"))?,
-        ]))
-    }
-    /// Evaluate both components; error naming the scene, field and expression if not finite.
-    pub fn eval(&self, x: f64, y: f64, t: f64, file: &Path, field: &str) -> Result<[f64; 2]> {
-        let v = [self.0[0].eval(x, y, t), self.0[1].eval(x, y, t)];
-        for (c, val) in v.iter().enumerate() {
-            if !val.is_finite() {
-                return Err(Error::input(
-                    file,
-                    format!("{field}[{c}]"),
-                    format!(
-                        "expression '{}' is not finite at x = {x}, y = {y}, t = {t}; fix the expression",
-                        self.0[c].text
-                    ),
-                ));
-            }
-        }
-        Ok(v)
-    }
-}
-
 /// A body of a validated scene.
 #[derive(Debug, Clone)]
 pub struct SceneBody {
@@ -212,8 +152,8 @@ pub struct Roller {
 pub struct Traction {
     /// Physical-curve name.
     pub curve: String,
-    /// g(x, y, t).
-    pub g: VectorExpr,
+    /// g(x, y, t); None: sigma(u) n of the manufactured solution, on the curve's body.
+    pub g: Option<VectorExpr>,
 }
 
 /// A validated scene, ready to be meshed and solved.
@@ -245,8 +185,8 @@ pub struct Scene {
     pub slave_curve: String,
     /// Gamma_C on body 2.
     pub master_curve: String,
-    /// Exact stress, if known.
-    pub exact_stress: Option<[Expr; 3]>,
+    /// The exact solution, if known (Box: it holds many expressions).
+    pub exact: Option<Box<Exact>>,
 }
 
 /// The folder of the built-in scenes.
@@ -450,12 +390,31 @@ impl Scene {
                 component,
             });
         }
+        let manufactured = sf.exact.as_ref().is_some_and(|e| e.manufactured);
         let mut tractions = Vec::new();
         for (i, t) in sf.traction.iter().enumerate() {
             claim(&t.curve, "traction", format!("traction[{i}].curve"))?;
+            let g = match (&t.g, manufactured) {
+                (Some(g), false) => Some(VectorExpr::parse(g, file, &format!("traction[{i}].g"))?),
+                (None, true) => None,
+                (None, false) => {
+                    return Err(Error::input(
+                        file,
+                        format!("traction[{i}].g"),
+                        "missing; give g = [\"gx\", \"gy\"] (only a manufactured scene derives it)",
+                    ));
+                }
+                (Some(_), true) => {
+                    return Err(Error::input(
+                        file,
+                        format!("traction[{i}].g"),
+                        "a manufactured scene derives g = sigma(u) n from exact.displacement; remove g",
+                    ));
+                }
+            };
             tractions.push(Traction {
                 curve: t.curve.clone(),
-                g: VectorExpr::parse(&t.g, file, &format!("traction[{i}].g"))?,
+                g,
             });
         }
         claim(
@@ -468,12 +427,8 @@ impl Scene {
             "contact",
             "contact.master_curve".into(),
         )?;
-        let exact_stress = match sf.exact.as_ref().and_then(|e| e.stress.as_ref()) {
-            Some(s) => Some([
-                Expr::parse(&s[0], file, "exact.stress[0]")?,
-                Expr::parse(&s[1], file, "exact.stress[1]")?,
-                Expr::parse(&s[2], file, "exact.stress[2]")?,
-            ]),
+        let exact = match &sf.exact {
+            Some(spec) => Some(Box::new(exact_solution(spec, &mut bodies, slave == 1, file)?)),
             None => None,
         };
         let [b0, b1]: [SceneBody; 2] = bodies.try_into().expect("two bodies");
@@ -491,7 +446,110 @@ impl Scene {
             tractions,
             slave_curve: sf.contact.slave_curve,
             master_curve: sf.contact.master_curve,
-            exact_stress,
+            exact,
         })
     }
+}
+
+/// The scene's exact solution from its `[exact]` table; `bodies` are in slave-first order
+/// (`swapped`: the file lists the master first). A manufactured solution's body forces are
+/// set on `bodies`.
+fn exact_solution(
+    spec: &ExactSpec,
+    bodies: &mut [SceneBody],
+    swapped: bool,
+    file: &Path,
+) -> Result<Exact> {
+    let order = |b: usize| if swapped { 1 - b } else { b };
+    let displacement = match &spec.displacement {
+        Some(d) => Some([0, 1].map(|b| {
+            let i = order(b);
+            [0, 1].map(|c| Expr::parse(&d[i][c], file, &format!("exact.displacement[{i}][{c}]")))
+        })),
+        None => None,
+    };
+    let displacement = match displacement {
+        Some([[a, b], [c, d]]) => Some([[a?, b?], [c?, d?]]),
+        None => None,
+    };
+    let stress_text = |b: usize| -> Option<(String, &[String; 3])> {
+        match spec.stress.as_ref()? {
+            StressSpec::Both(s) => Some(("exact.stress".into(), s)),
+            StressSpec::PerBody(s) => Some((format!("exact.stress[{}]", order(b)), &s[order(b)])),
+        }
+    };
+    let mut stress = Vec::new();
+    for b in 0..2 {
+        if let Some((field, s)) = stress_text(b) {
+            stress.push([
+                Expr::parse(&s[0], file, &format!("{field}[0]"))?,
+                Expr::parse(&s[1], file, &format!("{field}[1]"))?,
+                Expr::parse(&s[2], file, &format!("{field}[2]"))?,
+            ]);
+        }
+    }
+    let stress: Option<[[Expr; 3]; 2]> = stress.try_into().ok();
+    let pressure = spec
+        .pressure
+        .as_ref()
+        .map(|p| Expr::parse(p, file, "exact.pressure"))
+        .transpose()?;
+    if spec.manufactured {
+        if displacement.is_none() {
+            return Err(Error::input(
+                file,
+                "exact.manufactured",
+                "a manufactured solution needs exact.displacement = [[\"ux\", \"uy\"], [\"ux\", \"uy\"]], one pair per body",
+            ));
+        }
+        for b in bodies.iter() {
+            if b.material.viscoplastic.is_some() {
+                return Err(Error::input(
+                    file,
+                    "exact.manufactured",
+                    format!(
+                        "body '{}' is viscoplastic; manufactured solutions are for elastic bodies: remove its lambda and yield_stress",
+                        b.surface
+                    ),
+                ));
+            }
+            if b.body_force.is_some() {
+                return Err(Error::input(
+                    file,
+                    "exact.manufactured",
+                    format!(
+                        "body '{}' gives a body_force; a manufactured scene derives it from exact.displacement: remove it",
+                        b.surface
+                    ),
+                ));
+            }
+        }
+        if stress.is_some() {
+            return Err(Error::input(
+                file,
+                "exact.stress",
+                "a manufactured scene derives the stress from exact.displacement; remove exact.stress",
+            ));
+        }
+    }
+    let exact = Exact::new(
+        displacement,
+        stress,
+        pressure,
+        spec.manufactured,
+        [&bodies[0].material, &bodies[1].material],
+    );
+    if let Some(f) = &exact.body_force {
+        for (b, body) in bodies.iter_mut().enumerate() {
+            body.body_force = Some(VectorExpr(f[b].clone()));
+        }
+    }
+    if !exact.gives(Field::Displacement) && !exact.gives(Field::Stress) && !exact.gives(Field::Pressure) {
+        return Err(Error::input(
+            file,
+            "exact",
+            "the [exact] table gives nothing; give displacement, stress or pressure, or remove it",
+        ));
+    }
+    Ok(exact)
 }

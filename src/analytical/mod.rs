@@ -1,0 +1,146 @@
+//! Closed-form and manufactured solutions as first-class code: a scene's exact solution
+//! (displacement and stress of each body, the contact pressure on Gamma_C), with what
+//! follows from it by exact symbolic differentiation: the gradient, the stress of an
+//! elastic body, and for a manufactured solution the body force f = -div sigma(u).
+//!
+//! [`stacked`] derives the closed form of the `stacked-exact` scene.
+
+pub mod stacked;
+
+use crate::expr::Expr;
+use crate::material::Material;
+
+/// Displacement of one body: (u_x, u_y).
+pub type Displacement = [Expr; 2];
+/// Stress of one body: (s11, s22, s12).
+pub type StressField = [Expr; 3];
+
+/// The exact solution of a scene, per body (index 0 the slave, as in the scene).
+#[derive(Debug, Clone)]
+pub struct Exact {
+    /// Displacement of each body (length), if given.
+    pub displacement: Option<[Displacement; 2]>,
+    /// d u_c / d x_d of each body: `gradient[b][c][d]`, derived from the displacement.
+    pub gradient: Option<[[[Expr; 2]; 2]; 2]>,
+    /// Stress of each body (stress units), given or derived from the displacement of an
+    /// elastic body.
+    pub stress: Option<[StressField; 2]>,
+    /// Contact pressure on Gamma_C (force/length), if given; otherwise -sigma_nn of the
+    /// slave's stress where the stress is known.
+    pub pressure: Option<Expr>,
+    /// Body force f = -div sigma(u) of each body, for a manufactured solution.
+    pub body_force: Option<[[Expr; 2]; 2]>,
+}
+
+/// What an exact solution gives, for messages.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Field {
+    /// The displacement of both bodies.
+    Displacement,
+    /// The stress of both bodies.
+    Stress,
+    /// The contact pressure.
+    Pressure,
+}
+
+impl Field {
+    /// The key a scene's `[exact]` table gives it by.
+    pub fn key(self) -> &'static str {
+        match self {
+            Field::Displacement => "exact.displacement",
+            Field::Stress => "exact.stress",
+            Field::Pressure => "exact.pressure",
+        }
+    }
+}
+
+/// The gradient of a displacement: `[c][d]` = d u_c / d x_d.
+pub fn gradient(u: &Displacement) -> [[Expr; 2]; 2] {
+    [0, 1].map(|c| [0, 1].map(|d| u[c].partial(d)))
+}
+
+/// The stress of an elastic body with displacement gradient `g`: sigma = a tr(eps) I + b eps
+/// (plane stress, a = E nu / (1 - nu^2), b = E / (1 + nu)).
+pub fn elastic_stress(material: &Material, g: &[[Expr; 2]; 2]) -> StressField {
+    let (a, b) = (material.elastic.a(), material.elastic.b());
+    [
+        Expr::combine(&[(a + b, &g[0][0]), (a, &g[1][1])]),
+        Expr::combine(&[(a, &g[0][0]), (a + b, &g[1][1])]),
+        Expr::combine(&[(0.5 * b, &g[0][1]), (0.5 * b, &g[1][0])]),
+    ]
+}
+
+/// The body force that balances a stress field: f = -div sigma.
+pub fn body_force(s: &StressField) -> [Expr; 2] {
+    [
+        Expr::combine(&[(-1.0, &s[0].partial(0)), (-1.0, &s[2].partial(1))]),
+        Expr::combine(&[(-1.0, &s[2].partial(0)), (-1.0, &s[1].partial(1))]),
+    ]
+}
+
+impl Exact {
+    /// Complete what is given: the gradient of a given displacement, the stress of an
+    /// elastic body from it (when not given), and for a manufactured solution the body
+    /// forces. `materials` are the bodies' in scene order.
+    pub fn new(
+        displacement: Option<[Displacement; 2]>,
+        stress: Option<[StressField; 2]>,
+        pressure: Option<Expr>,
+        manufactured: bool,
+        materials: [&Material; 2],
+    ) -> Self {
+        let gradient = displacement.as_ref().map(|u| [gradient(&u[0]), gradient(&u[1])]);
+        let elastic = materials.iter().all(|m| m.viscoplastic.is_none());
+        let stress = stress.or_else(|| {
+            let g = gradient.as_ref().filter(|_| elastic)?;
+            Some([0, 1].map(|b| elastic_stress(materials[b], &g[b])))
+        });
+        let body_force = stress
+            .as_ref()
+            .filter(|_| manufactured)
+            .map(|s| [body_force(&s[0]), body_force(&s[1])]);
+        Exact {
+            displacement,
+            gradient,
+            stress,
+            pressure,
+            body_force,
+        }
+    }
+
+    /// Whether the exact solution gives `field` (the pressure also follows from the stress).
+    pub fn gives(&self, field: Field) -> bool {
+        match field {
+            Field::Displacement => self.displacement.is_some(),
+            Field::Stress => self.stress.is_some(),
+            Field::Pressure => self.pressure.is_some() || self.stress.is_some(),
+        }
+    }
+
+    /// Stress of body `b` at (x, y, t) as [s11, s22, s12].
+    pub fn stress_at(&self, b: usize, x: f64, y: f64, t: f64) -> Option<[f64; 3]> {
+        let s = &self.stress.as_ref()?[b];
+        Some([s[0].eval(x, y, t), s[1].eval(x, y, t), s[2].eval(x, y, t)])
+    }
+
+    /// Displacement of body `b` at (x, y, t).
+    pub fn displacement_at(&self, b: usize, x: f64, y: f64, t: f64) -> Option<[f64; 2]> {
+        let u = &self.displacement.as_ref()?[b];
+        Some([u[0].eval(x, y, t), u[1].eval(x, y, t)])
+    }
+
+    /// Contact pressure at (x, y, t) on Gamma_C with the slave's outward normal `n`: the
+    /// given pressure, or -n.sigma^1 n.
+    pub fn pressure_at(&self, n: [f64; 2], x: f64, y: f64, t: f64) -> Option<f64> {
+        if let Some(p) = &self.pressure {
+            return Some(p.eval(x, y, t));
+        }
+        let s = self.stress_at(0, x, y, t)?;
+        Some(-(n[0] * n[0] * s[0] + n[1] * n[1] * s[1] + 2.0 * n[0] * n[1] * s[2]))
+    }
+}
+
+/// The traction sigma n of a stress [s11, s22, s12] on a normal n.
+pub fn traction(s: [f64; 3], n: [f64; 2]) -> [f64; 2] {
+    [s[0] * n[0] + s[2] * n[1], s[2] * n[0] + s[1] * n[1]]
+}

@@ -1,0 +1,220 @@
+//! Expressions in x, y, t (and the constant `pi`) as scenes write them: parsed once,
+//! evaluated fast, and differentiated exactly (exmex's symbolic derivatives).
+//!
+//! Piecewise expressions are written with `abs` (max(z, 0) = (z + abs(z)) / 2). exmex
+//! cannot differentiate `abs`, so each `abs(z)` is differentiated on its branch: it is
+//! rewritten as `s_k * (z)` with a sign variable s_k, exmex differentiates that (s_k is
+//! constant on a branch), and evaluation sets s_k = sign(z(x, y, t)). Where the law needs a
+//! derivative to be continuous, the branches agree at z = 0, so the choice there does not
+//! matter.
+
+use crate::error::{Error, Result};
+use exmex::prelude::*;
+use exmex::Differentiate;
+use std::path::Path;
+
+/// Inputs an expression may read: x, y, t, pi, then the sign variables s0, s1, ...
+const NAMED: [&str; 4] = ["x", "y", "t", "pi"];
+
+/// A parsed expression in x, y, t (and the constant `pi`), evaluated without re-parsing.
+#[derive(Debug, Clone)]
+pub struct Expr {
+    /// The source text (for messages).
+    pub text: String,
+    // Boxed: a FlatEx keeps its nodes inline and is several kilobytes, which overflowed
+    // the 2 MiB stack of test threads once a Scene was moved around.
+    /// The expression with every `abs(z_k)` written as `s_k*(z_k)` (its branch form).
+    flat: Box<FlatEx<f64>>,
+    /// For each variable of `flat` (alphabetical order), which input it reads.
+    slots: Vec<usize>,
+    /// The arguments z_k of the `abs` calls, whose signs are the s_k.
+    signs: Vec<Expr>,
+}
+
+impl Expr {
+    /// Parse `text`; `file` and `field` name the place for error messages.
+    pub fn parse(text: &str, file: &Path, field: &str) -> Result<Self> {
+        let bad = |msg: String| Error::input(file, field, msg);
+        let (branch, arguments) = branch_form(text).map_err(|m| bad(format!("expression '{text}': {m}")))?;
+        let signs = arguments
+            .iter()
+            .map(|a| Expr::parse(a, file, field))
+            .collect::<Result<Vec<_>>>()?;
+        let flat = FlatEx::<f64>::parse(&branch).map_err(|e| {
+            bad(format!("cannot parse expression '{text}' ({e}); use x, y, t, numbers, + - * / ^ and functions such as sin, cos, exp, sqrt, abs"))
+        })?;
+        let slots = slots_of(&flat, signs.len())
+            .map_err(|v| bad(format!("expression '{text}' uses unknown variable '{v}'; only x, y, t and pi are defined")))?;
+        Ok(Expr {
+            text: text.to_string(),
+            flat: Box::new(flat),
+            slots,
+            signs,
+        })
+    }
+
+    /// A number as an expression.
+    pub fn constant(v: f64) -> Self {
+        Self::parse(&format!("{v:e}"), Path::new(""), "").expect("a number parses")
+    }
+
+    /// Evaluate at (x, y, t). Non-finite values are returned as they are; callers check.
+    pub fn eval(&self, x: f64, y: f64, t: f64) -> f64 {
+        let mut inputs = [0.0f64; 16];
+        inputs[..4].copy_from_slice(&[x, y, t, std::f64::consts::PI]);
+        for (k, z) in self.signs.iter().enumerate() {
+            // sign(0) = +1: at a kink the branches' derivatives agree where the law needs
+            // them to.
+            inputs[4 + k] = if z.eval(x, y, t) < 0.0 { -1.0 } else { 1.0 };
+        }
+        let mut vals = [0.0f64; 16];
+        for (k, &s) in self.slots.iter().enumerate() {
+            vals[k] = inputs[s];
+        }
+        self.flat
+            .eval(&vals[..self.slots.len()])
+            .unwrap_or(f64::NAN)
+    }
+
+    /// The exact partial derivative with respect to x (`var` 0), y (1) or t (2).
+    pub fn partial(&self, var: usize) -> Expr {
+        let name = NAMED[var];
+        let derivative = match self.flat.var_names().iter().position(|v| v == name) {
+            // exmex differentiates every operator a scene may use but abs, which the branch
+            // form has removed; a failure here is a bug.
+            Some(i) => (*self.flat)
+                .clone()
+                .partial(i)
+                .expect("exmex differentiates the branch form"),
+            None => FlatEx::<f64>::parse("0").expect("0 parses"),
+        };
+        let slots = slots_of(&derivative, self.signs.len()).expect("a derivative reads no new variable");
+        Expr {
+            text: format!("d/d{name} ({})", self.text),
+            flat: Box::new(derivative),
+            slots,
+            signs: self.signs.clone(),
+        }
+    }
+
+    /// The sum of `terms`, each a coefficient times an expression (all sharing their
+    /// sign variables' arguments only if they come from the same source).
+    pub fn combine(terms: &[(f64, &Expr)]) -> Expr {
+        // Each term's sign variables are renumbered after the previous terms'.
+        let mut text = String::new();
+        let mut signs = Vec::new();
+        for (c, e) in terms {
+            let mut body = e.flat.unparse().to_string();
+            for k in (0..e.signs.len()).rev() {
+                body = body.replace(&format!("{{s{k}}}"), &format!("{{s{}}}", signs.len() + k));
+            }
+            signs.extend(e.signs.iter().cloned());
+            if !text.is_empty() {
+                text.push('+');
+            }
+            text.push_str(&format!("({c:e})*({body})"));
+        }
+        if text.is_empty() {
+            text.push('0');
+        }
+        let flat = FlatEx::<f64>::parse(&text).expect("a combination of parsed expressions parses");
+        let slots = slots_of(&flat, signs.len()).expect("no new variable");
+        let source: Vec<String> = terms.iter().map(|(c, e)| format!("{c:e}*({})", e.text)).collect();
+        Expr {
+            text: source.join(" + "),
+            flat: Box::new(flat),
+            slots,
+            signs,
+        }
+    }
+}
+
+/// For each variable of `flat`, the input it reads; Err(name) for an unknown one.
+fn slots_of(flat: &FlatEx<f64>, n_signs: usize) -> std::result::Result<Vec<usize>, String> {
+    flat.var_names()
+        .iter()
+        .map(|v| {
+            if let Some(i) = NAMED.iter().position(|n| n == v) {
+                return Ok(i);
+            }
+            match v.strip_prefix('s').and_then(|k| k.parse::<usize>().ok()) {
+                Some(k) if k < n_signs && 4 + k < 16 => Ok(4 + k),
+                _ => Err(v.clone()),
+            }
+        })
+        .collect()
+}
+
+/// Rewrite every `abs(z)` of `text` as `({s_k}*(z))`; returns the new text and the z_k.
+/// Nested calls keep their inner `abs` inside z_k (evaluated natively).
+fn branch_form(text: &str) -> std::result::Result<(String, Vec<String>), String> {
+    let mut out = String::new();
+    let mut arguments = Vec::new();
+    let mut rest = text;
+    while let Some(i) = rest.find("abs(") {
+        // `abs(` must start a name: not part of a longer identifier such as `fabs(`.
+        let starts_name = rest[..i]
+            .chars()
+            .last()
+            .is_none_or(|c| !(c.is_alphanumeric() || c == '_'));
+        if !starts_name {
+            out.push_str(&rest[..i + 4]);
+            rest = &rest[i + 4..];
+            continue;
+        }
+        out.push_str(&rest[..i]);
+        let after = &rest[i + 4..];
+        let mut depth = 1;
+        let close = after
+            .char_indices()
+            .find(|&(_, c)| {
+                match c {
+                    '(' => depth += 1,
+                    ')' => depth -= 1,
+                    _ => {}
+                }
+                depth == 0
+            })
+            .map(|(j, _)| j)
+            .ok_or("an abs( is not closed")?;
+        if arguments.len() >= 12 {
+            return Err("more than 12 abs calls".into());
+        }
+        out.push_str(&format!("({{s{}}}*({}))", arguments.len(), &after[..close]));
+        arguments.push(after[..close].to_string());
+        rest = &after[close + 1..];
+    }
+    out.push_str(rest);
+    Ok((out, arguments))
+}
+
+/// A vector field given by two expressions.
+#[derive(Debug, Clone)]
+pub struct VectorExpr(pub [Expr; 2]);
+
+impl VectorExpr {
+    /// Parse both components; errors name `field[0]` or `field[1]`.
+    pub fn parse(e: &[String; 2], file: &Path, field: &str) -> Result<Self> {
+        Ok(VectorExpr([
+            Expr::parse(&e[0], file, &format!("{field}[0]"))?,
+            Expr::parse(&e[1], file, &format!("{field}[1]"))?,
+        ]))
+    }
+    /// Evaluate both components; error naming the scene, field and expression if not finite.
+    pub fn eval(&self, x: f64, y: f64, t: f64, file: &Path, field: &str) -> Result<[f64; 2]> {
+        let v = [self.0[0].eval(x, y, t), self.0[1].eval(x, y, t)];
+        for (c, val) in v.iter().enumerate() {
+            if !val.is_finite() {
+                return Err(Error::input(
+                    file,
+                    format!("{field}[{c}]"),
+                    format!(
+                        "expression '{}' is not finite at x = {x}, y = {y}, t = {t}; fix the expression",
+                        self.0[c].text
+                    ),
+                ));
+            }
+        }
+        Ok(v)
+    }
+}
