@@ -1,7 +1,7 @@
 //! A case: one scene on one mesh level with one cone, built from files through gmsh.
 
 use crate::contact::{Interface, Method};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::fe::Model;
 use crate::mesh::{gmsh, msh};
 use crate::scene::Scene;
@@ -105,6 +105,7 @@ impl Case {
         let interface = Interface::new(&model, &raw)?;
         let h = model.h();
         let warnings = support_warnings(&model, &interface, &raw)?;
+        verify_exact(&model, &interface, &raw)?;
         let problem = Problem::new(model, interface, method);
         Ok(Case {
             problem,
@@ -202,4 +203,135 @@ pub fn peak_rss_gib() -> Option<f64> {
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kb / (1024.0 * 1024.0))
+}
+
+/// Refuse an exact solution that is not a solution of the contact problem, before anything
+/// is solved: at 401 points of every piece of Gamma_C and at t = T/4, T/2, 3T/4, T, no
+/// tangential traction on either side, equal normal tractions, pressure >= 0, gap >= 0,
+/// pressure x gap = 0 (each to round-off, 1e-9 of the field's scale), a given pressure equal
+/// to -sigma_nn; and u = 0 on the clamps, u_c = 0 with no tangential traction on the rollers
+/// (at the ends and middle of their edges).
+pub fn verify_exact(model: &Model, interface: &Interface, raw: &crate::mesh::RawMesh) -> Result<()> {
+    use crate::analytical::traction;
+    let sc = &model.scene;
+    let Some(ex) = sc.exact.as_deref() else {
+        return Ok(());
+    };
+    const TOL: f64 = 1e-9;
+    let times: Vec<f64> = (1..=4).map(|k| sc.final_time * k as f64 / 4.0).collect();
+    // Points of Gamma_C with the slave's normal and the tangent.
+    let mut on_contact = Vec::new();
+    for p in &interface.pieces {
+        for k in 0..=400 {
+            let s = p.length * k as f64 / 400.0;
+            let x = [p.a[0] + s * p.tangent[0], p.a[1] + s * p.tangent[1]];
+            on_contact.push((x, p.normal, p.tangent));
+        }
+    }
+    // Points of the clamps and rollers, with their body and held components.
+    let mut supports: Vec<([f64; 2], usize, Vec<usize>, &str)> = Vec::new();
+    let held: Vec<(&str, Vec<usize>)> = sc
+        .clamps
+        .iter()
+        .map(|c| (c.as_str(), vec![0, 1]))
+        .chain(sc.rollers.iter().map(|r| (r.curve.as_str(), vec![r.component])))
+        .collect();
+    for (curve, components) in &held {
+        for b in 0..2 {
+            for e in model.meshes[b].curve_edges(raw, curve) {
+                let (pa, pb) = (model.meshes[b].nodes[e[0]], model.meshes[b].nodes[e[1]]);
+                for w in [0.0, 0.5, 1.0] {
+                    let x = [pa[0] + w * (pb[0] - pa[0]), pa[1] + w * (pb[1] - pa[1])];
+                    supports.push((x, b, components.clone(), curve));
+                }
+            }
+        }
+    }
+    // Scales: the largest stress component and displacement over these points and times.
+    let (mut s_scale, mut u_scale) = (f64::MIN_POSITIVE, f64::MIN_POSITIVE);
+    for &t in &times {
+        let points = on_contact.iter().map(|c| c.0).chain(supports.iter().map(|s| s.0));
+        for x in points {
+            for b in 0..2 {
+                if let Some(s) = ex.stress_at(b, x[0], x[1], t) {
+                    s_scale = s.iter().fold(s_scale, |m, v| m.max(v.abs()));
+                }
+                if let Some(u) = ex.displacement_at(b, x[0], x[1], t) {
+                    u_scale = u.iter().fold(u_scale, |m, v| m.max(v.abs()));
+                }
+            }
+            if let Some(p) = ex.pressure.as_ref() {
+                s_scale = s_scale.max(p.eval(x[0], x[1], t).abs());
+            }
+        }
+    }
+    let refuse = |what: String, x: [f64; 2], t: f64| {
+        Err(Error::input(
+            &sc.file,
+            "exact",
+            format!(
+                "the exact solution is not a solution of the contact problem: {what} at (x, y) = ({:.6}, {:.6}), t = {t}; fix the [exact] fields",
+                x[0], x[1]
+            ),
+        ))
+    };
+    let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
+    for &t in &times {
+        for &(x, n, tau) in &on_contact {
+            let (s1, s2) = (ex.stress_at(0, x[0], x[1], t), ex.stress_at(1, x[0], x[1], t));
+            let u = (ex.displacement_at(0, x[0], x[1], t), ex.displacement_at(1, x[0], x[1], t));
+            let mut pressure = ex.pressure.as_ref().map(|p| p.eval(x[0], x[1], t));
+            if let (Some(s1), Some(s2)) = (s1, s2) {
+                let (t1, t2) = (traction(s1, n), traction(s2, [-n[0], -n[1]]));
+                for (side, tr) in [("slave", t1), ("master", t2)] {
+                    if dot(tr, tau).abs() > TOL * s_scale {
+                        return refuse(format!("tangential traction on the {side} side {:.3e} (should be 0)", dot(tr, tau)), x, t);
+                    }
+                }
+                let (nn1, nn2) = (dot(t1, n), -dot(t2, n));
+                if (nn1 - nn2).abs() > TOL * s_scale {
+                    return refuse(format!("normal tractions differ: sigma_nn {nn1:.6e} on the slave side, {nn2:.6e} on the master side"), x, t);
+                }
+                if let Some(p) = pressure {
+                    if (p + nn1).abs() > TOL * s_scale {
+                        return refuse(format!("exact.pressure {p:.6e} is not -sigma_nn = {:.6e}", -nn1), x, t);
+                    }
+                }
+                pressure = Some(-nn1);
+            }
+            if let Some(p) = pressure {
+                if p < -TOL * s_scale {
+                    return refuse(format!("pressure {p:.3e} < 0 (the bodies pull on each other)"), x, t);
+                }
+            }
+            if let (Some(u1), Some(u2)) = u {
+                let gap = -dot([u1[0] - u2[0], u1[1] - u2[1]], n);
+                if gap < -TOL * u_scale {
+                    return refuse(format!("gap {gap:.3e} < 0 (the bodies interpenetrate)"), x, t);
+                }
+                if let Some(p) = pressure {
+                    if (p * gap).abs() > TOL * s_scale * u_scale {
+                        return refuse(format!("pressure x gap = {:.3e} != 0 (pressure {p:.6e}, gap {gap:.6e})", p * gap), x, t);
+                    }
+                }
+            }
+        }
+        for (x, b, components, curve) in &supports {
+            if let Some(u) = ex.displacement_at(*b, x[0], x[1], t) {
+                for &c in components {
+                    if u[c].abs() > TOL * u_scale {
+                        return refuse(format!("u_{} = {:.6e} on '{curve}', which holds it at 0", ["x", "y"][c], u[c]), *x, t);
+                    }
+                }
+            }
+            if components.len() == 1 {
+                if let Some(s) = ex.stress_at(*b, x[0], x[1], t) {
+                    if s[2].abs() > TOL * s_scale {
+                        return refuse(format!("tangential traction sigma_12 = {:.3e} on the roller '{curve}' (should be 0)", s[2]), *x, t);
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
 }

@@ -11,7 +11,8 @@ use contact_rates::study::{self, file::StudyFile, jobs::Mode, quantity::Quantity
 fn quick_rates_study_meets_the_theorem_thresholds() {
     contact_rates::init();
     let res = study::run("rates-quick").unwrap();
-    let (ref_err, p) = (res.reference.error, res.reference.error_rate);
+    let reference = res.reference.expect("a reference solve");
+    let (ref_err, p) = (reference.error, reference.error_rate);
     println!("reference error estimate {ref_err:.3e} (fitted p = {p:.2})");
     for r in res.rates.iter().filter(|r| r.quantity == Quantity::Theorem) {
         println!(

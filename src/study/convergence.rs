@@ -13,16 +13,19 @@
 //! 6. the provenance.
 
 use super::error::{self, Comparison, SquaredNorms};
+use super::exact_error::{ExactComparison, ExactDifference, exact_profiles, max_exact_displacement};
 use super::file::{StudyFile, Threshold};
 use super::jobs::{self, Job, JobId, Mode, Progress, Solved};
 use super::quantity::{Differences, Quantity};
 use super::rates::{self, Fit};
+use crate::analytical::{Exact, Field};
 use crate::case::Case;
 use crate::contact::Method;
 use crate::error::{Error, Result};
 use crate::metrics;
 use crate::scene::Scene;
 use crate::solve::{Settings, Solution, inf_norm};
+use rayon::prelude::*;
 use serde::{Serialize, Serializer};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -115,6 +118,8 @@ pub enum Source {
     Cone(Method),
     /// The reference.
     Reference,
+    /// The scene's exact solution.
+    Exact,
 }
 
 impl Source {
@@ -123,6 +128,7 @@ impl Source {
         match self {
             Source::Cone(m) => m.name(),
             Source::Reference => "reference",
+            Source::Exact => "exact",
         }
     }
 }
@@ -219,8 +225,11 @@ pub struct StudyResult {
     pub rates: Vec<RateRow>,
     /// Per-level facts.
     pub levels: Vec<LevelInfo>,
-    /// The reference.
-    pub reference: Reference,
+    /// The reference solve (None: measured against the scene's exact solution).
+    pub reference: Option<Reference>,
+    /// Gauss points per direction of the rule integrating errors against the exact
+    /// solution (None: measured against a reference solve).
+    pub exact_quadrature: Option<usize>,
     /// Pressure profiles at T on the profile level (and the reference's).
     pub pressure: Vec<ProfilePoint>,
     /// Gap profiles at T on the profile level (and the reference's).
@@ -292,6 +301,9 @@ impl Study {
         } else {
             Scene::load(&file.scene)?
         };
+        if file.reference.exact {
+            check_covered(&file, &scene, &path)?;
+        }
         Ok(Study {
             name: path.file_stem().unwrap().to_string_lossy().to_string(),
             path,
@@ -307,11 +319,52 @@ impl Study {
     }
 }
 
+/// What the exact solution must give for quantity `q`.
+fn needs(q: Quantity) -> &'static [Field] {
+    match q {
+        Quantity::Theorem => &[Field::Displacement, Field::Stress],
+        Quantity::H1U | Quantity::L2U | Quantity::MaxPenetration => &[Field::Displacement],
+        Quantity::L2Stress => &[Field::Stress],
+        Quantity::L2Pressure => &[Field::Pressure],
+    }
+}
+
+/// Every quantity of an exact study must be covered by the scene's exact solution.
+fn check_covered(file: &StudyFile, scene: &Scene, path: &Path) -> Result<()> {
+    let Some(exact) = scene.exact.as_deref() else {
+        return Err(Error::input(
+            path,
+            "reference.exact",
+            format!(
+                "scene '{}' gives no exact solution; add an [exact] table to {} or measure against a reference solve (reference.exact = false)",
+                scene.name,
+                scene.file.display()
+            ),
+        ));
+    };
+    for &q in &file.quantities {
+        if let Some(f) = needs(q).iter().find(|f| !exact.gives(**f)) {
+            return Err(Error::input(
+                path,
+                "quantities",
+                format!(
+                    "quantity '{q}' needs the exact solution's {} (`{}` in the scene's [exact] table), which scene '{}' does not give; add it there or remove '{q}'",
+                    &f.key()["exact.".len()..],
+                    f.key(),
+                    scene.name
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The study's solves, with a named handle for each.
 struct Plan {
     jobs: Vec<Job>,
-    /// The reference levels, coarsest first (the finest is the reference).
-    reference: [JobId; 3],
+    /// The reference levels, coarsest first (the finest is the reference); none when the
+    /// study measures against the exact solution.
+    reference: Option<[JobId; 3]>,
     /// Every cone on every study level, cone by cone.
     levels: Vec<(Method, usize, JobId)>,
     /// The time study: its reference, then one run per step count.
@@ -343,14 +396,10 @@ impl Plan {
             jobs.len() - 1
         };
         let r = study.reference_level();
-        let reference = [r - 2, r - 1, r].map(|l| {
-            add(
-                format!("reference level {l}"),
-                Method::Mortar,
-                l,
-                &reference_parameters,
-                sf.steps,
-            )
+        let reference = (!sf.reference.exact).then(|| {
+            [r - 2, r - 1, r].map(|l| {
+                add(format!("reference level {l}"), Method::Mortar, l, &reference_parameters, sf.steps)
+            })
         });
         let mut levels = Vec::new();
         for &method in &sf.methods {
@@ -392,19 +441,16 @@ impl Plan {
                 .collect();
             (reference, runs)
         });
-        let coarsest = &jobs[reference[0]];
-        let case = Case::build(
-            &study.scene,
-            coarsest.level,
-            coarsest.method,
-            &coarsest.params,
-        )?;
-        if case.problem.interface.min_relative_separation() > 1e-9 {
-            return Err(Error::input(
-                &study.path,
-                "reference.parameters",
-                "the reference meshes do not match on Gamma_C; set the .geo parameter that makes them match (e.g. matching = 1)",
-            ));
+        if let Some(reference) = reference {
+            let coarsest = &jobs[reference[0]];
+            let case = Case::build(&study.scene, coarsest.level, coarsest.method, &coarsest.params)?;
+            if case.problem.interface.min_relative_separation() > 1e-9 {
+                return Err(Error::input(
+                    &study.path,
+                    "reference.parameters",
+                    "the reference meshes do not match on Gamma_C; set the .geo parameter that makes them match (e.g. matching = 1)",
+                ));
+            }
         }
         Ok(Plan {
             jobs,
@@ -430,8 +476,8 @@ struct ReferenceSolution {
 /// conforming spaces, so their errors are close to orthogonal: d(L, R)^2 = e_L^2 - e_R^2 with
 /// e_L = C h_L^p (measured on the rates scene: d(R-2,R)/d(R-1,R) = 2.24 = sqrt(5), i.e.
 /// p = 1). Hence (d(R-2,R)/d(R-1,R))^2 = 4^p + 1 and e_R = d(R-1,R) / sqrt(4^p - 1).
-fn reference(plan: &Plan, solved: &mut Solved, level: usize) -> ReferenceSolution {
-    let [coarser2, coarser1, finest] = plan.reference.map(|id| solved.take(id));
+fn reference(ids: [JobId; 3], solved: &mut Solved, level: usize) -> ReferenceSolution {
+    let [coarser2, coarser1, finest] = ids.map(|id| solved.take(id));
     let (case, solution) = finest;
     let d1 = super::theorem_distance(&coarser1.0, &coarser1.1, &case, &solution);
     let d2 = super::theorem_distance(&coarser2.0, &coarser2.1, &case, &solution);
@@ -468,6 +514,32 @@ fn reference(plan: &Plan, solved: &mut Solved, level: usize) -> ReferenceSolutio
     }
 }
 
+/// What the levels are measured against.
+enum Truth<'s> {
+    /// A fine reference solve on matching meshes.
+    Solved(ReferenceSolution),
+    /// The scene's exact solution, with the Gauss points per direction of the rule.
+    Exact(&'s Exact, usize),
+}
+
+impl Truth<'_> {
+    /// Every quantity's relative error of one solved level.
+    fn relative_errors(&self, case: &Case, sol: &Solution) -> BTreeMap<Quantity, f64> {
+        match self {
+            Truth::Solved(reference) => relative_errors(case, sol, reference),
+            Truth::Exact(exact, points) => exact_errors(case, sol, exact, *points),
+        }
+    }
+
+    /// The estimated error of the truth (0 for the exact solution).
+    fn error(&self) -> f64 {
+        match self {
+            Truth::Solved(r) => r.facts.error,
+            Truth::Exact(..) => 0.0,
+        }
+    }
+}
+
 /// What step 3 measured.
 #[derive(Default)]
 struct Measured {
@@ -476,24 +548,58 @@ struct Measured {
     pressure: Vec<ProfilePoint>,
     gap: Vec<ProfilePoint>,
     deformed: Vec<DeformedMesh>,
+    /// The mesh provenance and scene warnings of the first level.
+    mesh: Option<crate::mesh::gmsh::GeneratedMesh>,
+    warnings: Vec<String>,
 }
 
-/// Step 3: every level of every cone against the reference; profiles and deformed meshes
+/// Step 3: every level of every cone against the truth (levels in parallel: each is
+/// measured on its own, so the numbers equal a serial run's); profiles and deformed meshes
 /// on `profile_level`.
 fn measure_levels(
     sf: &StudyFile,
     plan: &Plan,
     solved: &mut Solved,
-    reference: &ReferenceSolution,
+    truth: &Truth,
     profile_level: usize,
 ) -> Result<Measured> {
-    let (rcase, rsol) = (&reference.case, &reference.solution);
+    let runs: Vec<(Method, usize, Case, Solution)> = plan
+        .levels
+        .iter()
+        .map(|&(method, level, id)| {
+            let (case, sol) = solved.take(id);
+            (method, level, case, sol)
+        })
+        .collect();
+    let all_errors: Vec<BTreeMap<Quantity, f64>> = runs
+        .par_iter()
+        .map(|(_, _, case, sol)| truth.relative_errors(case, sol))
+        .collect();
     let mut out = Measured::default();
-    profiles(rcase, rsol, Source::Reference, &mut out);
-    let magnification = 0.1 / inf_norm(&rsol.last().u).max(f64::MIN_POSITIVE);
-    for &(method, level, id) in &plan.levels {
-        let (case, sol) = solved.take(id);
-        let errors = relative_errors(&case, &sol, reference);
+    if let Some((_, _, case, _)) = runs.first() {
+        out.mesh = Some(case.mesh.clone());
+        out.warnings = case.warnings.clone();
+    }
+    let magnification = match truth {
+        Truth::Solved(reference) => {
+            profiles(&reference.case, &reference.solution, Source::Reference, &mut out);
+            0.1 / inf_norm(&reference.solution.last().u).max(f64::MIN_POSITIVE)
+        }
+        Truth::Exact(exact, _) => {
+            let (_, _, case, sol) = runs
+                .iter()
+                .find(|r| r.1 == profile_level)
+                .expect("the profile level is a study level");
+            exact_profile_points(case, exact, sol.last().time, &mut out);
+            let umax = match exact.displacement {
+                Some(_) => max_exact_displacement(&case.problem.model, exact, sol.last().time),
+                None => inf_norm(&sol.last().u),
+            };
+            0.1 / umax.max(f64::MIN_POSITIVE)
+        }
+    };
+    for ((method, level, case, sol), errors) in runs.iter().zip(&all_errors) {
+        let (method, level) = (*method, *level);
         for &quantity in &sf.quantities {
             let error = errors[&quantity];
             if !error.is_finite() {
@@ -512,19 +618,63 @@ fn measure_levels(
                 wall_s: sol.wall_s,
             });
         }
-        out.levels.push(level_info(
-            &case,
-            &sol,
-            method,
-            errors[&Quantity::Theorem] < 5.0 * reference.facts.error,
-        ));
+        let flagged = errors[&Quantity::Theorem] < 5.0 * truth.error();
+        out.levels.push(level_info(case, sol, method, flagged));
         if level == profile_level {
-            profiles(&case, &sol, Source::Cone(method), &mut out);
-            out.deformed
-                .push(deformed(&case, &sol, method, magnification));
+            profiles(case, sol, Source::Cone(method), &mut out);
+            out.deformed.push(deformed(case, sol, method, magnification));
         }
     }
     Ok(out)
+}
+
+/// Every quantity's relative error of one solved level against the exact solution.
+fn exact_errors(case: &Case, sol: &Solution, exact: &Exact, points: usize) -> BTreeMap<Quantity, f64> {
+    let cmp = ExactComparison::new(exact, points);
+    let diffs: Vec<ExactDifference> = sol
+        .states
+        .iter()
+        .skip(1)
+        .map(|s| cmp.difference(&case.problem, s))
+        .collect();
+    let fields: Vec<SquaredNorms> = diffs.iter().map(|d| d.difference).collect();
+    let reference: Vec<SquaredNorms> = diffs.iter().map(|d| d.exact).collect();
+    let pressure: Vec<(f64, f64)> = diffs.iter().map(|d| d.pressure).collect();
+    let penetration = sol
+        .states
+        .iter()
+        .map(|s| metrics::max_penetration(&case.problem, s))
+        .fold(0.0f64, f64::max);
+    Differences {
+        fields: &fields,
+        reference: &reference,
+        pressure: &pressure,
+        penetration,
+        reference_displacement: diffs.iter().map(|d| d.max_displacement).fold(0.0, f64::max),
+    }
+    .relative()
+}
+
+/// The exact pressure and gap along Gamma_C at time `t`, where the solution gives them.
+fn exact_profile_points(case: &Case, exact: &Exact, t: f64, out: &mut Measured) {
+    for (x, pressure, gap) in exact_profiles(&case.problem, exact, t) {
+        if pressure.is_finite() {
+            out.pressure.push(ProfilePoint {
+                label: Source::Exact,
+                x: x[0],
+                y: x[1],
+                value: pressure,
+            });
+        }
+        if gap.is_finite() {
+            out.gap.push(ProfilePoint {
+                label: Source::Exact,
+                x: x[0],
+                y: x[1],
+                value: gap,
+            });
+        }
+    }
 }
 
 /// Every quantity's relative error of one solved level against the reference.
@@ -651,7 +801,7 @@ fn fit_rates(sf: &StudyFile, measured: &Measured) -> Vec<RateRow> {
             let errors = column(&used, |r| r.error);
             let fit = rates::fit(&column(&used, |r| r.h), &errors);
             let fit_dofs = rates::fit(&column(&used, |r| r.dofs as f64), &errors);
-            let threshold = (quantity == Quantity::Theorem).then_some(threshold);
+            let threshold = (quantity == sf.thresholds.quantity).then_some(threshold);
             let pass = threshold.map(|t| match t {
                 Threshold::Exact(bound) => {
                     column(&rows, |r| r.error)
@@ -712,14 +862,14 @@ fn time_study(sf: &StudyFile, plan: &Plan, solved: &mut Solved) -> Option<TimeSt
 }
 
 /// Step 6: where the numbers come from.
-fn provenance(study: &Study, reference: &Case) -> BTreeMap<String, String> {
+fn provenance(study: &Study, mesh: &crate::mesh::gmsh::GeneratedMesh) -> BTreeMap<String, String> {
     let geo = study.scene.geo.file_name().unwrap().to_string_lossy();
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     BTreeMap::from([
-        ("gmsh".into(), reference.mesh.gmsh_version.clone()),
+        ("gmsh".into(), mesh.gmsh_version.clone()),
         (
             "geo".into(),
-            format!("{geo} (sha256 {})", reference.mesh.geo_hash),
+            format!("{geo} (sha256 {})", mesh.geo_hash),
         ),
         (
             "solver".into(),
@@ -766,12 +916,22 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
         return Ok(None);
     }
     let mut solved = Solved::complete(outputs).expect("every job ran or was loaded");
-    let reference = reference(&plan, &mut solved, study.reference_level());
+    let truth = match plan.reference {
+        Some(ids) => Truth::Solved(reference(ids, &mut solved, study.reference_level())),
+        None => Truth::Exact(
+            study.scene.exact.as_deref().expect("checked when the study was read"),
+            sf.reference.quadrature,
+        ),
+    };
     let profile_level = sf.mesh.levels[sf.mesh.levels.len() / 2];
-    let measured = measure_levels(sf, &plan, &mut solved, &reference, profile_level)?;
+    let measured = measure_levels(sf, &plan, &mut solved, &truth, profile_level)?;
     let rates = fit_rates(sf, &measured);
     let time_study = time_study(sf, &plan, &mut solved);
-    let provenance = provenance(&study, &reference.case);
+    let (reference, exact_quadrature, mesh, warnings) = match &truth {
+        Truth::Solved(r) => (Some(r.facts), None, r.case.mesh.clone(), r.case.warnings.clone()),
+        Truth::Exact(_, points) => (None, Some(*points), measured.mesh.clone().expect("at least one level"), measured.warnings.clone()),
+    };
+    let provenance = provenance(&study, &mesh);
     Ok(Some(StudyResult {
         name: study.name,
         description: sf.description.clone(),
@@ -779,7 +939,8 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
         errors: measured.errors,
         rates,
         levels: measured.levels,
-        reference: reference.facts,
+        reference,
+        exact_quadrature,
         pressure: measured.pressure,
         gap: measured.gap,
         profile_level,
@@ -787,7 +948,7 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
         time_study,
         provenance,
         wall_s: t0.elapsed().as_secs_f64(),
-        warnings: reference.case.warnings.clone(),
+        warnings,
         file: study.file,
     }))
 }

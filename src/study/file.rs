@@ -31,11 +31,19 @@ pub struct MeshSpec {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReferenceSpec {
-    /// Reference level minus the finest study level (at least 2).
+    /// Reference level minus the finest study level (at least 2; not with `exact`).
+    #[serde(default)]
     pub levels_above: usize,
     /// gmsh parameter overrides that make the meshes match on Gamma_C.
     #[serde(default)]
     pub parameters: BTreeMap<String, f64>,
+    /// Measure against the scene's exact solution instead of a reference solve.
+    #[serde(default)]
+    pub exact: bool,
+    /// Gauss points per direction of the rule that integrates errors against the exact
+    /// solution (n x n per triangle, exact to degree 2n - 2).
+    #[serde(default = "default_quadrature")]
+    pub quadrature: usize,
 }
 
 /// Rate thresholds of Theorem 3.1 for the `theorem` quantity.
@@ -52,13 +60,24 @@ pub struct ThresholdSpec {
     /// their `theorem` error must stay below `exact_tolerance` instead of meeting a rate.
     #[serde(default)]
     pub exact: Vec<Method>,
-    /// Largest relative `theorem` error allowed for the `exact` methods.
+    /// Largest relative error allowed for the `exact` methods.
     #[serde(default = "default_exact_tolerance")]
     pub exact_tolerance: f64,
+    /// The quantity the thresholds apply to (default `theorem`, Theorem 3.1's norm).
+    #[serde(default = "default_threshold_quantity")]
+    pub quantity: Quantity,
 }
 
 fn default_exact_tolerance() -> f64 {
     1e-9
+}
+
+fn default_quadrature() -> usize {
+    super::exact_error::DEFAULT_POINTS
+}
+
+fn default_threshold_quantity() -> Quantity {
+    Quantity::Theorem
 }
 
 /// What a method's `theorem` error must satisfy.
@@ -186,10 +205,13 @@ impl StudyFile {
         if s.methods.is_empty() {
             return bad("methods", "list at least one method".into());
         }
-        if !s.quantities.contains(&Quantity::Theorem) {
+        if !s.quantities.contains(&s.thresholds.quantity) {
             return bad(
                 "quantities",
-                "the thresholds apply to 'theorem': include it".into(),
+                format!(
+                    "the thresholds apply to '{}': include it",
+                    s.thresholds.quantity
+                ),
             );
         }
         if s.steps == 0 {
@@ -235,10 +257,22 @@ impl StudyFile {
                 }
             }
         }
-        if s.reference.levels_above < 2 {
+        if !s.reference.exact && s.reference.levels_above < 2 {
             return bad(
                 "reference.levels_above",
                 "the reference must be at least 2 levels finer than the finest study level".into(),
+            );
+        }
+        if s.reference.exact && (s.reference.levels_above != 0 || !s.reference.parameters.is_empty()) {
+            return bad(
+                "reference",
+                "an exact reference is not solved: remove levels_above and parameters".into(),
+            );
+        }
+        if !(1..=32).contains(&s.reference.quadrature) {
+            return bad(
+                "reference.quadrature",
+                format!("give 1 to 32 Gauss points per direction, got {}", s.reference.quadrature),
             );
         }
         let t = &s.thresholds;

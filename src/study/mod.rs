@@ -11,6 +11,7 @@
 
 pub mod convergence;
 pub mod error;
+pub mod exact_error;
 pub mod file;
 pub mod intersect;
 pub mod jobs;

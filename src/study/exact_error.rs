@@ -1,0 +1,152 @@
+//! Errors of a study solution against a scene's exact solution, integrated on the study's
+//! own mesh by a collapsed Gauss rule per triangle (n x n points, exact to degree 2n - 2)
+//! and Gauss-Legendre on Gamma_C's segments: the exact fields are not polynomials, so the
+//! rule is chosen with its own error far below the errors measured (a test doubles it).
+
+use super::error::{SquaredNorms, pressure_profile};
+use crate::analytical::Exact;
+use crate::fe::Model;
+use crate::quadrature;
+use crate::solve::{Problem, State};
+
+/// Gauss points per direction of the default rule (16 points per triangle, degree 6).
+pub const DEFAULT_POINTS: usize = 4;
+
+/// An exact solution with the quadrature that measures against it.
+pub struct ExactComparison<'a> {
+    exact: &'a Exact,
+    triangle: Vec<(f64, f64, f64)>,
+    segment: Vec<(f64, f64)>,
+}
+
+/// What one state measured against the exact solution at its time.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ExactDifference {
+    /// Squared norms of (solution - exact).
+    pub difference: SquaredNorms,
+    /// Squared norms of the exact solution.
+    pub exact: SquaredNorms,
+    /// (||p_h - p||^2, ||p||^2) on Gamma_C.
+    pub pressure: (f64, f64),
+    /// Largest |u| component of the exact solution at the mesh's nodes.
+    pub max_displacement: f64,
+}
+
+fn tensor_norm2(s: [f64; 3]) -> f64 {
+    s[0] * s[0] + s[1] * s[1] + 2.0 * s[2] * s[2]
+}
+
+impl<'a> ExactComparison<'a> {
+    /// Measure against `exact` with `points` Gauss points per direction on triangles (and
+    /// 2 `points` on segments).
+    pub fn new(exact: &'a Exact, points: usize) -> Self {
+        ExactComparison {
+            exact,
+            triangle: quadrature::triangle(points),
+            segment: quadrature::gauss_legendre(2 * points),
+        }
+    }
+
+    /// Everything one state measures against the exact solution at the state's time.
+    pub fn difference(&self, p: &Problem, s: &State) -> ExactDifference {
+        let (m, ex, t) = (&p.model, self.exact, s.time);
+        let mut out = ExactDifference {
+            pressure: self.pressure_difference(p, s),
+            ..Default::default()
+        };
+        for (i, el) in m.elements.iter().enumerate() {
+            let b = el.body;
+            let pos = el.nodes.map(|n| m.position(n));
+            let uh = el.nodes.map(|n| [s.u[2 * n], s.u[2 * n + 1]]);
+            let mut grad_h = [[0.0; 2]; 2];
+            for a in 0..3 {
+                for c in 0..2 {
+                    for d in 0..2 {
+                        grad_h[c][d] += uh[a][c] * el.grads[a][d];
+                    }
+                }
+            }
+            let sh = [s.sigma[i][0], s.sigma[i][1], s.sigma[i][2]];
+            for &(l1, l2, w) in &self.triangle {
+                let lam = [1.0 - l1 - l2, l1, l2];
+                let x = [0, 1].map(|c| (0..3).map(|a| lam[a] * pos[a][c]).sum::<f64>());
+                let w = w * el.area;
+                if let (Some(u), Some(g)) = (&ex.displacement, &ex.gradient) {
+                    for c in 0..2 {
+                        let ue = u[b][c].eval(x[0], x[1], t);
+                        let uhc: f64 = (0..3).map(|a| lam[a] * uh[a][c]).sum();
+                        out.difference.l2_u += w * (uhc - ue).powi(2);
+                        out.exact.l2_u += w * ue * ue;
+                        for d in 0..2 {
+                            let ge = g[b][c][d].eval(x[0], x[1], t);
+                            out.difference.semi_u += w * (grad_h[c][d] - ge).powi(2);
+                            out.exact.semi_u += w * ge * ge;
+                        }
+                    }
+                }
+                if let Some(se) = ex.stress_at(b, x[0], x[1], t) {
+                    out.difference.stress += w * tensor_norm2([0, 1, 2].map(|k| sh[k] - se[k]));
+                    out.exact.stress += w * tensor_norm2(se);
+                }
+            }
+        }
+        out.max_displacement = max_exact_displacement(m, ex, t);
+        out
+    }
+
+    /// (||p_h - p||^2, ||p||^2) in L2(Gamma_C), p_h linear between the slave nodes.
+    fn pressure_difference(&self, p: &Problem, s: &State) -> (f64, f64) {
+        let t = s.time;
+        let (mut diff, mut norm) = (0.0, 0.0);
+        for (piece, profile) in p.interface.pieces.iter().zip(pressure_profile(p, s)) {
+            for w in profile.windows(2) {
+                let ((xa, pa), (xb, pb)) = (w[0], w[1]);
+                let len = (xb[0] - xa[0]).hypot(xb[1] - xa[1]);
+                for &(q, wq) in &self.segment {
+                    let x = [xa[0] + q * (xb[0] - xa[0]), xa[1] + q * (xb[1] - xa[1])];
+                    let exact = self
+                        .exact
+                        .pressure_at(piece.normal, x[0], x[1], t)
+                        .unwrap_or(f64::NAN);
+                    let ph = pa + q * (pb - pa);
+                    diff += wq * len * (ph - exact).powi(2);
+                    norm += wq * len * exact * exact;
+                }
+            }
+        }
+        (diff, norm)
+    }
+}
+
+/// The exact pressure and gap along Gamma_C at time `t`, at 401 points per piece:
+/// (x, y, pressure, gap); a field the solution does not give is NaN.
+pub fn exact_profiles(p: &Problem, exact: &Exact, t: f64) -> Vec<([f64; 2], f64, f64)> {
+    let mut out = Vec::new();
+    for piece in &p.interface.pieces {
+        let n = piece.normal;
+        for k in 0..=400 {
+            let s = piece.length * k as f64 / 400.0;
+            let x = [piece.a[0] + s * piece.tangent[0], piece.a[1] + s * piece.tangent[1]];
+            let pressure = exact.pressure_at(n, x[0], x[1], t).unwrap_or(f64::NAN);
+            let gap = match (exact.displacement_at(0, x[0], x[1], t), exact.displacement_at(1, x[0], x[1], t)) {
+                (Some(u1), Some(u2)) => -((u1[0] - u2[0]) * n[0] + (u1[1] - u2[1]) * n[1]),
+                _ => f64::NAN,
+            };
+            out.push((x, pressure, gap));
+        }
+    }
+    out
+}
+
+/// Largest |u| component of the exact solution at the nodes of `m` at time `t`.
+pub fn max_exact_displacement(m: &Model, exact: &Exact, t: f64) -> f64 {
+    let mut out = 0.0f64;
+    for b in 0..2 {
+        for x in &m.meshes[b].nodes {
+            if let Some(u) = exact.displacement_at(b, x[0], x[1], t) {
+                out = out.max(u[0].abs()).max(u[1].abs());
+            }
+        }
+    }
+    out
+}
