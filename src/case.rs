@@ -247,18 +247,20 @@ pub fn verify_exact(model: &Model, interface: &Interface, raw: &crate::mesh::Raw
             }
         }
     }
-    // Scales: the largest stress component and displacement over these points and times.
+    // Scales: the largest stress component and displacement over these points and times,
+    // each point in its own body (both bodies on Gamma_C).
     let (mut s_scale, mut u_scale) = (f64::MIN_POSITIVE, f64::MIN_POSITIVE);
-    for &t in &times {
-        let points = on_contact.iter().map(|c| c.0).chain(supports.iter().map(|s| s.0));
-        for x in points {
-            for b in 0..2 {
-                if let Some(s) = ex.stress_at(b, x[0], x[1], t) {
-                    s_scale = s.iter().fold(s_scale, |m, v| m.max(v.abs()));
-                }
-                if let Some(u) = ex.displacement_at(b, x[0], x[1], t) {
-                    u_scale = u.iter().fold(u_scale, |m, v| m.max(v.abs()));
-                }
+    let points = on_contact
+        .iter()
+        .flat_map(|c| [(c.0, 0), (c.0, 1)])
+        .chain(supports.iter().map(|s| (s.0, s.1)));
+    for (x, b) in points {
+        for &t in &times {
+            if let Some(s) = ex.stress_at(b, x[0], x[1], t) {
+                s_scale = s.iter().fold(s_scale, |m, v| m.max(v.abs()));
+            }
+            if let Some(u) = ex.displacement_at(b, x[0], x[1], t) {
+                u_scale = u.iter().fold(u_scale, |m, v| m.max(v.abs()));
             }
             if let Some(p) = ex.pressure.as_ref() {
                 s_scale = s_scale.max(p.eval(x[0], x[1], t).abs());

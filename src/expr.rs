@@ -55,7 +55,7 @@ impl Expr {
 
     /// A number as an expression.
     pub fn constant(v: f64) -> Self {
-        Self::parse(&format!("{v:e}"), Path::new(""), "").expect("a number parses")
+        Self::parse(&format!("{v}"), Path::new(""), "").expect("a number parses")
     }
 
     /// Evaluate at (x, y, t). Non-finite values are returned as they are; callers check.
@@ -104,7 +104,7 @@ impl Expr {
         let mut text = String::new();
         let mut signs = Vec::new();
         for (c, e) in terms {
-            let mut body = e.flat.unparse().to_string();
+            let mut body = plain_numbers(&e.flat.unparse());
             for k in (0..e.signs.len()).rev() {
                 body = body.replace(&format!("{{s{k}}}"), &format!("{{s{}}}", signs.len() + k));
             }
@@ -112,14 +112,14 @@ impl Expr {
             if !text.is_empty() {
                 text.push('+');
             }
-            text.push_str(&format!("({c:e})*({body})"));
+            text.push_str(&format!("({c})*({body})"));
         }
         if text.is_empty() {
             text.push('0');
         }
         let flat = FlatEx::<f64>::parse(&text).expect("a combination of parsed expressions parses");
         let slots = slots_of(&flat, signs.len()).expect("no new variable");
-        let source: Vec<String> = terms.iter().map(|(c, e)| format!("{c:e}*({})", e.text)).collect();
+        let source: Vec<String> = terms.iter().map(|(c, e)| format!("{c}*({})", e.text)).collect();
         Expr {
             text: source.join(" + "),
             flat: Box::new(flat),
@@ -127,6 +127,47 @@ impl Expr {
             signs,
         }
     }
+}
+
+/// `text` with every number in exponent notation (as exmex unparses very small or large
+/// constants, e.g. `7.5e-19`) written out in full, which exmex's parser reads back.
+fn plain_numbers(text: &str) -> String {
+    let chars: Vec<char> = text.chars().collect();
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        let starts_number = c.is_ascii_digit()
+            && (i == 0 || !(chars[i - 1].is_alphanumeric() || chars[i - 1] == '_' || chars[i - 1] == '.'));
+        if !starts_number {
+            out.push(c);
+            i += 1;
+            continue;
+        }
+        let mut j = i;
+        while j < chars.len() && (chars[j].is_ascii_digit() || chars[j] == '.') {
+            j += 1;
+        }
+        if j < chars.len() && (chars[j] == 'e' || chars[j] == 'E') {
+            let mut k = j + 1;
+            if k < chars.len() && (chars[k] == '-' || chars[k] == '+') {
+                k += 1;
+            }
+            if k < chars.len() && chars[k].is_ascii_digit() {
+                while k < chars.len() && chars[k].is_ascii_digit() {
+                    k += 1;
+                }
+                let literal: String = chars[i..k].iter().collect();
+                let v: f64 = literal.parse().expect("a number literal");
+                out.push_str(&format!("{v}"));
+                i = k;
+                continue;
+            }
+        }
+        out.extend(&chars[i..j]);
+        i = j;
+    }
+    out
 }
 
 /// For each variable of `flat`, the input it reads; Err(name) for an unknown one.

@@ -37,7 +37,8 @@ pub fn plastic_fraction(p: &Problem, s: &State) -> f64 {
         .filter(|(e, sg)| m.materials[e.body].is_plastic(sg))
         .map(|(e, _)| e.area)
         .sum();
-    plastic / total
+    // + 0.0: an empty float sum is -0.0.
+    (plastic + 0.0) / total
 }
 
 /// Largest aspect ratio over all triangles: longest edge over the altitude onto it,

@@ -172,7 +172,7 @@ impl StackedBlocks {
     pub fn expressions(&self) -> [[String; 2]; 2] {
         let profile = |c: Profile| {
             format!(
-                "(({:e})+({:e})*y)*cosh(pi*y)+(({:e})+({:e})*y)*sinh(pi*y)",
+                "(({})+({})*y)*cosh(pi*y)+(({})+({})*y)*sinh(pi*y)",
                 c[0], c[1], c[2], c[3]
             )
         };
@@ -181,7 +181,7 @@ impl StackedBlocks {
             let (ux, uy) = self.displacement_profiles(b);
             [
                 format!("t*sin(pi*x)*({})", profile(ux)),
-                format!("t*(cos(pi*x)*({})-({squeeze:e})*y)", profile(uy)),
+                format!("t*(cos(pi*x)*({})-({squeeze})*y)", profile(uy)),
             ]
         })
     }
