@@ -211,7 +211,11 @@ pub fn peak_rss_gib() -> Option<f64> {
 /// pressure x gap = 0 (each to round-off, 1e-9 of the field's scale), a given pressure equal
 /// to -sigma_nn; and u = 0 on the clamps, u_c = 0 with no tangential traction on the rollers
 /// (at the ends and middle of their edges).
-pub fn verify_exact(model: &Model, interface: &Interface, raw: &crate::mesh::RawMesh) -> Result<()> {
+pub fn verify_exact(
+    model: &Model,
+    interface: &Interface,
+    raw: &crate::mesh::RawMesh,
+) -> Result<()> {
     use crate::analytical::traction;
     let sc = &model.scene;
     let Some(ex) = sc.exact.as_deref() else {
@@ -234,7 +238,11 @@ pub fn verify_exact(model: &Model, interface: &Interface, raw: &crate::mesh::Raw
         .clamps
         .iter()
         .map(|c| (c.as_str(), vec![0, 1]))
-        .chain(sc.rollers.iter().map(|r| (r.curve.as_str(), vec![r.component])))
+        .chain(
+            sc.rollers
+                .iter()
+                .map(|r| (r.curve.as_str(), vec![r.component])),
+        )
         .collect();
     for (curve, components) in &held {
         for b in 0..2 {
@@ -280,40 +288,78 @@ pub fn verify_exact(model: &Model, interface: &Interface, raw: &crate::mesh::Raw
     let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
     for &t in &times {
         for &(x, n, tau) in &on_contact {
-            let (s1, s2) = (ex.stress_at(0, x[0], x[1], t), ex.stress_at(1, x[0], x[1], t));
-            let u = (ex.displacement_at(0, x[0], x[1], t), ex.displacement_at(1, x[0], x[1], t));
+            let (s1, s2) = (
+                ex.stress_at(0, x[0], x[1], t),
+                ex.stress_at(1, x[0], x[1], t),
+            );
+            let u = (
+                ex.displacement_at(0, x[0], x[1], t),
+                ex.displacement_at(1, x[0], x[1], t),
+            );
             let mut pressure = ex.pressure.as_ref().map(|p| p.eval(x[0], x[1], t));
             if let (Some(s1), Some(s2)) = (s1, s2) {
                 let (t1, t2) = (traction(s1, n), traction(s2, [-n[0], -n[1]]));
                 for (side, tr) in [("slave", t1), ("master", t2)] {
                     if dot(tr, tau).abs() > TOL * s_scale {
-                        return refuse(format!("tangential traction on the {side} side {:.3e} (should be 0)", dot(tr, tau)), x, t);
+                        return refuse(
+                            format!(
+                                "tangential traction on the {side} side {:.3e} (should be 0)",
+                                dot(tr, tau)
+                            ),
+                            x,
+                            t,
+                        );
                     }
                 }
                 let (nn1, nn2) = (dot(t1, n), -dot(t2, n));
                 if (nn1 - nn2).abs() > TOL * s_scale {
-                    return refuse(format!("normal tractions differ: sigma_nn {nn1:.6e} on the slave side, {nn2:.6e} on the master side"), x, t);
+                    return refuse(
+                        format!(
+                            "normal tractions differ: sigma_nn {nn1:.6e} on the slave side, {nn2:.6e} on the master side"
+                        ),
+                        x,
+                        t,
+                    );
                 }
                 if let Some(p) = pressure {
                     if (p + nn1).abs() > TOL * s_scale {
-                        return refuse(format!("exact.pressure {p:.6e} is not -sigma_nn = {:.6e}", -nn1), x, t);
+                        return refuse(
+                            format!("exact.pressure {p:.6e} is not -sigma_nn = {:.6e}", -nn1),
+                            x,
+                            t,
+                        );
                     }
                 }
                 pressure = Some(-nn1);
             }
             if let Some(p) = pressure {
                 if p < -TOL * s_scale {
-                    return refuse(format!("pressure {p:.3e} < 0 (the bodies pull on each other)"), x, t);
+                    return refuse(
+                        format!("pressure {p:.3e} < 0 (the bodies pull on each other)"),
+                        x,
+                        t,
+                    );
                 }
             }
             if let (Some(u1), Some(u2)) = u {
                 let gap = -dot([u1[0] - u2[0], u1[1] - u2[1]], n);
                 if gap < -TOL * u_scale {
-                    return refuse(format!("gap {gap:.3e} < 0 (the bodies interpenetrate)"), x, t);
+                    return refuse(
+                        format!("gap {gap:.3e} < 0 (the bodies interpenetrate)"),
+                        x,
+                        t,
+                    );
                 }
                 if let Some(p) = pressure {
                     if (p * gap).abs() > TOL * s_scale * u_scale {
-                        return refuse(format!("pressure x gap = {:.3e} != 0 (pressure {p:.6e}, gap {gap:.6e})", p * gap), x, t);
+                        return refuse(
+                            format!(
+                                "pressure x gap = {:.3e} != 0 (pressure {p:.6e}, gap {gap:.6e})",
+                                p * gap
+                            ),
+                            x,
+                            t,
+                        );
                     }
                 }
             }
@@ -322,14 +368,29 @@ pub fn verify_exact(model: &Model, interface: &Interface, raw: &crate::mesh::Raw
             if let Some(u) = ex.displacement_at(*b, x[0], x[1], t) {
                 for &c in components {
                     if u[c].abs() > TOL * u_scale {
-                        return refuse(format!("u_{} = {:.6e} on '{curve}', which holds it at 0", ["x", "y"][c], u[c]), *x, t);
+                        return refuse(
+                            format!(
+                                "u_{} = {:.6e} on '{curve}', which holds it at 0",
+                                ["x", "y"][c],
+                                u[c]
+                            ),
+                            *x,
+                            t,
+                        );
                     }
                 }
             }
             if components.len() == 1 {
                 if let Some(s) = ex.stress_at(*b, x[0], x[1], t) {
                     if s[2].abs() > TOL * s_scale {
-                        return refuse(format!("tangential traction sigma_12 = {:.3e} on the roller '{curve}' (should be 0)", s[2]), *x, t);
+                        return refuse(
+                            format!(
+                                "tangential traction sigma_12 = {:.3e} on the roller '{curve}' (should be 0)",
+                                s[2]
+                            ),
+                            *x,
+                            t,
+                        );
                     }
                 }
             }

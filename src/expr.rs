@@ -9,8 +9,8 @@
 //! matter.
 
 use crate::error::{Error, Result};
-use exmex::prelude::*;
 use exmex::Differentiate;
+use exmex::prelude::*;
 use std::path::Path;
 
 /// Inputs an expression may read: x, y, t, pi, then the sign variables s0, s1, ...
@@ -35,7 +35,8 @@ impl Expr {
     /// Parse `text`; `file` and `field` name the place for error messages.
     pub fn parse(text: &str, file: &Path, field: &str) -> Result<Self> {
         let bad = |msg: String| Error::input(file, field, msg);
-        let (branch, arguments) = branch_form(text).map_err(|m| bad(format!("expression '{text}': {m}")))?;
+        let (branch, arguments) =
+            branch_form(text).map_err(|m| bad(format!("expression '{text}': {m}")))?;
         let signs = arguments
             .iter()
             .map(|a| Expr::parse(a, file, field))
@@ -43,8 +44,11 @@ impl Expr {
         let flat = FlatEx::<f64>::parse(&branch).map_err(|e| {
             bad(format!("cannot parse expression '{text}' ({e}); use x, y, t, numbers, + - * / ^ and functions such as sin, cos, exp, sqrt, abs"))
         })?;
-        let slots = slots_of(&flat, signs.len())
-            .map_err(|v| bad(format!("expression '{text}' uses unknown variable '{v}'; only x, y, t and pi are defined")))?;
+        let slots = slots_of(&flat, signs.len()).map_err(|v| {
+            bad(format!(
+                "expression '{text}' uses unknown variable '{v}'; only x, y, t and pi are defined"
+            ))
+        })?;
         Ok(Expr {
             text: text.to_string(),
             flat: Box::new(flat),
@@ -88,7 +92,8 @@ impl Expr {
                 .expect("exmex differentiates the branch form"),
             None => FlatEx::<f64>::parse("0").expect("0 parses"),
         };
-        let slots = slots_of(&derivative, self.signs.len()).expect("a derivative reads no new variable");
+        let slots =
+            slots_of(&derivative, self.signs.len()).expect("a derivative reads no new variable");
         Expr {
             text: format!("d/d{name} ({})", self.text),
             flat: Box::new(derivative),
@@ -119,7 +124,10 @@ impl Expr {
         }
         let flat = FlatEx::<f64>::parse(&text).expect("a combination of parsed expressions parses");
         let slots = slots_of(&flat, signs.len()).expect("no new variable");
-        let source: Vec<String> = terms.iter().map(|(c, e)| format!("{c}*({})", e.text)).collect();
+        let source: Vec<String> = terms
+            .iter()
+            .map(|(c, e)| format!("{c}*({})", e.text))
+            .collect();
         Expr {
             text: source.join(" + "),
             flat: Box::new(flat),
@@ -138,7 +146,8 @@ fn plain_numbers(text: &str) -> String {
     while i < chars.len() {
         let c = chars[i];
         let starts_number = c.is_ascii_digit()
-            && (i == 0 || !(chars[i - 1].is_alphanumeric() || chars[i - 1] == '_' || chars[i - 1] == '.'));
+            && (i == 0
+                || !(chars[i - 1].is_alphanumeric() || chars[i - 1] == '_' || chars[i - 1] == '.'));
         if !starts_number {
             out.push(c);
             i += 1;

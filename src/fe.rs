@@ -335,7 +335,9 @@ impl Model {
             return Err(Error::input(
                 &self.scene.file,
                 field,
-                format!("the traction derived from exact.displacement is not finite at x = {x}, y = {y}, t = {t}; fix the displacement"),
+                format!(
+                    "the traction derived from exact.displacement is not finite at x = {x}, y = {y}, t = {t}; fix the displacement"
+                ),
             ));
         }
         Ok(g)

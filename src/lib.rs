@@ -3,7 +3,8 @@
 //! of two elastic-viscoplastic bodies on non-matching meshes.
 //!
 //! The modules follow the pipeline: [`mesh`] -> [`scene`] -> [`material`] -> [`fe`] ->
-//! [`contact`] -> [`solve`] -> [`case`] / [`metrics`] / [`io`] -> [`study`] -> [`report`];
+//! [`contact`] -> [`solve`] -> [`case`] / [`metrics`] / [`io`] -> [`study`] -> [`report`],
+//! with [`expr`], [`quadrature`] and [`analytical`] (exact solutions) beside the scene;
 //! the binary is a thin CLI over them. Scenes are data ([`scene`]).
 
 pub mod analytical;

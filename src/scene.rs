@@ -428,7 +428,12 @@ impl Scene {
             "contact.master_curve".into(),
         )?;
         let exact = match &sf.exact {
-            Some(spec) => Some(Box::new(exact_solution(spec, &mut bodies, slave == 1, file)?)),
+            Some(spec) => Some(Box::new(exact_solution(
+                spec,
+                &mut bodies,
+                slave == 1,
+                file,
+            )?)),
             None => None,
         };
         let [b0, b1]: [SceneBody; 2] = bodies.try_into().expect("two bodies");
@@ -544,7 +549,10 @@ fn exact_solution(
             body.body_force = Some(VectorExpr(f[b].clone()));
         }
     }
-    if !exact.gives(Field::Displacement) && !exact.gives(Field::Stress) && !exact.gives(Field::Pressure) {
+    if !exact.gives(Field::Displacement)
+        && !exact.gives(Field::Stress)
+        && !exact.gives(Field::Pressure)
+    {
         return Err(Error::input(
             file,
             "exact",

@@ -47,16 +47,28 @@ fn derived_body_force_and_traction_of_a_polynomial_field_equal_the_hand_derived_
         ];
         let s = ex.stress_at(0, x, y, 1.0).unwrap();
         for k in 0..3 {
-            assert!((s[k] - s_hand[k]).abs() <= 1e-13 * s_hand[k].abs().max(1.0), "sigma[{k}] at ({x}, {y}): {} vs {}", s[k], s_hand[k]);
+            assert!(
+                (s[k] - s_hand[k]).abs() <= 1e-13 * s_hand[k].abs().max(1.0),
+                "sigma[{k}] at ({x}, {y}): {} vs {}",
+                s[k],
+                s_hand[k]
+            );
         }
         for c in 0..2 {
             let v = f[0][c].eval(x, y, 1.0);
-            assert!((v - f_hand[c]).abs() <= 1e-13 * f_hand[c].abs().max(1.0), "f[{c}] at ({x}, {y}): {v} vs {}", f_hand[c]);
+            assert!(
+                (v - f_hand[c]).abs() <= 1e-13 * f_hand[c].abs().max(1.0),
+                "f[{c}] at ({x}, {y}): {v} vs {}",
+                f_hand[c]
+            );
         }
         // The traction on a boundary with outward normal n is sigma n.
         let n = [0.6, -0.8];
         let g = traction(s, n);
-        let g_hand = [s_hand[0] * n[0] + s_hand[2] * n[1], s_hand[2] * n[0] + s_hand[1] * n[1]];
+        let g_hand = [
+            s_hand[0] * n[0] + s_hand[2] * n[1],
+            s_hand[2] * n[0] + s_hand[1] * n[1],
+        ];
         for c in 0..2 {
             assert!((g[c] - g_hand[c]).abs() <= 1e-13 * g_hand[c].abs().max(1.0));
         }
@@ -89,7 +101,10 @@ fn repo() -> PathBuf {
 fn mms_scene(dir: &Path, edit: impl Fn(String) -> String) -> PathBuf {
     let text = std::fs::read_to_string(repo().join("scenes/contact-mms.toml")).unwrap();
     let geo = repo().join("meshes/two_blocks.geo");
-    let text = text.replace("\"../meshes/two_blocks.geo\"", &format!("{:?}", geo.display().to_string()));
+    let text = text.replace(
+        "\"../meshes/two_blocks.geo\"",
+        &format!("{:?}", geo.display().to_string()),
+    );
     let f = dir.join("mms.toml");
     std::fs::write(&f, edit(text)).unwrap();
     f
@@ -97,7 +112,13 @@ fn mms_scene(dir: &Path, edit: impl Fn(String) -> String) -> PathBuf {
 
 fn solve(scene: &Path, out: &Path) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_contact-rates"))
-        .args(["solve", "--scene", scene.to_str().unwrap(), "--out", out.to_str().unwrap()])
+        .args([
+            "solve",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
         .output()
         .unwrap()
 }
@@ -108,21 +129,47 @@ fn a_field_that_is_not_a_contact_solution_is_refused_before_solving() {
     let out = dir.path().join("out");
     // The unperturbed field passes the check and solves.
     let ok = solve(&mms_scene(dir.path(), |t| t), &out);
-    assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
     std::fs::remove_dir_all(&out).unwrap();
     let cases: [(Box<dyn Fn(String) -> String>, &[&str]); 2] = [
         (
             // The gap opens at 0.4 while the pressure acts up to 0.5871.
             Box::new(|t: String| {
-                t.replace("0.8*t*((x-0.5871+abs(x-0.5871))/2)^3", "0.8*t*((x-0.4+abs(x-0.4))/2)^3")
-                    .replace("0.2*t*((x-0.5871+abs(x-0.5871))/2)^4", "0.2*t*((x-0.4+abs(x-0.4))/2)^4")
+                t.replace(
+                    "0.8*t*((x-0.5871+abs(x-0.5871))/2)^3",
+                    "0.8*t*((x-0.4+abs(x-0.4))/2)^3",
+                )
+                .replace(
+                    "0.2*t*((x-0.5871+abs(x-0.5871))/2)^4",
+                    "0.2*t*((x-0.4+abs(x-0.4))/2)^4",
+                )
             }),
-            &["not a solution of the contact problem", "pressure x gap", "!= 0", "(x, y) = (0.", "t = 0.25"],
+            &[
+                "not a solution of the contact problem",
+                "pressure x gap",
+                "!= 0",
+                "(x, y) = (0.",
+                "t = 0.25",
+            ],
         ),
         (
             // A shear u_x = 0.01 t (y - 1) x: sigma_12 = b 0.01 t x / 2 on y = 1.
-            Box::new(|t: String| t.replacen("+ 0.02*t*(y-1)^2*sin(pi*x)", "+ 0.02*t*(y-1)^2*sin(pi*x) + 0.01*t*(y-1)*x", 1)),
-            &["not a solution of the contact problem", "tangential traction on the slave side", "(x, y) = ("],
+            Box::new(|t: String| {
+                t.replacen(
+                    "+ 0.02*t*(y-1)^2*sin(pi*x)",
+                    "+ 0.02*t*(y-1)^2*sin(pi*x) + 0.01*t*(y-1)*x",
+                    1,
+                )
+            }),
+            &[
+                "not a solution of the contact problem",
+                "tangential traction on the slave side",
+                "(x, y) = (",
+            ],
         ),
     ];
     for (edit, needles) in cases {

@@ -19,7 +19,10 @@ fn gauss_legendre_integrates_degree_2n_minus_1_exactly() {
         for d in 0..(2 * n as i32) {
             let q: f64 = rule.iter().map(|&(x, w)| w * x.powi(d)).sum();
             let exact = 1.0 / (d + 1) as f64;
-            assert!((q - exact).abs() < 1e-14, "n {n} degree {d}: {q} vs {exact}");
+            assert!(
+                (q - exact).abs() < 1e-14,
+                "n {n} degree {d}: {q} vs {exact}"
+            );
         }
     }
 }
@@ -48,7 +51,10 @@ fn collapsed_rule_integrates_degree_2n_minus_2_exactly_on_the_triangle() {
 #[test]
 fn collapsed_rule_converges_on_a_smooth_integrand() {
     // The unit square as the triangles (0,0),(1,0),(1,1) and (0,0),(1,1),(0,1).
-    let tris = [[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]], [[0.0, 0.0], [1.0, 1.0], [0.0, 1.0]]];
+    let tris = [
+        [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]],
+        [[0.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+    ];
     let f = |x: f64, y: f64| (std::f64::consts::PI * x).sin() * y.exp();
     let exact = 2.0 * (1f64.exp() - 1.0) / std::f64::consts::PI;
     let integral = |n: usize| -> f64 {
@@ -63,9 +69,15 @@ fn collapsed_rule_converges_on_a_smooth_integrand() {
         }
         s
     };
-    let errors: Vec<f64> = [2, 4, 8].iter().map(|&n| (integral(n) - exact).abs()).collect();
+    let errors: Vec<f64> = [2, 4, 8]
+        .iter()
+        .map(|&n| (integral(n) - exact).abs())
+        .collect();
     println!("errors with 2, 4, 8 points per direction: {errors:?}");
     // Spectral convergence on the whole square (h = 1): the rule of a study, on triangles
     // of h <= 0.3, is far more accurate still.
-    assert!(errors[0] > errors[1] && errors[1] < 1e-4 * exact && errors[2] < 1e-14 * exact, "{errors:?}");
+    assert!(
+        errors[0] > errors[1] && errors[1] < 1e-4 * exact && errors[2] < 1e-14 * exact,
+        "{errors:?}"
+    );
 }

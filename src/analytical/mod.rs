@@ -89,7 +89,9 @@ impl Exact {
         manufactured: bool,
         materials: [&Material; 2],
     ) -> Self {
-        let gradient = displacement.as_ref().map(|u| [gradient(&u[0]), gradient(&u[1])]);
+        let gradient = displacement
+            .as_ref()
+            .map(|u| [gradient(&u[0]), gradient(&u[1])]);
         let elastic = materials.iter().all(|m| m.viscoplastic.is_none());
         let stress = stress.or_else(|| {
             let g = gradient.as_ref().filter(|_| elastic)?;

@@ -80,7 +80,9 @@ impl StackedBlocks {
         // Each condition: (body, linear functional of that body's profile, value) or a
         // difference of the two bodies' functionals.
         type Functional = Box<dyn Fn(Profile) -> f64>;
-        let at = |op: fn(Profile) -> Profile, y: f64| -> Functional { Box::new(move |c| eval(op(c), y)) };
+        let at = |op: fn(Profile) -> Profile, y: f64| -> Functional {
+            Box::new(move |c| eval(op(c), y))
+        };
         let conditions: Vec<(Option<Functional>, Option<Functional>, f64)> = vec![
             // Top: sigma_22 = -pi^2 f = -cosine, sigma_12 = pi f' = 0.
             (Some(at(f, 2.0)), None, cosine / PI.powi(2)),
@@ -88,17 +90,33 @@ impl StackedBlocks {
             // Interface: no shear on either side; equal sigma_22 and u_y.
             (Some(at(d1, 1.0)), None, 0.0),
             (None, Some(at(d1, 1.0)), 0.0),
-            (Some(at(f, 1.0)), Some(Box::new(move |c| -eval(c, 1.0))), 0.0),
             (
-                Some(Box::new(move |c| eval(big_f(c), 1.0) * PI.powi(2) + nu * eval(d1(c), 1.0))),
-                Some(Box::new(move |c| -(eval(big_f(c), 1.0) * PI.powi(2) + nu * eval(d1(c), 1.0)))),
+                Some(at(f, 1.0)),
+                Some(Box::new(move |c| -eval(c, 1.0))),
+                0.0,
+            ),
+            (
+                Some(Box::new(move |c| {
+                    eval(big_f(c), 1.0) * PI.powi(2) + nu * eval(d1(c), 1.0)
+                })),
+                Some(Box::new(move |c| {
+                    -(eval(big_f(c), 1.0) * PI.powi(2) + nu * eval(d1(c), 1.0))
+                })),
                 0.0,
             ),
             // Clamp at y = 0: u_x = 0 (f'' + nu pi^2 f = 0) and u_y = 0 (pi^2 F + nu f' = 0).
-            (None, Some(Box::new(move |c| eval(d2(c), 0.0) + nu * PI.powi(2) * eval(c, 0.0))), 0.0),
             (
                 None,
-                Some(Box::new(move |c| PI.powi(2) * eval(big_f(c), 0.0) + nu * eval(d1(c), 0.0))),
+                Some(Box::new(move |c| {
+                    eval(d2(c), 0.0) + nu * PI.powi(2) * eval(c, 0.0)
+                })),
+                0.0,
+            ),
+            (
+                None,
+                Some(Box::new(move |c| {
+                    PI.powi(2) * eval(big_f(c), 0.0) + nu * eval(d1(c), 0.0)
+                })),
                 0.0,
             ),
         ];
@@ -117,7 +135,10 @@ impl StackedBlocks {
             }
             rhs[row] = *value;
         }
-        let x = m.lu().solve(&rhs).expect("the eight conditions are independent");
+        let x = m
+            .lu()
+            .solve(&rhs)
+            .expect("the eight conditions are independent");
         StackedBlocks {
             young,
             poisson,

@@ -253,5 +253,10 @@ fn table(res: &SpeedResult) -> String {
 
 /// What `study speed` prints: the table of the runs, and where the report went.
 pub fn console(res: &SpeedResult, dir: &Path) -> String {
-    format!("{}wrote {} ({:.1} s)\n", table(res), dir.display(), res.wall_s)
+    format!(
+        "{}wrote {} ({:.1} s)\n",
+        table(res),
+        dir.display(),
+        res.wall_s
+    )
 }

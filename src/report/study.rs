@@ -233,10 +233,13 @@ fn profiles(res: &StudyResult, d: &Path) -> Result<()> {
                     .collect();
                 pts.sort_by(|a, b| a.0.total_cmp(&b.0));
                 pts.dedup_by(|a, b| a.0 == b.0);
-                let reference = source != Source::Cone(Method::Mortar) && source != Source::Cone(Method::Nts);
+                let reference =
+                    source != Source::Cone(Method::Mortar) && source != Source::Cone(Method::Nts);
                 Series {
                     label: match (source, res.reference) {
-                        (Source::Reference, Some(r)) => format!("reference (level {}, matching)", r.level),
+                        (Source::Reference, Some(r)) => {
+                            format!("reference (level {}, matching)", r.level)
+                        }
                         (Source::Exact, _) => "exact solution".into(),
                         _ => format!("{} (level {})", source.name(), res.profile_level),
                     },
@@ -539,7 +542,10 @@ fn cones_against_exact(s: &mut String, res: &StudyResult) {
                 } else if a > 1.5 * b {
                     format!("mortar's error is {:.2}x nts's", a / b)
                 } else {
-                    format!("the cones agree within a factor 1.5 (nts / mortar = {:.3})", b / a)
+                    format!(
+                        "the cones agree within a factor 1.5 (nts / mortar = {:.3})",
+                        b / a
+                    )
                 };
                 let _ = writeln!(s, "- {q}: {verdict} at level {finest}.");
             }

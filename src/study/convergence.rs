@@ -13,7 +13,9 @@
 //! 6. the provenance.
 
 use super::error::{self, Comparison, SquaredNorms};
-use super::exact_error::{ExactComparison, ExactDifference, exact_profiles, max_exact_displacement};
+use super::exact_error::{
+    ExactComparison, ExactDifference, exact_profiles, max_exact_displacement,
+};
 use super::file::{StudyFile, Threshold};
 use super::jobs::{self, Job, JobId, Mode, Progress, Solved};
 use super::quantity::{Differences, Quantity};
@@ -398,7 +400,13 @@ impl Plan {
         let r = study.reference_level();
         let reference = (!sf.reference.exact).then(|| {
             [r - 2, r - 1, r].map(|l| {
-                add(format!("reference level {l}"), Method::Mortar, l, &reference_parameters, sf.steps)
+                add(
+                    format!("reference level {l}"),
+                    Method::Mortar,
+                    l,
+                    &reference_parameters,
+                    sf.steps,
+                )
             })
         });
         let mut levels = Vec::new();
@@ -443,7 +451,12 @@ impl Plan {
         });
         if let Some(reference) = reference {
             let coarsest = &jobs[reference[0]];
-            let case = Case::build(&study.scene, coarsest.level, coarsest.method, &coarsest.params)?;
+            let case = Case::build(
+                &study.scene,
+                coarsest.level,
+                coarsest.method,
+                &coarsest.params,
+            )?;
             if case.problem.interface.min_relative_separation() > 1e-9 {
                 return Err(Error::input(
                     &study.path,
@@ -472,6 +485,18 @@ struct ReferenceSolution {
     facts: Reference,
 }
 
+/// The estimated relative error of a reference R and the rate p of the model, from its
+/// distances d1 = d(R-1, R) and d2 = d(R-2, R) to its two coarser nested levels: with
+/// e_L = C h_L^p and d(L, R)^2 = e_L^2 - e_R^2, (d2 / d1)^2 = 4^p + 1 and
+/// e_R = d1 / sqrt(4^p - 1). p is kept in [0.25, 3].
+pub fn estimated_reference_error(d1: f64, d2: f64) -> (f64, f64) {
+    let p = ((d2 / d1).powi(2) - 1.0)
+        .max(1.0 + 1e-12)
+        .log(4.0)
+        .clamp(0.25, 3.0);
+    (d1 / (4f64.powf(p) - 1.0).sqrt(), p)
+}
+
 /// Step 2: the reference and the estimate of its own error. The reference levels are nested
 /// conforming spaces, so their errors are close to orthogonal: d(L, R)^2 = e_L^2 - e_R^2 with
 /// e_L = C h_L^p (measured on the rates scene: d(R-2,R)/d(R-1,R) = 2.24 = sqrt(5), i.e.
@@ -481,11 +506,7 @@ fn reference(ids: [JobId; 3], solved: &mut Solved, level: usize) -> ReferenceSol
     let (case, solution) = finest;
     let d1 = super::theorem_distance(&coarser1.0, &coarser1.1, &case, &solution);
     let d2 = super::theorem_distance(&coarser2.0, &coarser2.1, &case, &solution);
-    let error_rate = ((d2 / d1).powi(2) - 1.0)
-        .max(1.0 + 1e-12)
-        .log(4.0)
-        .clamp(0.25, 3.0);
-    let error = d1 / (4f64.powf(error_rate) - 1.0).sqrt();
+    let (error, error_rate) = estimated_reference_error(d1, d2);
     let norms = solution
         .states
         .iter()
@@ -582,7 +603,12 @@ fn measure_levels(
     }
     let magnification = match truth {
         Truth::Solved(reference) => {
-            profiles(&reference.case, &reference.solution, Source::Reference, &mut out);
+            profiles(
+                &reference.case,
+                &reference.solution,
+                Source::Reference,
+                &mut out,
+            );
             0.1 / inf_norm(&reference.solution.last().u).max(f64::MIN_POSITIVE)
         }
         Truth::Exact(exact, _) => {
@@ -622,14 +648,20 @@ fn measure_levels(
         out.levels.push(level_info(case, sol, method, flagged));
         if level == profile_level {
             profiles(case, sol, Source::Cone(method), &mut out);
-            out.deformed.push(deformed(case, sol, method, magnification));
+            out.deformed
+                .push(deformed(case, sol, method, magnification));
         }
     }
     Ok(out)
 }
 
 /// Every quantity's relative error of one solved level against the exact solution.
-fn exact_errors(case: &Case, sol: &Solution, exact: &Exact, points: usize) -> BTreeMap<Quantity, f64> {
+fn exact_errors(
+    case: &Case,
+    sol: &Solution,
+    exact: &Exact,
+    points: usize,
+) -> BTreeMap<Quantity, f64> {
     let cmp = ExactComparison::new(exact, points);
     let diffs: Vec<ExactDifference> = sol
         .states
@@ -867,10 +899,7 @@ fn provenance(study: &Study, mesh: &crate::mesh::gmsh::GeneratedMesh) -> BTreeMa
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     BTreeMap::from([
         ("gmsh".into(), mesh.gmsh_version.clone()),
-        (
-            "geo".into(),
-            format!("{geo} (sha256 {})", mesh.geo_hash),
-        ),
+        ("geo".into(), format!("{geo} (sha256 {})", mesh.geo_hash)),
         (
             "solver".into(),
             format!(
@@ -919,7 +948,11 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
     let truth = match plan.reference {
         Some(ids) => Truth::Solved(reference(ids, &mut solved, study.reference_level())),
         None => Truth::Exact(
-            study.scene.exact.as_deref().expect("checked when the study was read"),
+            study
+                .scene
+                .exact
+                .as_deref()
+                .expect("checked when the study was read"),
             sf.reference.quadrature,
         ),
     };
@@ -928,8 +961,18 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
     let rates = fit_rates(sf, &measured);
     let time_study = time_study(sf, &plan, &mut solved);
     let (reference, exact_quadrature, mesh, warnings) = match &truth {
-        Truth::Solved(r) => (Some(r.facts), None, r.case.mesh.clone(), r.case.warnings.clone()),
-        Truth::Exact(_, points) => (None, Some(*points), measured.mesh.clone().expect("at least one level"), measured.warnings.clone()),
+        Truth::Solved(r) => (
+            Some(r.facts),
+            None,
+            r.case.mesh.clone(),
+            r.case.warnings.clone(),
+        ),
+        Truth::Exact(_, points) => (
+            None,
+            Some(*points),
+            measured.mesh.clone().expect("at least one level"),
+            measured.warnings.clone(),
+        ),
     };
     let provenance = provenance(&study, &mesh);
     Ok(Some(StudyResult {

@@ -263,7 +263,9 @@ impl StudyFile {
                 "the reference must be at least 2 levels finer than the finest study level".into(),
             );
         }
-        if s.reference.exact && (s.reference.levels_above != 0 || !s.reference.parameters.is_empty()) {
+        if s.reference.exact
+            && (s.reference.levels_above != 0 || !s.reference.parameters.is_empty())
+        {
             return bad(
                 "reference",
                 "an exact reference is not solved: remove levels_above and parameters".into(),
@@ -272,7 +274,10 @@ impl StudyFile {
         if !(1..=32).contains(&s.reference.quadrature) {
             return bad(
                 "reference.quadrature",
-                format!("give 1 to 32 Gauss points per direction, got {}", s.reference.quadrature),
+                format!(
+                    "give 1 to 32 Gauss points per direction, got {}",
+                    s.reference.quadrature
+                ),
             );
         }
         let t = &s.thresholds;

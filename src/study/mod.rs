@@ -153,7 +153,9 @@ impl Outcome {
     }
 }
 
-pub(crate) fn solve_case(case: &Case, kind: SolverKind, steps: usize) -> Result<(Solution, f64)> {
+/// Solve `case` with `kind` on `steps` uniform steps, keeping the history; with the wall
+/// time of the call (s).
+pub fn solve_case(case: &Case, kind: SolverKind, steps: usize) -> Result<(Solution, f64)> {
     let t = Instant::now();
     let sol = solve::solve(
         &case.problem,
@@ -168,7 +170,7 @@ pub(crate) fn solve_case(case: &Case, kind: SolverKind, steps: usize) -> Result<
 }
 
 /// Theorem-quantity distance of two solutions with the same time grid, relative to `b`.
-pub(crate) fn theorem_distance(ca: &Case, sa: &Solution, cb: &Case, sb: &Solution) -> f64 {
+pub fn theorem_distance(ca: &Case, sa: &Solution, cb: &Case, sb: &Solution) -> f64 {
     let cmp = Comparison::new(&ca.problem.model, &cb.problem.model);
     let d = sa
         .states
