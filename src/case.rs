@@ -1,5 +1,6 @@
 //! A case: one scene on one mesh level with one cone, built from files through gmsh.
 
+use crate::analytical::Exact;
 use crate::contact::{Interface, Method};
 use crate::error::{Error, Result};
 use crate::fe::Model;
@@ -205,6 +206,15 @@ pub fn peak_rss_gib() -> Option<f64> {
     Some(kb / (1024.0 * 1024.0))
 }
 
+/// Round-off bound of the checks of an exact solution, relative to the field's scale.
+const EXACT_TOL: f64 = 1e-9;
+
+/// A point of Gamma_C with the slave's outward normal and the tangent.
+type ContactSample = ([f64; 2], [f64; 2], [f64; 2]);
+
+/// A point of a clamp or roller: position, body, held components, curve name.
+type SupportSample<'a> = ([f64; 2], usize, Vec<usize>, &'a str);
+
 /// Refuse an exact solution that is not a solution of the contact problem, before anything
 /// is solved: at 401 points of every piece of Gamma_C and at t = T/4, T/2, 3T/4, T, no
 /// tangential traction on either side, equal normal tractions, pressure >= 0, gap >= 0,
@@ -216,54 +226,94 @@ pub fn verify_exact(
     interface: &Interface,
     raw: &crate::mesh::RawMesh,
 ) -> Result<()> {
-    use crate::analytical::traction;
     let sc = &model.scene;
     let Some(ex) = sc.exact.as_deref() else {
         return Ok(());
     };
-    const TOL: f64 = 1e-9;
     let times: Vec<f64> = (1..=4).map(|k| sc.final_time * k as f64 / 4.0).collect();
-    // Points of Gamma_C with the slave's normal and the tangent.
-    let mut on_contact = Vec::new();
-    for p in &interface.pieces {
-        for k in 0..=400 {
-            let s = p.length * k as f64 / 400.0;
-            let x = [p.a[0] + s * p.tangent[0], p.a[1] + s * p.tangent[1]];
-            on_contact.push((x, p.normal, p.tangent));
+    let contact: Vec<ContactSample> = interface
+        .pieces
+        .iter()
+        .flat_map(|p| {
+            (0..=400).map(move |k| {
+                let s = p.length * k as f64 / 400.0;
+                (
+                    [p.a[0] + s * p.tangent[0], p.a[1] + s * p.tangent[1]],
+                    p.normal,
+                    p.tangent,
+                )
+            })
+        })
+        .collect();
+    let supports = support_samples(model, raw);
+    let scales = exact_scales(ex, &contact, &supports, &times);
+    for &t in &times {
+        let failure = contact
+            .iter()
+            .find_map(|c| {
+                check_contact_point(ex, c, t, scales)
+                    .err()
+                    .map(|w| (w, c.0))
+            })
+            .or_else(|| {
+                supports.iter().find_map(|s| {
+                    check_support_point(ex, s, t, scales)
+                        .err()
+                        .map(|w| (w, s.0))
+                })
+            });
+        if let Some((what, x)) = failure {
+            return Err(Error::input(
+                &sc.file,
+                "exact",
+                format!(
+                    "the exact solution is not a solution of the contact problem: {what} at (x, y) = ({:.6}, {:.6}), t = {t}; fix the [exact] fields",
+                    x[0], x[1]
+                ),
+            ));
         }
     }
-    // Points of the clamps and rollers, with their body and held components.
-    let mut supports: Vec<([f64; 2], usize, Vec<usize>, &str)> = Vec::new();
-    let held: Vec<(&str, Vec<usize>)> = sc
-        .clamps
-        .iter()
-        .map(|c| (c.as_str(), vec![0, 1]))
-        .chain(
-            sc.rollers
-                .iter()
-                .map(|r| (r.curve.as_str(), vec![r.component])),
-        )
-        .collect();
-    for (curve, components) in &held {
+    Ok(())
+}
+
+/// Points of the clamps and rollers (the ends and middle of every edge).
+fn support_samples<'a>(model: &'a Model, raw: &crate::mesh::RawMesh) -> Vec<SupportSample<'a>> {
+    let sc = &model.scene;
+    let held = sc.clamps.iter().map(|c| (c.as_str(), vec![0, 1])).chain(
+        sc.rollers
+            .iter()
+            .map(|r| (r.curve.as_str(), vec![r.component])),
+    );
+    let mut out = Vec::new();
+    for (curve, components) in held {
         for b in 0..2 {
             for e in model.meshes[b].curve_edges(raw, curve) {
                 let (pa, pb) = (model.meshes[b].nodes[e[0]], model.meshes[b].nodes[e[1]]);
                 for w in [0.0, 0.5, 1.0] {
                     let x = [pa[0] + w * (pb[0] - pa[0]), pa[1] + w * (pb[1] - pa[1])];
-                    supports.push((x, b, components.clone(), curve));
+                    out.push((x, b, components.clone(), curve));
                 }
             }
         }
     }
-    // Scales: the largest stress component and displacement over these points and times,
-    // each point in its own body (both bodies on Gamma_C).
+    out
+}
+
+/// The largest stress component (or pressure) and displacement over the samples and times,
+/// each point in its own body (both bodies on Gamma_C): the scales of the round-off bounds.
+fn exact_scales(
+    ex: &Exact,
+    contact: &[ContactSample],
+    supports: &[SupportSample],
+    times: &[f64],
+) -> (f64, f64) {
     let (mut s_scale, mut u_scale) = (f64::MIN_POSITIVE, f64::MIN_POSITIVE);
-    let points = on_contact
+    let points = contact
         .iter()
         .flat_map(|c| [(c.0, 0), (c.0, 1)])
         .chain(supports.iter().map(|s| (s.0, s.1)));
     for (x, b) in points {
-        for &t in &times {
+        for &t in times {
             if let Some(s) = ex.stress_at(b, x[0], x[1], t) {
                 s_scale = s.iter().fold(s_scale, |m, v| m.max(v.abs()));
             }
@@ -275,124 +325,103 @@ pub fn verify_exact(
             }
         }
     }
-    let refuse = |what: String, x: [f64; 2], t: f64| {
-        Err(Error::input(
-            &sc.file,
-            "exact",
-            format!(
-                "the exact solution is not a solution of the contact problem: {what} at (x, y) = ({:.6}, {:.6}), t = {t}; fix the [exact] fields",
-                x[0], x[1]
-            ),
-        ))
-    };
-    let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
-    for &t in &times {
-        for &(x, n, tau) in &on_contact {
-            let (s1, s2) = (
-                ex.stress_at(0, x[0], x[1], t),
-                ex.stress_at(1, x[0], x[1], t),
-            );
-            let u = (
-                ex.displacement_at(0, x[0], x[1], t),
-                ex.displacement_at(1, x[0], x[1], t),
-            );
-            let mut pressure = ex.pressure.as_ref().map(|p| p.eval(x[0], x[1], t));
-            if let (Some(s1), Some(s2)) = (s1, s2) {
-                let (t1, t2) = (traction(s1, n), traction(s2, [-n[0], -n[1]]));
-                for (side, tr) in [("slave", t1), ("master", t2)] {
-                    if dot(tr, tau).abs() > TOL * s_scale {
-                        return refuse(
-                            format!(
-                                "tangential traction on the {side} side {:.3e} (should be 0)",
-                                dot(tr, tau)
-                            ),
-                            x,
-                            t,
-                        );
-                    }
-                }
-                let (nn1, nn2) = (dot(t1, n), -dot(t2, n));
-                if (nn1 - nn2).abs() > TOL * s_scale {
-                    return refuse(
-                        format!(
-                            "normal tractions differ: sigma_nn {nn1:.6e} on the slave side, {nn2:.6e} on the master side"
-                        ),
-                        x,
-                        t,
-                    );
-                }
-                if let Some(p) = pressure {
-                    if (p + nn1).abs() > TOL * s_scale {
-                        return refuse(
-                            format!("exact.pressure {p:.6e} is not -sigma_nn = {:.6e}", -nn1),
-                            x,
-                            t,
-                        );
-                    }
-                }
-                pressure = Some(-nn1);
-            }
-            if let Some(p) = pressure {
-                if p < -TOL * s_scale {
-                    return refuse(
-                        format!("pressure {p:.3e} < 0 (the bodies pull on each other)"),
-                        x,
-                        t,
-                    );
-                }
-            }
-            if let (Some(u1), Some(u2)) = u {
-                let gap = -dot([u1[0] - u2[0], u1[1] - u2[1]], n);
-                if gap < -TOL * u_scale {
-                    return refuse(
-                        format!("gap {gap:.3e} < 0 (the bodies interpenetrate)"),
-                        x,
-                        t,
-                    );
-                }
-                if let Some(p) = pressure {
-                    if (p * gap).abs() > TOL * s_scale * u_scale {
-                        return refuse(
-                            format!(
-                                "pressure x gap = {:.3e} != 0 (pressure {p:.6e}, gap {gap:.6e})",
-                                p * gap
-                            ),
-                            x,
-                            t,
-                        );
-                    }
-                }
+    (s_scale, u_scale)
+}
+
+fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
+    a[0] * b[0] + a[1] * b[1]
+}
+
+/// The contact conditions at one point of Gamma_C; Err says which fails and by how much.
+fn check_contact_point(
+    ex: &Exact,
+    &(x, n, tau): &ContactSample,
+    t: f64,
+    (s_scale, u_scale): (f64, f64),
+) -> std::result::Result<(), String> {
+    use crate::analytical::traction;
+    let mut pressure = ex.pressure.as_ref().map(|p| p.eval(x[0], x[1], t));
+    if let (Some(s1), Some(s2)) = (
+        ex.stress_at(0, x[0], x[1], t),
+        ex.stress_at(1, x[0], x[1], t),
+    ) {
+        let (t1, t2) = (traction(s1, n), traction(s2, [-n[0], -n[1]]));
+        for (side, tr) in [("slave", t1), ("master", t2)] {
+            if dot(tr, tau).abs() > EXACT_TOL * s_scale {
+                return Err(format!(
+                    "tangential traction on the {side} side {:.3e} (should be 0)",
+                    dot(tr, tau)
+                ));
             }
         }
-        for (x, b, components, curve) in &supports {
-            if let Some(u) = ex.displacement_at(*b, x[0], x[1], t) {
-                for &c in components {
-                    if u[c].abs() > TOL * u_scale {
-                        return refuse(
-                            format!(
-                                "u_{} = {:.6e} on '{curve}', which holds it at 0",
-                                ["x", "y"][c],
-                                u[c]
-                            ),
-                            *x,
-                            t,
-                        );
-                    }
-                }
+        let (nn1, nn2) = (dot(t1, n), -dot(t2, n));
+        if (nn1 - nn2).abs() > EXACT_TOL * s_scale {
+            return Err(format!(
+                "normal tractions differ: sigma_nn {nn1:.6e} on the slave side, {nn2:.6e} on the master side"
+            ));
+        }
+        if let Some(p) = pressure {
+            if (p + nn1).abs() > EXACT_TOL * s_scale {
+                return Err(format!(
+                    "exact.pressure {p:.6e} is not -sigma_nn = {:.6e}",
+                    -nn1
+                ));
             }
-            if components.len() == 1 {
-                if let Some(s) = ex.stress_at(*b, x[0], x[1], t) {
-                    if s[2].abs() > TOL * s_scale {
-                        return refuse(
-                            format!(
-                                "tangential traction sigma_12 = {:.3e} on the roller '{curve}' (should be 0)",
-                                s[2]
-                            ),
-                            *x,
-                            t,
-                        );
-                    }
-                }
+        }
+        pressure = Some(-nn1);
+    }
+    if let Some(p) = pressure {
+        if p < -EXACT_TOL * s_scale {
+            return Err(format!(
+                "pressure {p:.3e} < 0 (the bodies pull on each other)"
+            ));
+        }
+    }
+    if let (Some(u1), Some(u2)) = (
+        ex.displacement_at(0, x[0], x[1], t),
+        ex.displacement_at(1, x[0], x[1], t),
+    ) {
+        let gap = -dot([u1[0] - u2[0], u1[1] - u2[1]], n);
+        if gap < -EXACT_TOL * u_scale {
+            return Err(format!("gap {gap:.3e} < 0 (the bodies interpenetrate)"));
+        }
+        if let Some(p) = pressure {
+            if (p * gap).abs() > EXACT_TOL * s_scale * u_scale {
+                return Err(format!(
+                    "pressure x gap = {:.3e} != 0 (pressure {p:.6e}, gap {gap:.6e})",
+                    p * gap
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The support conditions at one point of a clamp or roller.
+fn check_support_point(
+    ex: &Exact,
+    (x, b, components, curve): &SupportSample,
+    t: f64,
+    (s_scale, u_scale): (f64, f64),
+) -> std::result::Result<(), String> {
+    if let Some(u) = ex.displacement_at(*b, x[0], x[1], t) {
+        for &c in components {
+            if u[c].abs() > EXACT_TOL * u_scale {
+                return Err(format!(
+                    "u_{} = {:.6e} on '{curve}', which holds it at 0",
+                    ["x", "y"][c],
+                    u[c]
+                ));
+            }
+        }
+    }
+    if components.len() == 1 {
+        if let Some(s) = ex.stress_at(*b, x[0], x[1], t) {
+            if s[2].abs() > EXACT_TOL * s_scale {
+                return Err(format!(
+                    "tangential traction sigma_12 = {:.3e} on the roller '{curve}' (should be 0)",
+                    s[2]
+                ));
             }
         }
     }
