@@ -672,11 +672,7 @@ fn exact_errors(
     let fields: Vec<SquaredNorms> = diffs.iter().map(|d| d.difference).collect();
     let reference: Vec<SquaredNorms> = diffs.iter().map(|d| d.exact).collect();
     let pressure: Vec<(f64, f64)> = diffs.iter().map(|d| d.pressure).collect();
-    let penetration = sol
-        .states
-        .iter()
-        .map(|s| metrics::max_penetration(&case.problem, s))
-        .fold(0.0f64, f64::max);
+    let penetration = history_penetration(case, sol);
     Differences {
         fields: &fields,
         reference: &reference,
@@ -685,6 +681,14 @@ fn exact_errors(
         reference_displacement: diffs.iter().map(|d| d.max_displacement).fold(0.0, f64::max),
     }
     .relative()
+}
+
+/// The largest interpenetration over a solution's history (length).
+fn history_penetration(case: &Case, sol: &Solution) -> f64 {
+    sol.states
+        .iter()
+        .map(|s| metrics::max_penetration(&case.problem, s))
+        .fold(0.0f64, f64::max)
 }
 
 /// The exact pressure and gap along Gamma_C at time `t`, where the solution gives them.
@@ -725,11 +729,7 @@ fn relative_errors(
     let pressure: Vec<(f64, f64)> = steps()
         .map(|(s, r)| error::pressure_difference(&case.problem, s, &rcase.problem, r))
         .collect();
-    let penetration = sol
-        .states
-        .iter()
-        .map(|s| metrics::max_penetration(&case.problem, s))
-        .fold(0.0f64, f64::max);
+    let penetration = history_penetration(case, sol);
     Differences {
         fields: &fields,
         reference: &reference.norms,
