@@ -9,6 +9,7 @@ use crate::io::{csv_bytes, fmt3};
 use crate::study::convergence::{RateRow, Source, StudyResult, join};
 use crate::study::file::Threshold;
 use crate::study::quantity::Quantity;
+use crate::study::rates::{self, Verdict};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -28,8 +29,11 @@ struct RateCsv {
     threshold: Option<f64>,
     pass: Option<bool>,
     rate_dofs: Option<f64>,
-    /// Successive rates, space separated.
+    /// Successive rates, space separated ("-" next to a level at round-off).
     successive: String,
+    /// What the errors support: fitted, pre-asymptotic, too few levels, not converging,
+    /// round-off.
+    verdict: &'static str,
 }
 
 impl RateCsv {
@@ -44,6 +48,7 @@ impl RateCsv {
             pass: r.pass,
             rate_dofs: r.rate_dofs,
             successive: successive(r),
+            verdict: r.verdict.name(),
         }
     }
 }
@@ -51,7 +56,7 @@ impl RateCsv {
 fn successive(r: &RateRow) -> String {
     r.successive
         .iter()
-        .map(|s| format!("{s:.3}"))
+        .map(|s| s.map_or("-".into(), |s| format!("{s:.3}")))
         .collect::<Vec<_>>()
         .join(" ")
 }
@@ -65,9 +70,13 @@ fn threshold_text(t: Threshold, digits: usize) -> String {
 }
 
 fn fmt_rate(r: &RateRow) -> String {
-    match r.fit {
-        Some(f) => format!("{:.3} ± {:.3}", f.rate, f.stderr),
-        None => "n/a".into(),
+    match (r.verdict, r.fit) {
+        (Verdict::Fitted, Some(f)) => format!("{:.3} ± {:.3}", f.rate, f.stderr),
+        (Verdict::PreAsymptotic, Some(f)) => format!("{:.3} ± {:.3} (pre-asymptotic)", f.rate, f.stderr),
+        (Verdict::RoundOff, _) => format!("exact (round-off, <= {:.0e})", rates::ROUNDOFF),
+        (Verdict::NotConverging, _) => "**does not converge**".into(),
+        (Verdict::TooFewLevels, _) => format!("no fit (< {} levels)", rates::MIN_FIT_LEVELS),
+        _ => "n/a".into(),
     }
 }
 
@@ -310,7 +319,7 @@ fn readme(res: &StudyResult) -> String {
     let _ = writeln!(s, "![error against h](error_vs_h.png)\n");
     let _ = writeln!(
         s,
-        "## Rates\n\nLeast-squares slope of log(error) against log(h) over the levels used (± standard error), rate against dofs, and successive rates between neighbouring levels. The `theorem` quantity is max_n (||u - u_ref||_H1 + ||sigma - sigma_ref||_L2) over both bodies, relative to the reference's; Theorem 3.1 predicts h^(3/4) for mortar (K_h^pi) and h^(1/2) for nts (K_h^I).\n"
+        "## Rates\n\nLeast-squares slope of log(error) against log(h) over the levels used (± standard error), rate against dofs, and successive rates between neighbouring levels. A rate never overstates: errors at round-off (<= 1e-10, the solvers' tolerance) are marked and never fitted (their successive rates are `-`), levels within 5x of the truth's own error in that quantity are left out, a rate needs at least 3 levels, a rate whose last two successive rates differ by more than 0.25 is flagged pre-asymptotic, and a quantity whose last two successive rates average below 0.15 is called non-converging and given no slope. The `theorem` quantity is max_n (||u - u_ref||_H1 + ||sigma - sigma_ref||_L2) over both bodies, relative to the reference's; Theorem 3.1 predicts h^(3/4) for mortar (K_h^pi) and h^(1/2) for nts (K_h^I).\n"
     );
     let _ = writeln!(
         s,
@@ -343,7 +352,13 @@ fn readme(res: &StudyResult) -> String {
             res.errors
                 .iter()
                 .find(|r| r.method == l.method && r.level == l.level && r.quantity == q)
-                .map(|r| format!("{:.3e}", r.error))
+                .map(|r| {
+                    if r.error <= rates::ROUNDOFF {
+                        format!("{:.3e} (round-off)", r.error)
+                    } else {
+                        format!("{:.3e}", r.error)
+                    }
+                })
                 .unwrap_or_default()
         };
         let wall = res
@@ -445,12 +460,13 @@ pub fn console(res: &StudyResult, dir: &Path) -> String {
     for r in &res.rates {
         let _ = writeln!(
             s,
-            "{:7} {:16} rate {:>6} +- {} (levels {}){}",
+            "{:7} {:16} rate {:>6} +- {} (levels {}) {}{}",
             r.method.name(),
             r.quantity.name(),
             fmt3(r.rate()),
             fmt3(r.stderr()),
             join(&r.levels_used),
+            r.verdict.name(),
             r.threshold
                 .map(|t| format!(
                     " threshold {}: {}",

@@ -19,7 +19,7 @@ use super::exact_error::{
 use super::file::{StudyFile, Threshold};
 use super::jobs::{self, Job, JobId, Mode, Progress, Solved};
 use super::quantity::{Differences, Quantity};
-use super::rates::{self, Fit};
+use super::rates::{self, Fit, LevelError, Verdict};
 use crate::analytical::{Exact, Field};
 use crate::case::Case;
 use crate::contact::Method;
@@ -61,18 +61,24 @@ pub struct RateRow {
     pub method: Method,
     /// Quantity.
     pub quantity: Quantity,
+    /// What the errors support: a rate, a flagged rate, or why there is none.
+    pub verdict: Verdict,
     /// Least-squares fit of log(error) against log(h), if the levels used allow one.
     pub fit: Option<Fit>,
-    /// Levels used in the fit.
+    /// Exactly the levels in the fit.
     pub levels_used: Vec<usize>,
+    /// Levels whose error is at round-off (never fitted).
+    pub roundoff_levels: Vec<usize>,
+    /// Levels left out for being within 5x of the truth's own error in this quantity.
+    pub near_truth_levels: Vec<usize>,
     /// What the error must satisfy (the `theorem` quantity only).
     pub threshold: Option<Threshold>,
     /// Whether it does.
     pub pass: Option<bool>,
     /// Rate against dofs (error ~ dofs^-rate_dofs).
     pub rate_dofs: Option<f64>,
-    /// Successive rates between neighbouring levels (all levels).
-    pub successive: Vec<f64>,
+    /// Successive rates between neighbouring levels; None where either is at round-off.
+    pub successive: Vec<Option<f64>>,
 }
 
 impl RateRow {
@@ -483,6 +489,8 @@ struct ReferenceSolution {
     /// Largest |u| over the history (length).
     max_displacement: f64,
     facts: Reference,
+    /// Each quantity's estimated own error (the same nested-space model per quantity).
+    quantity_errors: BTreeMap<Quantity, f64>,
 }
 
 /// The estimated relative error of a reference R and the rate p of the model, from its
@@ -504,9 +512,6 @@ pub fn estimated_reference_error(d1: f64, d2: f64) -> (f64, f64) {
 fn reference(ids: [JobId; 3], solved: &mut Solved, level: usize) -> ReferenceSolution {
     let [coarser2, coarser1, finest] = ids.map(|id| solved.take(id));
     let (case, solution) = finest;
-    let d1 = super::theorem_distance(&coarser1.0, &coarser1.1, &case, &solution);
-    let d2 = super::theorem_distance(&coarser2.0, &coarser2.1, &case, &solution);
-    let (error, error_rate) = estimated_reference_error(d1, d2);
     let norms = solution
         .states
         .iter()
@@ -523,16 +528,28 @@ fn reference(ids: [JobId; 3], solved: &mut Solved, level: usize) -> ReferenceSol
         h: case.h,
         dofs: case.problem.model.n_free,
         wall_s: solution.wall_s,
-        error,
-        error_rate,
+        error: 0.0,
+        error_rate: 0.0,
     };
-    ReferenceSolution {
+    let mut reference = ReferenceSolution {
         case,
         solution,
         norms,
         max_displacement,
         facts,
+        quantity_errors: BTreeMap::new(),
+    };
+    // Every quantity's distances of the two coarser levels to the reference.
+    let d1 = relative_errors(&coarser1.0, &coarser1.1, &reference);
+    let d2 = relative_errors(&coarser2.0, &coarser2.1, &reference);
+    for q in Quantity::ALL {
+        let (error, rate) = estimated_reference_error(d1[&q], d2[&q]);
+        if q == Quantity::Theorem {
+            (reference.facts.error, reference.facts.error_rate) = (error, rate);
+        }
+        reference.quantity_errors.insert(q, if d1[&q] > 0.0 { error } else { 0.0 });
     }
+    reference
 }
 
 /// What the levels are measured against.
@@ -552,10 +569,15 @@ impl Truth<'_> {
         }
     }
 
-    /// The estimated error of the truth (0 for the exact solution).
+    /// The estimated error of the truth in the theorem norm (0 for the exact solution).
     fn error(&self) -> f64 {
+        self.quantity_error(Quantity::Theorem)
+    }
+
+    /// The estimated error of the truth in quantity `q` (0 for the exact solution).
+    fn quantity_error(&self, q: Quantity) -> f64 {
         match self {
-            Truth::Solved(r) => r.facts.error,
+            Truth::Solved(r) => r.quantity_errors[&q],
             Truth::Exact(..) => 0.0,
         }
     }
@@ -803,15 +825,10 @@ fn deformed(case: &Case, sol: &Solution, method: Method, magnification: f64) -> 
     }
 }
 
-/// Step 4: rates of every quantity of every cone over its unflagged levels (all levels for
-/// a method that must be exact), and the thresholds of the `theorem` quantity.
-fn fit_rates(sf: &StudyFile, measured: &Measured) -> Vec<RateRow> {
-    let flagged = |method: Method, level: usize| {
-        measured
-            .levels
-            .iter()
-            .any(|l| l.method == method && l.level == level && l.flagged)
-    };
+/// Step 4: every quantity of every cone judged over its levels ([`rates::assess`]: no rate
+/// on round-off, on levels within 5x of the truth's own error in that quantity, on fewer
+/// than three levels, or for a quantity that stops converging), and the thresholds.
+fn fit_rates(sf: &StudyFile, measured: &Measured, truth: &Truth) -> Vec<RateRow> {
     let mut out = Vec::new();
     for &method in &sf.methods {
         let threshold = sf.thresholds.of(method);
@@ -821,37 +838,33 @@ fn fit_rates(sf: &StudyFile, measured: &Measured) -> Vec<RateRow> {
                 .iter()
                 .filter(|r| r.method == method && r.quantity == quantity)
                 .collect();
-            let exact = matches!(threshold, Threshold::Exact(_));
-            let used: Vec<&ErrorRow> = rows
+            let levels: Vec<LevelError> = rows
                 .iter()
-                .copied()
-                .filter(|r| exact || !flagged(method, r.level))
+                .map(|r| LevelError {
+                    level: r.level,
+                    h: r.h,
+                    dofs: r.dofs as f64,
+                    error: r.error,
+                })
                 .collect();
-            let column = |rows: &[&ErrorRow], f: fn(&ErrorRow) -> f64| -> Vec<f64> {
-                rows.iter().map(|r| f(r)).collect()
-            };
-            let errors = column(&used, |r| r.error);
-            let fit = rates::fit(&column(&used, |r| r.h), &errors);
-            let fit_dofs = rates::fit(&column(&used, |r| r.dofs as f64), &errors);
+            let a = rates::assess(&levels, truth.quantity_error(quantity));
             let threshold = (quantity == sf.thresholds.quantity).then_some(threshold);
             let pass = threshold.map(|t| match t {
-                Threshold::Exact(bound) => {
-                    column(&rows, |r| r.error)
-                        .into_iter()
-                        .fold(0.0f64, f64::max)
-                        <= bound
-                }
-                Threshold::Rate(rate) => used.len() >= 3 && fit.is_some_and(|f| f.rate >= rate),
+                Threshold::Exact(bound) => rows.iter().map(|r| r.error).fold(0.0f64, f64::max) <= bound,
+                Threshold::Rate(rate) => a.used.len() >= rates::MIN_FIT_LEVELS && a.fit.is_some_and(|f| f.rate >= rate),
             });
             out.push(RateRow {
                 method,
                 quantity,
-                fit,
-                levels_used: used.iter().map(|r| r.level).collect(),
+                verdict: a.verdict,
+                fit: a.fit,
+                levels_used: a.used,
+                roundoff_levels: a.roundoff,
+                near_truth_levels: a.near_truth,
                 threshold,
                 pass,
-                rate_dofs: fit_dofs.map(|f| -f.rate),
-                successive: rates::successive(&column(&rows, |r| r.h), &column(&rows, |r| r.error)),
+                rate_dofs: a.fit_dofs.map(|f| -f.rate),
+                successive: a.successive,
             });
         }
     }
@@ -958,7 +971,7 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
     };
     let profile_level = sf.mesh.levels[sf.mesh.levels.len() / 2];
     let measured = measure_levels(sf, &plan, &mut solved, &truth, profile_level)?;
-    let rates = fit_rates(sf, &measured);
+    let rates = fit_rates(sf, &measured, &truth);
     let time_study = time_study(sf, &plan, &mut solved);
     let (reference, exact_quadrature, mesh, warnings) = match &truth {
         Truth::Solved(r) => (
