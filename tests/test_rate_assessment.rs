@@ -35,7 +35,11 @@ fn round_off_levels_are_marked_and_never_fitted() {
     // Level 1 at round-off (nts max_penetration of `rates` at level 1: 3.9e-17).
     let a = assess(&table(&[1e-2, 3.9e-17, 2.5e-3, 1.25e-3]), 0.0);
     assert_eq!(a.roundoff, vec![1]);
-    assert_eq!(a.used, vec![0, 2, 3], "levels used are exactly the fitted ones");
+    assert_eq!(
+        a.used,
+        vec![0, 2, 3],
+        "levels used are exactly the fitted ones"
+    );
     assert_eq!(a.successive[0], None);
     assert_eq!(a.successive[1], None);
     assert!((a.successive[2].unwrap() - 1.0).abs() < 1e-12);

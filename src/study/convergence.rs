@@ -12,6 +12,7 @@
 //! 5. the rate in time on a fixed mesh;
 //! 6. the provenance.
 
+use super::contact_error::{self, ContactStep, TruthPressure, contact_step, reference_profile};
 use super::error::{self, Comparison, SquaredNorms};
 use super::exact_error::{
     ExactComparison, ExactDifference, exact_profiles, max_exact_displacement,
@@ -248,6 +249,8 @@ pub struct StudyResult {
     pub deformed: Vec<DeformedMesh>,
     /// The time study, if the study file asks for one.
     pub time_study: Option<TimeStudy>,
+    /// The variant families (alignment of the contact edge), if any.
+    pub variants: Vec<Variant>,
     /// gmsh version, .geo hash, solver, cores, commit.
     pub provenance: BTreeMap<String, String>,
     /// Total wall time (s).
@@ -331,9 +334,17 @@ impl Study {
 fn needs(q: Quantity) -> &'static [Field] {
     match q {
         Quantity::Theorem => &[Field::Displacement, Field::Stress],
-        Quantity::H1U | Quantity::L2U | Quantity::MaxPenetration => &[Field::Displacement],
+        Quantity::H1U | Quantity::L2U => &[Field::Displacement],
+        // The truth has no penetration; without an exact displacement the study's own
+        // largest displacement makes it relative.
+        Quantity::MaxPenetration | Quantity::L2Penetration => &[],
         Quantity::L2Stress => &[Field::Stress],
-        Quantity::L2Pressure => &[Field::Pressure],
+        Quantity::L2Pressure
+        | Quantity::ContactEdge
+        | Quantity::PressureResultant
+        | Quantity::PressureWeighted
+        | Quantity::PressureOscillation => &[Field::Pressure],
+        Quantity::BandStress => &[Field::Stress],
     }
 }
 
@@ -375,6 +386,8 @@ struct Plan {
     reference: Option<[JobId; 3]>,
     /// Every cone on every study level, cone by cone.
     levels: Vec<(Method, usize, JobId)>,
+    /// The variant families: their coarsest size and their levels like `levels`.
+    variants: Vec<(f64, Vec<(Method, usize, JobId)>)>,
     /// The time study: its reference, then one run per step count.
     time: Option<(JobId, Vec<(usize, JobId)>)>,
 }
@@ -428,6 +441,18 @@ impl Plan {
                 levels.push((method, level, id));
             }
         }
+        let mut variants = Vec::new();
+        for &coarsest in &sf.mesh.variants {
+            let params = sf.variant_parameters(coarsest);
+            let mut runs = Vec::new();
+            for &method in &sf.methods {
+                for &level in &sf.mesh.levels {
+                    let label = format!("{method} level {level} (family {coarsest})");
+                    runs.push((method, level, add(label, method, level, &params, sf.steps)));
+                }
+            }
+            variants.push((coarsest, runs));
+        }
         let time = sf.time.as_ref().map(|ts| {
             let method = sf.methods[0];
             let reference = add(
@@ -475,6 +500,7 @@ impl Plan {
             jobs,
             reference,
             levels,
+            variants,
             time,
         })
     }
@@ -547,7 +573,9 @@ fn reference(ids: [JobId; 3], solved: &mut Solved, level: usize) -> ReferenceSol
         if q == Quantity::Theorem {
             (reference.facts.error, reference.facts.error_rate) = (error, rate);
         }
-        reference.quantity_errors.insert(q, if d1[&q] > 0.0 { error } else { 0.0 });
+        reference
+            .quantity_errors
+            .insert(q, if d1[&q] > 0.0 { error } else { 0.0 });
     }
     reference
 }
@@ -648,24 +676,8 @@ fn measure_levels(
     };
     for ((method, level, case, sol), errors) in runs.iter().zip(&all_errors) {
         let (method, level) = (*method, *level);
-        for &quantity in &sf.quantities {
-            let error = errors[&quantity];
-            if !error.is_finite() {
-                return Err(Error::NotConverged(format!(
-                    "{method} level {level}: the {quantity} error is not finite"
-                )));
-            }
-            out.errors.push(ErrorRow {
-                method,
-                level,
-                h: case.h,
-                dofs: case.problem.model.n_free,
-                steps: sf.steps,
-                quantity,
-                error,
-                wall_s: sol.wall_s,
-            });
-        }
+        out.errors
+            .extend(error_rows(sf, method, case, sol, errors)?);
         let flagged = errors[&Quantity::Theorem] < 5.0 * truth.error();
         out.levels.push(level_info(case, sol, method, flagged));
         if level == profile_level {
@@ -673,6 +685,83 @@ fn measure_levels(
             out.deformed
                 .push(deformed(case, sol, method, magnification));
         }
+    }
+    Ok(out)
+}
+
+/// The rows of errors.csv of one solved level: the study's quantities, each finite.
+fn error_rows(
+    sf: &StudyFile,
+    method: Method,
+    case: &Case,
+    sol: &Solution,
+    errors: &BTreeMap<Quantity, f64>,
+) -> Result<Vec<ErrorRow>> {
+    sf.quantities
+        .iter()
+        .map(|&quantity| {
+            let error = errors[&quantity];
+            if !error.is_finite() {
+                return Err(Error::NotConverged(format!(
+                    "{method} level {}: the {quantity} error is not finite",
+                    case.level
+                )));
+            }
+            Ok(ErrorRow {
+                method,
+                level: case.level,
+                h: case.h,
+                dofs: case.problem.model.n_free,
+                steps: sf.steps,
+                quantity,
+                error,
+                wall_s: sol.wall_s,
+            })
+        })
+        .collect()
+}
+
+/// A variant family: its coarsest size, its errors and its judged rates.
+#[derive(Debug, Clone)]
+pub struct Variant {
+    /// Size of body 1 at level 0 (length).
+    pub coarsest: f64,
+    /// Errors per method, level and quantity.
+    pub errors: Vec<ErrorRow>,
+    /// Rates per method and quantity.
+    pub rates: Vec<RateRow>,
+}
+
+/// Step 3b: the variant families, measured against the same truth.
+fn measure_variants(
+    sf: &StudyFile,
+    plan: &Plan,
+    solved: &mut Solved,
+    truth: &Truth,
+) -> Result<Vec<Variant>> {
+    let mut out = Vec::new();
+    for (coarsest, runs) in &plan.variants {
+        let taken: Vec<(Method, Case, Solution)> = runs
+            .iter()
+            .map(|&(method, _, id)| {
+                let (case, sol) = solved.take(id);
+                (method, case, sol)
+            })
+            .collect();
+        let all_errors: Vec<BTreeMap<Quantity, f64>> = taken
+            .par_iter()
+            .map(|(_, case, sol)| truth.relative_errors(case, sol))
+            .collect();
+        let mut errors = Vec::new();
+        for ((method, case, sol), e) in taken.iter().zip(&all_errors) {
+            errors.extend(error_rows(sf, *method, case, sol, e)?);
+        }
+        let rates = fit_rates(sf, &errors, truth);
+        out.push(Variant {
+            coarsest: *coarsest,
+            errors,
+            rates,
+        });
     }
     Ok(out)
 }
@@ -694,13 +783,30 @@ fn exact_errors(
     let fields: Vec<SquaredNorms> = diffs.iter().map(|d| d.difference).collect();
     let reference: Vec<SquaredNorms> = diffs.iter().map(|d| d.exact).collect();
     let pressure: Vec<(f64, f64)> = diffs.iter().map(|d| d.pressure).collect();
+    let band_stress: Vec<(f64, f64)> = diffs.iter().map(|d| d.band_stress).collect();
+    let contact: Vec<ContactStep> = sol
+        .states
+        .iter()
+        .skip(1)
+        .map(|s| contact_step(&case.problem, s, &TruthPressure::Exact(exact, s.time)))
+        .collect();
     let penetration = history_penetration(case, sol);
     Differences {
         fields: &fields,
         reference: &reference,
         pressure: &pressure,
         penetration,
-        reference_displacement: diffs.iter().map(|d| d.max_displacement).fold(0.0, f64::max),
+        reference_displacement: match exact.displacement {
+            Some(_) => diffs.iter().map(|d| d.max_displacement).fold(0.0, f64::max),
+            None => sol
+                .states
+                .iter()
+                .map(|s| inf_norm(&s.u))
+                .fold(0.0, f64::max),
+        },
+        contact: &contact,
+        band_stress: &band_stress,
+        contact_length: case.problem.interface.length(),
     }
     .relative()
 }
@@ -751,6 +857,14 @@ fn relative_errors(
     let pressure: Vec<(f64, f64)> = steps()
         .map(|(s, r)| error::pressure_difference(&case.problem, s, &rcase.problem, r))
         .collect();
+    let band = contact_error::band(&case.problem);
+    let band_stress: Vec<(f64, f64)> = steps().map(|(s, r)| cmp.band_stress(s, r, &band)).collect();
+    let contact: Vec<ContactStep> = steps()
+        .map(|(s, r)| {
+            let truth = reference_profile(&case.problem.interface, &rcase.problem, r);
+            contact_step(&case.problem, s, &truth)
+        })
+        .collect();
     let penetration = history_penetration(case, sol);
     Differences {
         fields: &fields,
@@ -758,6 +872,9 @@ fn relative_errors(
         pressure: &pressure,
         penetration,
         reference_displacement: reference.max_displacement,
+        contact: &contact,
+        band_stress: &band_stress,
+        contact_length: case.problem.interface.length(),
     }
     .relative()
 }
@@ -828,13 +945,12 @@ fn deformed(case: &Case, sol: &Solution, method: Method, magnification: f64) -> 
 /// Step 4: every quantity of every cone judged over its levels ([`rates::assess`]: no rate
 /// on round-off, on levels within 5x of the truth's own error in that quantity, on fewer
 /// than three levels, or for a quantity that stops converging), and the thresholds.
-fn fit_rates(sf: &StudyFile, measured: &Measured, truth: &Truth) -> Vec<RateRow> {
+fn fit_rates(sf: &StudyFile, errors: &[ErrorRow], truth: &Truth) -> Vec<RateRow> {
     let mut out = Vec::new();
     for &method in &sf.methods {
         let threshold = sf.thresholds.of(method);
         for &quantity in &sf.quantities {
-            let rows: Vec<&ErrorRow> = measured
-                .errors
+            let rows: Vec<&ErrorRow> = errors
                 .iter()
                 .filter(|r| r.method == method && r.quantity == quantity)
                 .collect();
@@ -850,8 +966,12 @@ fn fit_rates(sf: &StudyFile, measured: &Measured, truth: &Truth) -> Vec<RateRow>
             let a = rates::assess(&levels, truth.quantity_error(quantity));
             let threshold = (quantity == sf.thresholds.quantity).then_some(threshold);
             let pass = threshold.map(|t| match t {
-                Threshold::Exact(bound) => rows.iter().map(|r| r.error).fold(0.0f64, f64::max) <= bound,
-                Threshold::Rate(rate) => a.used.len() >= rates::MIN_FIT_LEVELS && a.fit.is_some_and(|f| f.rate >= rate),
+                Threshold::Exact(bound) => {
+                    rows.iter().map(|r| r.error).fold(0.0f64, f64::max) <= bound
+                }
+                Threshold::Rate(rate) => {
+                    a.used.len() >= rates::MIN_FIT_LEVELS && a.fit.is_some_and(|f| f.rate >= rate)
+                }
             });
             out.push(RateRow {
                 method,
@@ -971,7 +1091,8 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
     };
     let profile_level = sf.mesh.levels[sf.mesh.levels.len() / 2];
     let measured = measure_levels(sf, &plan, &mut solved, &truth, profile_level)?;
-    let rates = fit_rates(sf, &measured, &truth);
+    let rates = fit_rates(sf, &measured.errors, &truth);
+    let variants = measure_variants(sf, &plan, &mut solved, &truth)?;
     let time_study = time_study(sf, &plan, &mut solved);
     let (reference, exact_quadrature, mesh, warnings) = match &truth {
         Truth::Solved(r) => (
@@ -1002,6 +1123,7 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
         profile_level,
         deformed: measured.deformed,
         time_study,
+        variants,
         provenance,
         wall_s: t0.elapsed().as_secs_f64(),
         warnings,

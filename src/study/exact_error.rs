@@ -30,6 +30,8 @@ pub struct ExactDifference {
     pub pressure: (f64, f64),
     /// Largest |u| component of the exact solution at the mesh's nodes.
     pub max_displacement: f64,
+    /// (||sigma - sigma_ex||^2, ||sigma_ex||^2) on the band of triangles touching Gamma_C.
+    pub band_stress: (f64, f64),
 }
 
 fn tensor_norm2(s: [f64; 3]) -> f64 {
@@ -54,6 +56,7 @@ impl<'a> ExactComparison<'a> {
             pressure: self.pressure_difference(p, s),
             ..Default::default()
         };
+        let band = super::contact_error::band(p);
         for (i, el) in m.elements.iter().enumerate() {
             let b = el.body;
             let pos = el.nodes.map(|n| m.position(n));
@@ -85,8 +88,16 @@ impl<'a> ExactComparison<'a> {
                     }
                 }
                 if let Some(se) = ex.stress_at(b, x[0], x[1], t) {
-                    out.difference.stress += w * tensor_norm2([0, 1, 2].map(|k| sh[k] - se[k]));
-                    out.exact.stress += w * tensor_norm2(se);
+                    let (d, n) = (
+                        tensor_norm2([0, 1, 2].map(|k| sh[k] - se[k])),
+                        tensor_norm2(se),
+                    );
+                    out.difference.stress += w * d;
+                    out.exact.stress += w * n;
+                    if band[i] {
+                        out.band_stress.0 += w * d;
+                        out.band_stress.1 += w * n;
+                    }
                 }
             }
         }

@@ -22,6 +22,11 @@ pub struct MeshSpec {
     pub ratio: f64,
     /// Refinement levels of the study (each splits every triangle in four).
     pub levels: Vec<usize>,
+    /// Coarsest sizes of body 1 of further families (same ratio and levels), solved and
+    /// measured like the main one: they put the contact edge elsewhere relative to the
+    /// nodes, so the spread of their rates measures the alignment effect.
+    #[serde(default)]
+    pub variants: Vec<f64>,
     /// Other gmsh parameters.
     #[serde(default)]
     pub parameters: BTreeMap<String, f64>,
@@ -238,6 +243,17 @@ impl StudyFile {
                 format!("the mesh size must be positive, got {}", s.mesh.coarsest),
             );
         }
+        if let Some(v) = s
+            .mesh
+            .variants
+            .iter()
+            .find(|&&v| !(v > 0.0 && v.is_finite()) || v == s.mesh.coarsest)
+        {
+            return bad(
+                "mesh.variants",
+                format!("{v} is not a positive size other than mesh.coarsest; fix the value"),
+            );
+        }
         if !(s.mesh.ratio > 0.0 && s.mesh.ratio.is_finite()) {
             return bad(
                 "mesh.ratio",
@@ -309,16 +325,21 @@ impl StudyFile {
 
     /// gmsh parameters of the study family.
     pub fn family_parameters(&self) -> Vec<(String, f64)> {
+        self.variant_parameters(self.mesh.coarsest)
+    }
+
+    /// gmsh parameters of the family whose body 1 has size `coarsest` at level 0.
+    pub fn variant_parameters(&self, coarsest: f64) -> Vec<(String, f64)> {
         let mut v: Vec<(String, f64)> = self
             .mesh
             .parameters
             .iter()
             .map(|(k, v)| (k.clone(), *v))
             .collect();
-        v.push((self.mesh.size_parameter_1.clone(), self.mesh.coarsest));
+        v.push((self.mesh.size_parameter_1.clone(), coarsest));
         v.push((
             self.mesh.size_parameter_2.clone(),
-            self.mesh.coarsest / self.mesh.ratio,
+            coarsest / self.mesh.ratio,
         ));
         v
     }

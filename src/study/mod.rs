@@ -9,6 +9,7 @@
 //! [`Kind`] names them; [`Kind::run`] runs one and gives its [`Outcome`], which
 //! [`crate::report`] writes.
 
+pub mod contact_error;
 pub mod convergence;
 pub mod error;
 pub mod exact_error;

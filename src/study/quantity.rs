@@ -1,6 +1,7 @@
 //! The quantities a convergence study measures, each a relative error of one time history
 //! against the reference's (max over the time steps).
 
+use super::contact_error::ContactStep;
 use super::error::SquaredNorms;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -27,18 +28,65 @@ pub enum Quantity {
     /// Largest interpenetration over the history, relative to max |u_ref|.
     #[serde(rename = "max_penetration")]
     MaxPenetration,
+    /// max_n ||sigma - sigma_ref||_L2 over the triangles touching Gamma_C, relative to the
+    /// reference's stress norm over both bodies: a consistency error of fixed size in the
+    /// one-element layer then shows as h^(1/2) (relative to the band's own norm, which
+    /// shrinks like h^(1/2) too, it would not converge at all).
+    #[serde(rename = "band_stress")]
+    BandStress,
+    /// Largest distance of a contact edge of the truth to the nearest discrete one, relative
+    /// to the length of Gamma_C.
+    #[serde(rename = "contact_edge")]
+    ContactEdge,
+    /// max_n |int p - int p_ref| / max_n int |p_ref|: the resultant contact force.
+    #[serde(rename = "pressure_resultant")]
+    PressureResultant,
+    /// max_n ||h^(1/2) (p - p_ref)||_L2(Gamma_C) / (|Gamma_C|^(1/2) max_n ||p_ref||): the
+    /// discrete stand-in for H^(-1/2) (one half order above the L2 rate).
+    #[serde(rename = "pressure_weighted")]
+    PressureWeighted,
+    /// max_n |TV(p) - TV(p_ref)| / max_n max(TV(p_ref), max |p_ref|): oscillation of the
+    /// pressure (the second scale keeps it defined for a constant truth).
+    #[serde(rename = "pressure_oscillation")]
+    PressureOscillation,
+    /// max_n ||[u.nu]^+||_L2(Gamma_C), relative to |Gamma_C|^(1/2) max |u_ref|.
+    #[serde(rename = "l2_penetration")]
+    L2Penetration,
 }
 
 impl Quantity {
     /// Every quantity, in the order reports list them.
-    pub const ALL: [Quantity; 6] = [
+    pub const ALL: [Quantity; 12] = [
         Quantity::Theorem,
         Quantity::H1U,
         Quantity::L2U,
         Quantity::L2Stress,
         Quantity::L2Pressure,
         Quantity::MaxPenetration,
+        Quantity::BandStress,
+        Quantity::ContactEdge,
+        Quantity::PressureResultant,
+        Quantity::PressureWeighted,
+        Quantity::PressureOscillation,
+        Quantity::L2Penetration,
     ];
+
+    /// The quantities measured on Gamma_C and next to it, where the cones differ.
+    pub const CONTACT: [Quantity; 8] = [
+        Quantity::BandStress,
+        Quantity::ContactEdge,
+        Quantity::L2Pressure,
+        Quantity::PressureWeighted,
+        Quantity::PressureResultant,
+        Quantity::PressureOscillation,
+        Quantity::MaxPenetration,
+        Quantity::L2Penetration,
+    ];
+
+    /// Whether it is measured on Gamma_C or next to it.
+    pub fn is_contact(self) -> bool {
+        Self::CONTACT.contains(&self)
+    }
 
     /// Name in study files and reports.
     pub fn name(self) -> &'static str {
@@ -49,6 +97,12 @@ impl Quantity {
             Quantity::L2Stress => "l2_stress",
             Quantity::L2Pressure => "l2_pressure",
             Quantity::MaxPenetration => "max_penetration",
+            Quantity::BandStress => "band_stress",
+            Quantity::ContactEdge => "contact_edge",
+            Quantity::PressureResultant => "pressure_resultant",
+            Quantity::PressureWeighted => "pressure_weighted",
+            Quantity::PressureOscillation => "pressure_oscillation",
+            Quantity::L2Penetration => "l2_penetration",
         }
     }
 }
@@ -84,6 +138,12 @@ pub struct Differences<'a> {
     pub penetration: f64,
     /// Largest |u_ref| over the history (length).
     pub reference_displacement: f64,
+    /// Gamma_C's quantities per step.
+    pub contact: &'a [ContactStep],
+    /// (||sigma - sigma_ref||^2, ||sigma_ref||^2) on the band per step.
+    pub band_stress: &'a [(f64, f64)],
+    /// The length of Gamma_C.
+    pub contact_length: f64,
 }
 
 impl Differences<'_> {
@@ -106,7 +166,46 @@ impl Differences<'_> {
             .iter()
             .map(|p| p.1.sqrt())
             .fold(0.0f64, f64::max);
+        let max =
+            |f: &dyn Fn(&ContactStep) -> f64| self.contact.iter().map(f).fold(0.0f64, f64::max);
+        let ratio = |a: f64, b: f64| a / b.max(f64::MIN_POSITIVE);
+        let band = self
+            .band_stress
+            .iter()
+            .map(|b| b.0.sqrt())
+            .fold(0.0f64, f64::max);
+        let p_norm = pressure_ref * self.contact_length.sqrt();
         BTreeMap::from([
+            (
+                Quantity::BandStress,
+                ratio(band, max_over(&|n| n.stress.sqrt(), self.reference)),
+            ),
+            (
+                Quantity::ContactEdge,
+                max(&|c| c.edge) / self.contact_length,
+            ),
+            (
+                Quantity::PressureResultant,
+                ratio(max(&|c| c.resultant.0.abs()), max(&|c| c.resultant.1)),
+            ),
+            (
+                Quantity::PressureWeighted,
+                ratio(max(&|c| c.pressure_weighted.sqrt()), p_norm),
+            ),
+            (
+                Quantity::PressureOscillation,
+                ratio(
+                    max(&|c| (c.variation.0 - c.variation.1).abs()),
+                    max(&|c| c.variation.1.max(c.pressure_max)),
+                ),
+            ),
+            (
+                Quantity::L2Penetration,
+                ratio(
+                    max(&|c| c.penetration_l2.sqrt()),
+                    self.contact_length.sqrt() * self.reference_displacement,
+                ),
+            ),
             (Quantity::Theorem, rel(&|n| n.theorem())),
             (Quantity::H1U, rel(&|n| n.h1())),
             (Quantity::L2U, rel(&|n| n.l2_u.sqrt())),

@@ -137,7 +137,11 @@ pub struct Assessment {
 /// on levels too close to the truth, on fewer than three levels, or of a stalled quantity.
 pub fn assess(levels: &[LevelError], truth_error: f64) -> Assessment {
     let at_roundoff = |e: &LevelError| e.error <= ROUNDOFF;
-    let roundoff: Vec<usize> = levels.iter().filter(|e| at_roundoff(e)).map(|e| e.level).collect();
+    let roundoff: Vec<usize> = levels
+        .iter()
+        .filter(|e| at_roundoff(e))
+        .map(|e| e.level)
+        .collect();
     let near_truth: Vec<usize> = levels
         .iter()
         .filter(|e| !at_roundoff(e) && e.error < TRUTH_MARGIN * truth_error)

@@ -1,0 +1,368 @@
+//! The quantities that tell the two cones apart: what happens on Gamma_C. For one state of
+//! a study solution against the truth (a reference solve's profile, or the exact solution)
+//! at the same time:
+//! - the pressure (beside its L2(Gamma_C) error, in [`super::error`]) in the h^(1/2)-weighted L2 norm (the discrete stand-in for
+//!   H^(-1/2), where mortar theory bounds the multiplier), its resultant, and its total
+//!   variation (oscillation);
+//! - the contact edges: the transition points between contact and separation;
+//! - the L2(Gamma_C) norm of the positive part of the normal jump (penetration).
+//!
+//! A discrete pressure is linear between the body-1 nodes (nodal multiplier over lumped
+//! weight). Integrals run over the merged breakpoints of the study's and the truth's traces
+//! with 8 Gauss points per piece: exact for the piecewise-linear truth of a reference, and
+//! far below the errors measured for a smooth exact pressure.
+
+use super::error::pressure_profile;
+use crate::analytical::Exact;
+use crate::contact::{Interface, Piece};
+use crate::quadrature::gauss_legendre;
+use crate::solve::{Problem, State};
+
+/// The truth's pressure on the study's pieces of Gamma_C.
+pub enum TruthPressure<'a> {
+    /// A reference's nodal pressure (piecewise linear) on each study piece, (s, p) sorted,
+    /// and its nodal gap -[u.nu] at its body-1 nodes, (s, gap) sorted.
+    Profile(Vec<Vec<(f64, f64)>>, Vec<Vec<(f64, f64)>>),
+    /// The exact solution at time `t`.
+    Exact(&'a Exact, f64),
+}
+
+/// What one state measured on Gamma_C (squared norms where a norm is named).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ContactStep {
+    /// sum_e h_e ||p_h - p||^2_e over the study's body-1 segments e.
+    pub pressure_weighted: f64,
+    /// (int p_h - int p, int |p|).
+    pub resultant: (f64, f64),
+    /// (TV(p_h), TV(p)): total variations along Gamma_C.
+    pub variation: (f64, f64),
+    /// max |p| of the truth (the scale of the oscillation when the truth is constant).
+    pub pressure_max: f64,
+    /// Largest distance of a truth's contact edge to the nearest discrete one (length;
+    /// the length of Gamma_C when the discrete solution has none, 0 when neither has).
+    pub edge: f64,
+    /// ||[u.nu]^+||^2 in L2(Gamma_C) (length^3).
+    pub penetration_l2: f64,
+}
+
+/// The abscissa of `x` along `piece` and its distance off the piece's line.
+fn on_piece(piece: &Piece, x: [f64; 2]) -> (f64, f64) {
+    let d = [x[0] - piece.a[0], x[1] - piece.a[1]];
+    (
+        d[0] * piece.tangent[0] + d[1] * piece.tangent[1],
+        (d[0] * piece.normal[0] + d[1] * piece.normal[1]).abs(),
+    )
+}
+
+/// The reference's nodal pressure and gap projected on each study piece (points within 1e-9
+/// of the piece's length), sorted and deduplicated.
+pub fn reference_profile(
+    study: &Interface,
+    reference: &Problem,
+    r: &State,
+) -> TruthPressure<'static> {
+    let pressure = project(study, &pressure_profile(reference, r).concat());
+    let gap = project(study, &slave_gaps(reference, r));
+    TruthPressure::Profile(pressure, gap)
+}
+
+/// The gap -[u.nu] at the body-1 nodes of every piece, as (position, gap).
+fn slave_gaps(p: &Problem, s: &State) -> Vec<([f64; 2], f64)> {
+    let jumps = crate::contact::normal_jumps(&p.interface, &s.u);
+    let mut out = Vec::new();
+    for (pi, piece) in p.interface.pieces.iter().enumerate() {
+        // normal_jumps lists a piece's body-1 nodes first, in order.
+        for j in jumps
+            .iter()
+            .filter(|j| j.0 == pi)
+            .take(piece.slave_nodes.len())
+        {
+            out.push((
+                [
+                    piece.a[0] + j.1 * piece.tangent[0],
+                    piece.a[1] + j.1 * piece.tangent[1],
+                ],
+                -j.2,
+            ));
+        }
+    }
+    out
+}
+
+/// Points (position, value) projected on each study piece, sorted and deduplicated.
+fn project(study: &Interface, points: &[([f64; 2], f64)]) -> Vec<Vec<(f64, f64)>> {
+    study
+        .pieces
+        .iter()
+        .map(|piece| {
+            let tol = 1e-9 * piece.length;
+            let mut f: Vec<(f64, f64)> = points
+                .iter()
+                .filter_map(|&(x, p)| {
+                    let (s, off) = on_piece(piece, x);
+                    (off <= tol && s >= -tol && s <= piece.length + tol)
+                        .then_some((s.clamp(0.0, piece.length), p))
+                })
+                .collect();
+            f.sort_by(|a, b| a.0.total_cmp(&b.0));
+            f.dedup_by(|a, b| (a.0 - b.0).abs() <= 1e-12 * piece.length);
+            f
+        })
+        .collect()
+}
+
+/// Linear interpolation of sorted points (constant beyond the ends).
+fn linear(f: &[(f64, f64)], s: f64) -> f64 {
+    if f.len() == 1 {
+        return f[0].1;
+    }
+    let k = f.partition_point(|p| p.0 <= s).clamp(1, f.len() - 1);
+    let (a, b) = (f[k - 1], f[k]);
+    let t = if b.0 > a.0 {
+        ((s - a.0) / (b.0 - a.0)).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    a.1 + t * (b.1 - a.1)
+}
+
+/// The contact edges of nodal pressure `p` and gap `g` along a piece: the zeros of
+/// phi = p / max p - g^+ / max g^+ (positive in contact, negative in separation, zero where
+/// both vanish), linear between the nodes of `p` (the gap interpolated there).
+pub fn edges(p: &[(f64, f64)], g: &[(f64, f64)]) -> Vec<f64> {
+    let pmax = p
+        .iter()
+        .fold(0.0f64, |m, q| m.max(q.1))
+        .max(f64::MIN_POSITIVE);
+    let gmax = g
+        .iter()
+        .fold(0.0f64, |m, q| m.max(q.1))
+        .max(f64::MIN_POSITIVE);
+    let phi: Vec<(f64, f64)> = p
+        .iter()
+        .map(|&(s, v)| {
+            let gap = if g.is_empty() {
+                0.0
+            } else {
+                linear(g, s).max(0.0)
+            };
+            (s, v.max(0.0) / pmax - gap / gmax)
+        })
+        .collect();
+    phi.windows(2)
+        .filter(|w| (w[0].1 > 0.0) != (w[1].1 > 0.0))
+        .map(|w| {
+            let ((s0, f0), (s1, f1)) = (w[0], w[1]);
+            if f0 == f1 {
+                0.5 * (s0 + s1)
+            } else {
+                s0 + (s1 - s0) * f0 / (f0 - f1)
+            }
+        })
+        .collect()
+}
+
+impl TruthPressure<'_> {
+    fn at(&self, piece_index: usize, piece: &Piece, s: f64) -> f64 {
+        match self {
+            TruthPressure::Profile(f, _) => linear(&f[piece_index], s),
+            TruthPressure::Exact(ex, t) => {
+                let x = [
+                    piece.a[0] + s * piece.tangent[0],
+                    piece.a[1] + s * piece.tangent[1],
+                ];
+                ex.pressure_at(piece.normal, x[0], x[1], *t)
+                    .unwrap_or(f64::NAN)
+            }
+        }
+    }
+
+    /// Breakpoints of the truth on a piece (none for a smooth exact pressure).
+    fn breakpoints(&self, piece_index: usize) -> Vec<f64> {
+        match self {
+            TruthPressure::Profile(f, _) => f[piece_index].iter().map(|p| p.0).collect(),
+            TruthPressure::Exact(..) => Vec::new(),
+        }
+    }
+
+    /// The truth's total variation along a piece, its largest |p| and its contact edges.
+    fn variation_and_edges(&self, piece_index: usize, piece: &Piece) -> (f64, f64, Vec<f64>) {
+        match self {
+            TruthPressure::Profile(f, g) => {
+                let f = &f[piece_index];
+                let scale = f.iter().fold(0.0f64, |m, p| m.max(p.1.abs()));
+                let tv = f.windows(2).map(|w| (w[1].1 - w[0].1).abs()).sum();
+                (tv, scale, edges(f, &g[piece_index]))
+            }
+            TruthPressure::Exact(ex, t) => {
+                // 2001 samples; an edge is a sign change of p / max p - gap / max gap (both
+                // vanish there: p on one side, the gap on the other), found by bisection.
+                let n = 2000;
+                let x_of = |s: f64| {
+                    [
+                        piece.a[0] + s * piece.tangent[0],
+                        piece.a[1] + s * piece.tangent[1],
+                    ]
+                };
+                let gap = |s: f64| {
+                    let x = x_of(s);
+                    match (
+                        ex.displacement_at(0, x[0], x[1], *t),
+                        ex.displacement_at(1, x[0], x[1], *t),
+                    ) {
+                        (Some(u1), Some(u2)) => {
+                            -((u1[0] - u2[0]) * piece.normal[0] + (u1[1] - u2[1]) * piece.normal[1])
+                        }
+                        _ => 0.0,
+                    }
+                };
+                let ss: Vec<f64> = (0..=n)
+                    .map(|k| piece.length * k as f64 / n as f64)
+                    .collect();
+                let ps: Vec<f64> = ss.iter().map(|&s| self.at(piece_index, piece, s)).collect();
+                let gs: Vec<f64> = ss.iter().map(|&s| gap(s)).collect();
+                let tv = ps.windows(2).map(|w| (w[1] - w[0]).abs()).sum();
+                let (pmax, gmax) = (
+                    ps.iter()
+                        .fold(0.0f64, |m, v| m.max(v.abs()))
+                        .max(f64::MIN_POSITIVE),
+                    gs.iter()
+                        .fold(0.0f64, |m, v| m.max(v.abs()))
+                        .max(f64::MIN_POSITIVE),
+                );
+                let phi = |s: f64| {
+                    let p = self.at(piece_index, piece, s);
+                    let p = if p > 1e-12 * pmax { p } else { 0.0 };
+                    p / pmax - gap(s) / gmax
+                };
+                let mut edges = Vec::new();
+                for k in 0..n {
+                    let (mut a, mut b) = (ss[k], ss[k + 1]);
+                    let (fa, fb) = (phi(a), phi(b));
+                    if fa > 0.0 && fb <= 0.0 || fa <= 0.0 && fb > 0.0 {
+                        for _ in 0..60 {
+                            let m = 0.5 * (a + b);
+                            if (phi(m) > 0.0) == (fa > 0.0) {
+                                a = m;
+                            } else {
+                                b = m;
+                            }
+                        }
+                        edges.push(0.5 * (a + b));
+                    }
+                }
+                (tv, pmax, edges)
+            }
+        }
+    }
+}
+
+/// Everything one state of the study measures on Gamma_C against the truth.
+pub fn contact_step(p: &Problem, s: &State, truth: &TruthPressure) -> ContactStep {
+    let gauss = gauss_legendre(8);
+    let mut out = ContactStep::default();
+    let total: f64 = p.interface.length();
+    let mut worst_edge = 0.0f64;
+    for (i, (piece, profile)) in p
+        .interface
+        .pieces
+        .iter()
+        .zip(pressure_profile(p, s))
+        .enumerate()
+    {
+        let ph: Vec<(f64, f64)> = profile
+            .iter()
+            .map(|&(x, v)| (on_piece(piece, x).0, v))
+            .collect();
+        let nodes: Vec<f64> = ph.iter().map(|q| q.0).collect();
+        let mut br: Vec<f64> = nodes.iter().copied().chain(truth.breakpoints(i)).collect();
+        br.sort_by(f64::total_cmp);
+        br.dedup_by(|a, b| (*a - *b).abs() <= 1e-14 * piece.length);
+        for w in br.windows(2) {
+            let len = w[1] - w[0];
+            if len <= 0.0 {
+                continue;
+            }
+            let mid = 0.5 * (w[0] + w[1]);
+            let e = (nodes.partition_point(|&v| v <= mid).max(1) - 1)
+                .min(nodes.len().saturating_sub(2));
+            let h_e = nodes.get(e + 1).map_or(len, |b| b - nodes[e]);
+            for &(q, wq) in &gauss {
+                let sq = w[0] + q * len;
+                let (a, b) = (linear(&ph, sq), truth.at(i, piece, sq));
+                let wl = wq * len;
+                out.pressure_weighted += h_e * wl * (a - b).powi(2);
+                out.resultant.0 += wl * (a - b);
+                out.resultant.1 += wl * b.abs();
+            }
+        }
+        out.variation.0 += ph.windows(2).map(|w| (w[1].1 - w[0].1).abs()).sum::<f64>();
+        let (tv, pmax, truth_edges) = truth.variation_and_edges(i, piece);
+        out.variation.1 += tv;
+        out.pressure_max = out.pressure_max.max(pmax);
+        let gh: Vec<(f64, f64)> = project(&p.interface, &slave_gaps(p, s)).swap_remove(i);
+        let discrete_edges = edges(&ph, &gh);
+        for a in &truth_edges {
+            let d = discrete_edges
+                .iter()
+                .map(|b| (b - a).abs())
+                .fold(f64::INFINITY, f64::min);
+            worst_edge = worst_edge.max(if d.is_finite() { d } else { total });
+        }
+        if truth_edges.is_empty() && !discrete_edges.is_empty() {
+            worst_edge = total;
+        }
+    }
+    out.edge = worst_edge;
+    out.penetration_l2 = penetration_l2(&p.interface, &s.u);
+    out
+}
+
+/// ||[u.nu]^+||^2 in L2(Gamma_C): the normal jump is linear between the merged trace
+/// nodes of both bodies; its positive part squared is integrated exactly.
+pub fn penetration_l2(interface: &Interface, u: &[f64]) -> f64 {
+    let jumps = crate::contact::normal_jumps(interface, u);
+    let mut total = 0.0;
+    for pi in 0..interface.pieces.len() {
+        let mut f: Vec<(f64, f64)> = jumps
+            .iter()
+            .filter(|j| j.0 == pi)
+            .map(|j| (j.1, j.2))
+            .collect();
+        f.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for w in f.windows(2) {
+            let ((s0, f0), (s1, f1)) = (w[0], w[1]);
+            let len = s1 - s0;
+            if len <= 0.0 {
+                continue;
+            }
+            total += if f0 >= 0.0 && f1 >= 0.0 {
+                len * (f0 * f0 + f0 * f1 + f1 * f1) / 3.0
+            } else if f0 > 0.0 {
+                // Positive on [s0, s0 + theta len], theta = f0 / (f0 - f1).
+                len * f0 / (f0 - f1) * f0 * f0 / 3.0
+            } else if f1 > 0.0 {
+                len * f1 / (f1 - f0) * f1 * f1 / 3.0
+            } else {
+                0.0
+            };
+        }
+    }
+    total
+}
+
+/// The triangles of both bodies with a node on Gamma_C: the band where node-on-segment's
+/// consistency error lives.
+pub fn band(p: &Problem) -> Vec<bool> {
+    let mut on = vec![false; p.model.n_nodes];
+    for piece in &p.interface.pieces {
+        for &n in piece.slave_nodes.iter().chain(&piece.master_nodes) {
+            on[n] = true;
+        }
+    }
+    p.model
+        .elements
+        .iter()
+        .map(|e| e.nodes.iter().any(|&n| on[n]))
+        .collect()
+}
