@@ -80,6 +80,14 @@ impl Expr {
             .unwrap_or(f64::NAN)
     }
 
+    /// Which branch of each `abs` the point (x, y, t) is on, as bits (0 without abs): where
+    /// two points differ, a kink of the expression lies between them.
+    pub fn branch(&self, x: f64, y: f64, t: f64) -> u64 {
+        self.signs.iter().enumerate().fold(0, |bits, (k, z)| {
+            bits | (((z.eval(x, y, t) < 0.0) as u64) << k)
+        })
+    }
+
     /// The exact partial derivative with respect to x (`var` 0), y (1) or t (2).
     pub fn partial(&self, var: usize) -> Expr {
         let name = NAMED[var];

@@ -52,3 +52,33 @@ pub fn triangle(n: usize) -> Vec<(f64, f64, f64)> {
     }
     rule
 }
+
+/// The rule of [`triangle`] on each of the m^2 congruent sub-triangles of the reference
+/// triangle (weights summing to 1): for integrands that are smooth only piecewise, such as
+/// exact fields with a kink inside the triangle.
+pub fn triangle_composite(n: usize, m: usize) -> Vec<(f64, f64, f64)> {
+    let base = triangle(n);
+    let h = 1.0 / m as f64;
+    let mut rule = Vec::with_capacity(base.len() * m * m);
+    for i in 0..m {
+        for j in 0..m - i {
+            // Upward sub-triangle (i, j), (i+1, j), (i, j+1), and the downward one beside it.
+            let mut corners = vec![[[i, j], [i + 1, j], [i, j + 1]]];
+            if i + j + 1 < m {
+                corners.push([[i + 1, j], [i + 1, j + 1], [i, j + 1]]);
+            }
+            for c in corners {
+                let p = c.map(|[a, b]| [a as f64 * h, b as f64 * h]);
+                for &(l1, l2, w) in &base {
+                    let l0 = 1.0 - l1 - l2;
+                    rule.push((
+                        l0 * p[0][0] + l1 * p[1][0] + l2 * p[2][0],
+                        l0 * p[0][1] + l1 * p[1][1] + l2 * p[2][1],
+                        w / (m * m) as f64,
+                    ));
+                }
+            }
+        }
+    }
+    rule
+}

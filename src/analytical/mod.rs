@@ -119,6 +119,20 @@ impl Exact {
         }
     }
 
+    /// Which branches of the piecewise (abs) expressions of body `b` the point is on: where
+    /// two points differ, a kink of the exact fields lies between them.
+    pub fn branch(&self, b: usize, x: f64, y: f64, t: f64) -> u64 {
+        let mut bits = 0u64;
+        let mut mix = |e: &Expr| bits = bits.rotate_left(7) ^ e.branch(x, y, t);
+        if let Some(u) = &self.displacement {
+            u[b].iter().for_each(&mut mix);
+        }
+        if let Some(s) = &self.stress {
+            s[b].iter().for_each(&mut mix);
+        }
+        bits
+    }
+
     /// Stress of body `b` at (x, y, t) as [s11, s22, s12].
     pub fn stress_at(&self, b: usize, x: f64, y: f64, t: f64) -> Option<[f64; 3]> {
         let s = &self.stress.as_ref()?[b];
