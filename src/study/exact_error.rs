@@ -9,8 +9,8 @@ use crate::fe::Model;
 use crate::quadrature;
 use crate::solve::{Problem, State};
 
-/// Gauss points per direction of the default rule (36 points per triangle, degree 10).
-pub const DEFAULT_POINTS: usize = 6;
+/// Gauss points per direction of the default rule (16 points per triangle, degree 6).
+pub const DEFAULT_POINTS: usize = 4;
 
 /// An exact solution with the quadrature that measures against it.
 pub struct ExactComparison<'a> {
