@@ -787,23 +787,27 @@ fn alignment(s: &mut String, res: &StudyResult) {
             .filter_map(|v| last(&v.rates, m))
             .collect();
         if let Some(main) = main {
-            let stalls_everywhere =
-                main < rates::STALLED * 2.0 && others.iter().all(|&o| o < rates::STALLED * 2.0);
+            let stalled = |r: f64| r < 0.3;
+            let stalling = others.iter().filter(|&&o| stalled(o)).count();
+            let verdict = match (stalled(main), stalling) {
+                (false, 0) => "no family stalls".to_string(),
+                (true, n) if n == others.len() => {
+                    "every family stalls: not an alignment effect".to_string()
+                }
+                (_, n) => format!(
+                    "the stall depends on the family ({} of {} families stall): an alignment effect of the contact edge with the nodes",
+                    n + stalled(main) as usize,
+                    others.len() + 1
+                ),
+            };
             let _ = writeln!(
                 s,
-                "- {m} l2_pressure, last successive rate: {main:.3} in the main family, {} in the variants: {}.",
+                "- {m} l2_pressure, last successive rate (below 0.3: stalled): {main:.3} in the main family, {} in the variants: {verdict}.",
                 others
                     .iter()
                     .map(|o| format!("{o:.3}"))
                     .collect::<Vec<_>>()
                     .join(", "),
-                if main < 0.3 && !stalls_everywhere {
-                    "the stall between the last two levels is an alignment effect of the main family (the variants do not stall)"
-                } else if stalls_everywhere {
-                    "every family stalls: not an alignment effect"
-                } else {
-                    "no stall"
-                }
             );
         }
     }
