@@ -67,8 +67,10 @@ pub fn reference_profile(
 }
 
 /// The gap -[u.nu] at the body-1 nodes of every piece, as (position, gap).
+/// Gaps below 1e-8 of the largest displacement are round-off of a closed contact: 0.
 fn slave_gaps(p: &Problem, s: &State) -> Vec<([f64; 2], f64)> {
     let jumps = crate::contact::normal_jumps(&p.interface, &s.u);
+    let floor = 1e-8 * crate::solve::inf_norm(&s.u);
     let mut out = Vec::new();
     for (pi, piece) in p.interface.pieces.iter().enumerate() {
         // normal_jumps lists a piece's body-1 nodes first, in order.
@@ -82,7 +84,7 @@ fn slave_gaps(p: &Problem, s: &State) -> Vec<([f64; 2], f64)> {
                     piece.a[0] + j.1 * piece.tangent[0],
                     piece.a[1] + j.1 * piece.tangent[1],
                 ],
-                -j.2,
+                if -j.2 > floor { -j.2 } else { 0.0 },
             ));
         }
     }
@@ -146,7 +148,9 @@ pub fn edges(p: &[(f64, f64)], g: &[(f64, f64)]) -> Vec<f64> {
             } else {
                 linear(g, s).max(0.0)
             };
-            (s, v.max(0.0) / pmax - gap / gmax)
+            // Pressures below 1e-8 of the largest are round-off of a separated node.
+            let v = if v > 1e-8 * pmax { v } else { 0.0 };
+            (s, v / pmax - gap / gmax)
         })
         .collect();
     phi.windows(2)
