@@ -12,7 +12,7 @@
 //! with 8 Gauss points per piece: exact for the piecewise-linear truth of a reference, and
 //! far below the errors measured for a smooth exact pressure.
 
-use super::error::pressure_profile;
+use super::error::{eval_pl, pressure_profile};
 use crate::analytical::Exact;
 use crate::contact::{Interface, Piece};
 use crate::quadrature::gauss_legendre;
@@ -113,21 +113,6 @@ fn project(study: &Interface, points: &[([f64; 2], f64)]) -> Vec<Vec<(f64, f64)>
         .collect()
 }
 
-/// Linear interpolation of sorted points (constant beyond the ends).
-fn linear(f: &[(f64, f64)], s: f64) -> f64 {
-    if f.len() == 1 {
-        return f[0].1;
-    }
-    let k = f.partition_point(|p| p.0 <= s).clamp(1, f.len() - 1);
-    let (a, b) = (f[k - 1], f[k]);
-    let t = if b.0 > a.0 {
-        ((s - a.0) / (b.0 - a.0)).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    a.1 + t * (b.1 - a.1)
-}
-
 /// The contact edges of nodal pressure `p` and gap `g` along a piece: the zeros of
 /// phi = p / max p - g^+ / max g^+ (positive in contact, negative in separation, zero where
 /// both vanish), linear between the nodes of `p` (the gap interpolated there).
@@ -146,7 +131,7 @@ pub fn edges(p: &[(f64, f64)], g: &[(f64, f64)]) -> Vec<f64> {
             let gap = if g.is_empty() {
                 0.0
             } else {
-                linear(g, s).max(0.0)
+                eval_pl(g, s).max(0.0)
             };
             // Pressures below 1e-8 of the largest are round-off of a separated node.
             let v = if v > 1e-8 * pmax { v } else { 0.0 };
@@ -169,7 +154,7 @@ pub fn edges(p: &[(f64, f64)], g: &[(f64, f64)]) -> Vec<f64> {
 impl TruthPressure<'_> {
     fn at(&self, piece_index: usize, piece: &Piece, s: f64) -> f64 {
         match self {
-            TruthPressure::Profile(f, _) => linear(&f[piece_index], s),
+            TruthPressure::Profile(f, _) => eval_pl(&f[piece_index], s),
             TruthPressure::Exact(ex, t) => {
                 let x = [
                     piece.a[0] + s * piece.tangent[0],
@@ -293,7 +278,7 @@ pub fn contact_step(p: &Problem, s: &State, truth: &TruthPressure) -> ContactSte
             let h_e = nodes.get(e + 1).map_or(len, |b| b - nodes[e]);
             for &(q, wq) in &gauss {
                 let sq = w[0] + q * len;
-                let (a, b) = (linear(&ph, sq), truth.at(i, piece, sq));
+                let (a, b) = (eval_pl(&ph, sq), truth.at(i, piece, sq));
                 let wl = wq * len;
                 out.pressure_weighted += h_e * wl * (a - b).powi(2);
                 out.resultant.0 += wl * (a - b);

@@ -208,7 +208,12 @@ fn profile_on(interface: &Interface, piece: usize, profile: &[([f64; 2], f64)]) 
     v
 }
 
-fn eval_pl(f: &[(f64, f64)], x: f64) -> f64 {
+/// The piecewise-linear function through sorted points `f` at `x` (constant beyond the
+/// ends).
+pub fn eval_pl(f: &[(f64, f64)], x: f64) -> f64 {
+    if f.len() == 1 {
+        return f[0].1;
+    }
     let k = f.partition_point(|p| p.0 <= x).clamp(1, f.len() - 1);
     let (a, b) = (f[k - 1], f[k]);
     let t = if b.0 > a.0 {
