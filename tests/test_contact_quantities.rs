@@ -107,9 +107,9 @@ fn band_stress_error_of_a_known_stress_is_the_band_area() {
         .map(|e| e.area)
         .sum();
     assert!(
-        (d.band_stress.0 - 100.0 * area).abs() < 1e-12 * 100.0 * area,
+        (d.band_stress - 100.0 * area).abs() < 1e-12 * 100.0 * area,
         "{} vs {}",
-        d.band_stress.0,
+        d.band_stress,
         100.0 * area
     );
     assert_eq!(

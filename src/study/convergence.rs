@@ -783,7 +783,7 @@ fn exact_errors(
     let fields: Vec<SquaredNorms> = diffs.iter().map(|d| d.difference).collect();
     let reference: Vec<SquaredNorms> = diffs.iter().map(|d| d.exact).collect();
     let pressure: Vec<(f64, f64)> = diffs.iter().map(|d| d.pressure).collect();
-    let band_stress: Vec<(f64, f64)> = diffs.iter().map(|d| d.band_stress).collect();
+    let band_stress: Vec<f64> = diffs.iter().map(|d| d.band_stress).collect();
     let contact: Vec<ContactStep> = sol
         .states
         .iter()
@@ -858,7 +858,7 @@ fn relative_errors(
         .map(|(s, r)| error::pressure_difference(&case.problem, s, &rcase.problem, r))
         .collect();
     let band = contact_error::band(&case.problem);
-    let band_stress: Vec<(f64, f64)> = steps().map(|(s, r)| cmp.band_stress(s, r, &band)).collect();
+    let band_stress: Vec<f64> = steps().map(|(s, r)| cmp.band_stress(s, r, &band)).collect();
     let contact: Vec<ContactStep> = steps()
         .map(|(s, r)| {
             let truth = reference_profile(&case.problem.interface, &rcase.problem, r);

@@ -138,15 +138,13 @@ impl Comparison {
         n
     }
 
-    /// (||sigma - sigma_ref||^2, ||sigma_ref||^2) over the overlaps of the study triangles
-    /// marked in `band`.
-    pub fn band_stress(&self, s: &State, r: &State, band: &[bool]) -> (f64, f64) {
-        let (mut diff, mut norm) = (0.0, 0.0);
-        for o in self.overlaps.iter().filter(|o| band[o.a]) {
-            diff += o.area * tensor_norm2(&(s.sigma[o.a] - r.sigma[o.b]));
-            norm += o.area * tensor_norm2(&r.sigma[o.b]);
-        }
-        (diff, norm)
+    /// ||sigma - sigma_ref||^2 over the overlaps of the study triangles marked in `band`.
+    pub fn band_stress(&self, s: &State, r: &State, band: &[bool]) -> f64 {
+        self.overlaps
+            .iter()
+            .filter(|o| band[o.a])
+            .map(|o| o.area * tensor_norm2(&(s.sigma[o.a] - r.sigma[o.b])))
+            .sum()
     }
 
     /// Integral over the overlaps of a function of position evaluated exactly for

@@ -141,7 +141,7 @@ pub struct Differences<'a> {
     /// Gamma_C's quantities per step.
     pub contact: &'a [ContactStep],
     /// (||sigma - sigma_ref||^2, ||sigma_ref||^2) on the band per step.
-    pub band_stress: &'a [(f64, f64)],
+    pub band_stress: &'a [f64],
     /// The length of Gamma_C.
     pub contact_length: f64,
 }
@@ -172,7 +172,7 @@ impl Differences<'_> {
         let band = self
             .band_stress
             .iter()
-            .map(|b| b.0.sqrt())
+            .map(|b| b.sqrt())
             .fold(0.0f64, f64::max);
         let p_norm = pressure_ref * self.contact_length.sqrt();
         BTreeMap::from([
