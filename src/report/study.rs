@@ -544,12 +544,12 @@ pub fn console(res: &StudyResult, dir: &Path) -> String {
 
 /// The contact quantities against h, both cones (the cones differ only there).
 fn contact_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
+    // Four quantities: the plot's four colours (penetration is in the table).
     let shown = [
         Quantity::L2Pressure,
         Quantity::PressureWeighted,
         Quantity::ContactEdge,
         Quantity::BandStress,
-        Quantity::L2Penetration,
     ];
     let mut series = Vec::new();
     for (c, &q) in shown.iter().enumerate() {
