@@ -377,11 +377,7 @@ fn check_contact_point(
             ));
         }
     }
-    if let (Some(u1), Some(u2)) = (
-        ex.displacement_at(0, x[0], x[1], t),
-        ex.displacement_at(1, x[0], x[1], t),
-    ) {
-        let gap = -dot([u1[0] - u2[0], u1[1] - u2[1]], n);
+    if let Some(gap) = ex.gap_at(n, x[0], x[1], t) {
         if gap < -EXACT_TOL * u_scale {
             return Err(format!("gap {gap:.3e} < 0 (the bodies interpenetrate)"));
         }

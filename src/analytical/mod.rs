@@ -145,6 +145,15 @@ impl Exact {
         Some([u[0].eval(x, y, t), u[1].eval(x, y, t)])
     }
 
+    /// The gap -(u^1 - u^2).n at (x, y, t) on Gamma_C with the slave's outward normal `n`.
+    pub fn gap_at(&self, n: [f64; 2], x: f64, y: f64, t: f64) -> Option<f64> {
+        let (u1, u2) = (
+            self.displacement_at(0, x, y, t)?,
+            self.displacement_at(1, x, y, t)?,
+        );
+        Some(-((u1[0] - u2[0]) * n[0] + (u1[1] - u2[1]) * n[1]))
+    }
+
     /// Contact pressure at (x, y, t) on Gamma_C with the slave's outward normal `n`: the
     /// given pressure, or -n.sigma^1 n.
     pub fn pressure_at(&self, n: [f64; 2], x: f64, y: f64, t: f64) -> Option<f64> {

@@ -12,7 +12,7 @@
 //! with 8 Gauss points per piece: exact for the piecewise-linear truth of a reference, and
 //! far below the errors measured for a smooth exact pressure.
 
-use super::error::{eval_pl, pressure_profile};
+use super::error::{eval_pl, on_piece, pressure_profile, project};
 use crate::analytical::Exact;
 use crate::contact::{Interface, Piece};
 use crate::quadrature::gauss_legendre;
@@ -45,15 +45,6 @@ pub struct ContactStep {
     pub penetration_l2: f64,
 }
 
-/// The abscissa of `x` along `piece` and its distance off the piece's line.
-fn on_piece(piece: &Piece, x: [f64; 2]) -> (f64, f64) {
-    let d = [x[0] - piece.a[0], x[1] - piece.a[1]];
-    (
-        d[0] * piece.tangent[0] + d[1] * piece.tangent[1],
-        (d[0] * piece.normal[0] + d[1] * piece.normal[1]).abs(),
-    )
-}
-
 /// The reference's nodal pressure and gap projected on each study piece (points within 1e-9
 /// of the piece's length), sorted and deduplicated.
 pub fn reference_profile(
@@ -61,18 +52,23 @@ pub fn reference_profile(
     reference: &Problem,
     r: &State,
 ) -> TruthPressure<'static> {
+    let jumps = crate::contact::normal_jumps(&reference.interface, &r.u);
     let pressure = project(study, &pressure_profile(reference, r).concat());
-    let gap = project(study, &slave_gaps(reference, r));
+    let gap = project(study, &slave_gaps(&reference.interface, &jumps, &r.u));
     TruthPressure::Profile(pressure, gap)
 }
 
-/// The gap -[u.nu] at the body-1 nodes of every piece, as (position, gap).
-/// Gaps below 1e-8 of the largest displacement are round-off of a closed contact: 0.
-fn slave_gaps(p: &Problem, s: &State) -> Vec<([f64; 2], f64)> {
-    let jumps = crate::contact::normal_jumps(&p.interface, &s.u);
-    let floor = 1e-8 * crate::solve::inf_norm(&s.u);
+/// The gap -[u.nu] at the body-1 nodes of every piece, as (position, gap), from the
+/// normal jumps of the displacement `u`. Gaps below 1e-8 of the largest displacement are
+/// round-off of a closed contact: 0.
+fn slave_gaps(
+    interface: &Interface,
+    jumps: &[(usize, f64, f64)],
+    u: &[f64],
+) -> Vec<([f64; 2], f64)> {
+    let floor = 1e-8 * crate::solve::inf_norm(u);
     let mut out = Vec::new();
-    for (pi, piece) in p.interface.pieces.iter().enumerate() {
+    for (pi, piece) in interface.pieces.iter().enumerate() {
         // normal_jumps lists a piece's body-1 nodes first, in order.
         for j in jumps
             .iter()
@@ -89,28 +85,6 @@ fn slave_gaps(p: &Problem, s: &State) -> Vec<([f64; 2], f64)> {
         }
     }
     out
-}
-
-/// Points (position, value) projected on each study piece, sorted and deduplicated.
-fn project(study: &Interface, points: &[([f64; 2], f64)]) -> Vec<Vec<(f64, f64)>> {
-    study
-        .pieces
-        .iter()
-        .map(|piece| {
-            let tol = 1e-9 * piece.length;
-            let mut f: Vec<(f64, f64)> = points
-                .iter()
-                .filter_map(|&(x, p)| {
-                    let (s, off) = on_piece(piece, x);
-                    (off <= tol && s >= -tol && s <= piece.length + tol)
-                        .then_some((s.clamp(0.0, piece.length), p))
-                })
-                .collect();
-            f.sort_by(|a, b| a.0.total_cmp(&b.0));
-            f.dedup_by(|a, b| (a.0 - b.0).abs() <= 1e-12 * piece.length);
-            f
-        })
-        .collect()
 }
 
 /// The contact edges of nodal pressure `p` and gap `g` along a piece: the zeros of
@@ -195,15 +169,7 @@ impl TruthPressure<'_> {
                 };
                 let gap = |s: f64| {
                     let x = x_of(s);
-                    match (
-                        ex.displacement_at(0, x[0], x[1], *t),
-                        ex.displacement_at(1, x[0], x[1], *t),
-                    ) {
-                        (Some(u1), Some(u2)) => {
-                            -((u1[0] - u2[0]) * piece.normal[0] + (u1[1] - u2[1]) * piece.normal[1])
-                        }
-                        _ => 0.0,
-                    }
+                    ex.gap_at(piece.normal, x[0], x[1], *t).unwrap_or(0.0)
                 };
                 let ss: Vec<f64> = (0..=n)
                     .map(|k| piece.length * k as f64 / n as f64)
@@ -252,6 +218,8 @@ pub fn contact_step(p: &Problem, s: &State, truth: &TruthPressure) -> ContactSte
     let mut out = ContactStep::default();
     let total: f64 = p.interface.length();
     let mut worst_edge = 0.0f64;
+    let jumps = crate::contact::normal_jumps(&p.interface, &s.u);
+    let gaps = project(&p.interface, &slave_gaps(&p.interface, &jumps, &s.u));
     for (i, (piece, profile)) in p
         .interface
         .pieces
@@ -289,8 +257,7 @@ pub fn contact_step(p: &Problem, s: &State, truth: &TruthPressure) -> ContactSte
         let (tv, pmax, truth_edges) = truth.variation_and_edges(i, piece);
         out.variation.1 += tv;
         out.pressure_max = out.pressure_max.max(pmax);
-        let gh: Vec<(f64, f64)> = project(&p.interface, &slave_gaps(p, s)).swap_remove(i);
-        let discrete_edges = edges(&ph, &gh);
+        let discrete_edges = edges(&ph, &gaps[i]);
         for a in &truth_edges {
             let d = discrete_edges
                 .iter()
@@ -303,16 +270,23 @@ pub fn contact_step(p: &Problem, s: &State, truth: &TruthPressure) -> ContactSte
         }
     }
     out.edge = worst_edge;
-    out.penetration_l2 = penetration_l2(&p.interface, &s.u);
+    out.penetration_l2 = positive_jump_l2(p.interface.pieces.len(), &jumps);
     out
 }
 
 /// ||[u.nu]^+||^2 in L2(Gamma_C): the normal jump is linear between the merged trace
 /// nodes of both bodies; its positive part squared is integrated exactly.
 pub fn penetration_l2(interface: &Interface, u: &[f64]) -> f64 {
-    let jumps = crate::contact::normal_jumps(interface, u);
+    positive_jump_l2(
+        interface.pieces.len(),
+        &crate::contact::normal_jumps(interface, u),
+    )
+}
+
+/// ||[u.nu]^+||^2 from the normal jumps (piece, abscissa, jump) of `pieces` pieces.
+fn positive_jump_l2(pieces: usize, jumps: &[(usize, f64, f64)]) -> f64 {
     let mut total = 0.0;
-    for pi in 0..interface.pieces.len() {
+    for pi in 0..pieces {
         let mut f: Vec<(f64, f64)> = jumps
             .iter()
             .filter(|j| j.0 == pi)

@@ -2,7 +2,7 @@
 //! same bodies, integrated exactly over the intersection of the two triangulations.
 
 use super::intersect::{Overlap, Tri, intersect};
-use crate::contact::Interface;
+use crate::contact::{Interface, Piece};
 use crate::fe::Model;
 use crate::solve::{Problem, State};
 use nalgebra::Matrix2;
@@ -222,6 +222,37 @@ pub fn eval_pl(f: &[(f64, f64)], x: f64) -> f64 {
     a.1 + t * (b.1 - a.1)
 }
 
+/// The abscissa of `x` along `piece` and its distance off the piece's line.
+pub fn on_piece(piece: &Piece, x: [f64; 2]) -> (f64, f64) {
+    let d = [x[0] - piece.a[0], x[1] - piece.a[1]];
+    (
+        d[0] * piece.tangent[0] + d[1] * piece.tangent[1],
+        (d[0] * piece.normal[0] + d[1] * piece.normal[1]).abs(),
+    )
+}
+
+/// Points (position, value) projected on each study piece, sorted and deduplicated.
+pub fn project(study: &Interface, points: &[([f64; 2], f64)]) -> Vec<Vec<(f64, f64)>> {
+    study
+        .pieces
+        .iter()
+        .map(|piece| {
+            let tol = 1e-9 * piece.length;
+            let mut f: Vec<(f64, f64)> = points
+                .iter()
+                .filter_map(|&(x, p)| {
+                    let (s, off) = on_piece(piece, x);
+                    (off <= tol && s >= -tol && s <= piece.length + tol)
+                        .then_some((s.clamp(0.0, piece.length), p))
+                })
+                .collect();
+            f.sort_by(|a, b| a.0.total_cmp(&b.0));
+            f.dedup_by(|a, b| (a.0 - b.0).abs() <= 1e-12 * piece.length);
+            f
+        })
+        .collect()
+}
+
 /// (||p - p_ref||^2, ||p_ref||^2) in L2(Gamma_C), exact for the piecewise-linear profiles.
 /// Pieces of the reference are matched to the study's by their geometry.
 pub fn pressure_difference(
@@ -231,29 +262,12 @@ pub fn pressure_difference(
     r: &State,
 ) -> (f64, f64) {
     let ps = pressure_profile(study, s);
-    let pr = pressure_profile(reference, r);
+    // The reference's points that lie on each study piece.
+    let references = project(&study.interface, &pressure_profile(reference, r).concat());
     let (mut diff, mut norm) = (0.0, 0.0);
     for (i, piece) in study.interface.pieces.iter().enumerate() {
         let fs = profile_on(&study.interface, i, &ps[i]);
-        // Reference points that lie on this piece.
-        let mut fr: Vec<(f64, f64)> = Vec::new();
-        for prof in &pr {
-            for (x, p) in prof {
-                let s_ =
-                    (x[0] - piece.a[0]) * piece.tangent[0] + (x[1] - piece.a[1]) * piece.tangent[1];
-                let off = ((x[0] - piece.a[0]) * piece.normal[0]
-                    + (x[1] - piece.a[1]) * piece.normal[1])
-                    .abs();
-                if off <= 1e-9 * piece.length
-                    && s_ >= -1e-9 * piece.length
-                    && s_ <= piece.length * (1.0 + 1e-9)
-                {
-                    fr.push((s_.clamp(0.0, piece.length), *p));
-                }
-            }
-        }
-        fr.sort_by(|a, b| a.0.total_cmp(&b.0));
-        fr.dedup_by(|a, b| (a.0 - b.0).abs() <= 1e-12 * piece.length);
+        let fr = &references[i];
         if fs.len() < 2 || fr.len() < 2 {
             continue;
         }

@@ -151,13 +151,7 @@ pub fn exact_profiles(p: &Problem, exact: &Exact, t: f64) -> Vec<([f64; 2], f64,
                 piece.a[1] + s * piece.tangent[1],
             ];
             let pressure = exact.pressure_at(n, x[0], x[1], t).unwrap_or(f64::NAN);
-            let gap = match (
-                exact.displacement_at(0, x[0], x[1], t),
-                exact.displacement_at(1, x[0], x[1], t),
-            ) {
-                (Some(u1), Some(u2)) => -((u1[0] - u2[0]) * n[0] + (u1[1] - u2[1]) * n[1]),
-                _ => f64::NAN,
-            };
+            let gap = exact.gap_at(n, x[0], x[1], t).unwrap_or(f64::NAN);
             out.push((x, pressure, gap));
         }
     }
