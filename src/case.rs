@@ -160,13 +160,20 @@ pub struct RunSummary {
     pub timings: Timings,
     /// The floor measured on the same problem (s), when measured.
     pub floor_s: Option<f64>,
-    /// The process's peak resident memory when the summary was taken (GiB), where known.
+    /// Peak resident memory of the process during the solve (GiB; the peak is reset just
+    /// before it, see [`PeakMemory`]), where known.
     pub peak_rss_gib: Option<f64>,
 }
 
 impl RunSummary {
     /// Summarize `sol`, the solution of `case` by `solver`.
-    pub fn new(case: &Case, solver: SolverKind, sol: &Solution, floor_s: Option<f64>) -> Self {
+    pub fn new(
+        case: &Case,
+        solver: SolverKind,
+        sol: &Solution,
+        floor_s: Option<f64>,
+        peak_rss_gib: Option<f64>,
+    ) -> Self {
         let p = &case.problem;
         let last = sol.last();
         RunSummary {
@@ -188,22 +195,43 @@ impl RunSummary {
             time_loop_s: sol.wall_s,
             timings: sol.timings,
             floor_s,
-            peak_rss_gib: peak_rss_gib(),
+            peak_rss_gib,
         }
     }
 
-    /// Time loop over floor.
+    /// The solver's cost, its one-off set-up (pattern, symbolic analysis) plus the time
+    /// loop, over the floor (which has its own pattern and symbolic analysis).
     pub fn ratio_to_floor(&self) -> Option<f64> {
-        self.floor_s.map(|f| self.time_loop_s / f)
+        self.floor_s
+            .map(|f| (self.timings.setup_s + self.time_loop_s) / f)
     }
 }
 
-/// The process's peak resident set size (GiB), from /proc/self/status.
-pub fn peak_rss_gib() -> Option<f64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb / (1024.0 * 1024.0))
+/// The peak resident memory of one run: Linux keeps the process's peak (VmHWM in
+/// /proc/self/status) and resets it to the current size when "5" is written to
+/// /proc/self/clear_refs, so a run's peak is read after a reset just before it.
+pub struct PeakMemory {
+    reset: bool,
+}
+
+impl PeakMemory {
+    /// Reset the process's peak to its current resident size.
+    pub fn start() -> Self {
+        PeakMemory {
+            reset: std::fs::write("/proc/self/clear_refs", "5").is_ok(),
+        }
+    }
+
+    /// The peak since [`PeakMemory::start`] (GiB); None where it cannot be read or reset.
+    pub fn peak_gib(&self) -> Option<f64> {
+        if !self.reset {
+            return None;
+        }
+        let status = std::fs::read_to_string("/proc/self/status").ok()?;
+        let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+        let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+        Some(kb / (1024.0 * 1024.0))
+    }
 }
 
 /// Round-off bound of the checks of an exact solution, relative to the field's scale.

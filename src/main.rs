@@ -2,14 +2,14 @@
 
 use anyhow::Context;
 use clap::{Parser, Subcommand};
-use contact_rates::case::{Case, RunSummary};
+use contact_rates::case::{Case, PeakMemory, RunSummary};
 use contact_rates::contact::Method;
 use contact_rates::report;
 use contact_rates::scene::Scene;
 use contact_rates::solve::{self, Settings, SolverKind};
 use contact_rates::study::Kind;
 use contact_rates::study::jobs::Mode;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(Parser)]
 #[command(
@@ -71,6 +71,10 @@ enum Command {
         /// gmsh parameter overrides, NAME=VALUE (repeatable).
         #[arg(long = "set", value_name = "NAME=VALUE")]
         set: Vec<String>,
+        /// Also measure the floor (one sparse Cholesky of the stiffness and a solve per
+        /// step, from scratch) and report the solver's cost as a multiple of it.
+        #[arg(long)]
+        floor: bool,
     },
 }
 
@@ -108,6 +112,7 @@ fn run() -> anyhow::Result<()> {
             rho,
             tol,
             set,
+            floor,
         } => {
             let method = Method::parse(&method).with_context(|| {
                 format!("--method: unknown cone '{method}'; use mortar (K_h^pi) or nts (K_h^I)")
@@ -125,15 +130,16 @@ fn run() -> anyhow::Result<()> {
                 rho,
                 ..Settings::default()
             };
-            solve_one(
-                &scene,
+            solve_one(&SolveRequest {
+                scene,
                 method,
                 settings,
                 level,
                 steps,
-                &out,
-                &parse_sets(&set)?,
-            )
+                out,
+                params: parse_sets(&set)?,
+                floor,
+            })
         }
     }
 }
@@ -173,34 +179,44 @@ fn study(name: &str, out: Option<PathBuf>, shard: Option<&str>, merge: bool) -> 
     Ok(())
 }
 
-/// `solve`: one scene on one level with one cone and solver; solution.vtu and summary.csv.
-fn solve_one(
-    scene: &str,
+/// What `solve` was asked to do.
+struct SolveRequest {
+    scene: String,
     method: Method,
     settings: Settings,
     level: usize,
     steps: Option<usize>,
-    out: &Path,
-    params: &[(String, f64)],
-) -> anyhow::Result<()> {
-    let scene = Scene::load(scene)?;
-    let steps = steps.unwrap_or(scene.steps);
+    out: PathBuf,
+    params: Vec<(String, f64)>,
+    /// Measure the floor too.
+    floor: bool,
+}
+
+/// `solve`: one scene on one level with one cone and solver; solution.vtu and summary.csv.
+fn solve_one(req: &SolveRequest) -> anyhow::Result<()> {
+    let scene = Scene::load(&req.scene)?;
+    let steps = req.steps.unwrap_or(scene.steps);
     if steps == 0 {
         anyhow::bail!("--steps: the number of time steps must be at least 1");
     }
     // The output folder is checked (and created) before any computing.
-    report::check_writable(&out.join("solution"))?;
+    report::check_writable(&req.out.join("solution"))?;
     let t0 = std::time::Instant::now();
-    let case = Case::build(&scene, level, method, params)?;
+    let case = Case::build(&scene, req.level, req.method, &req.params)?;
     for w in &case.warnings {
         eprintln!("warning: {w}");
     }
-    let sol = solve::solve(&case.problem, &settings, steps, false)?;
-    let floor_s = solve::floor_time(&case.problem, steps)?;
-    let run = RunSummary::new(&case, settings.kind, &sol, Some(floor_s));
+    let memory = PeakMemory::start();
+    let sol = solve::solve(&case.problem, &req.settings, steps, false)?;
+    let peak = memory.peak_gib();
+    let floor_s = match req.floor {
+        true => Some(solve::floor_time(&case.problem, steps)?),
+        false => None,
+    };
+    let run = RunSummary::new(&case, req.settings.kind, &sol, floor_s, peak);
     let wall_s = t0.elapsed().as_secs_f64();
-    report::run::write_run(out, &case.problem.model, sol.last(), &run, wall_s)?;
-    print!("{}", report::run::console(&run, wall_s, out));
+    report::run::write_run(&req.out, &case.problem.model, sol.last(), &run, wall_s)?;
+    print!("{}", report::run::console(&run, wall_s, &req.out));
     Ok(())
 }
 

@@ -106,7 +106,7 @@ pub fn console(run: &RunSummary, wall_s: f64, dir: &Path) -> String {
     );
     let t = &run.timings;
     let floor = match (run.floor_s, run.ratio_to_floor()) {
-        (Some(f), Some(r)) => format!(" = {r:.2} x the floor ({f:.3} s)"),
+        (Some(f), Some(r)) => format!(" (set-up + time loop = {r:.2} x the floor, {f:.3} s)"),
         _ => String::new(),
     };
     let _ = writeln!(

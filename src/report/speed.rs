@@ -7,7 +7,7 @@ use crate::contact::Method;
 use crate::error::Result;
 use crate::io::csv_bytes;
 use crate::solve::SolverKind;
-use crate::study::speed::{SpeedResult, SpeedRun};
+use crate::study::speed::{FAMILIES, Family, SpeedResult, SpeedRun};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -29,15 +29,19 @@ struct SpeedCsv {
     /// One-off set-up per mesh, not in wall_s: pattern, slot map, symbolic analysis (s).
     setup_s: f64,
     repeats: usize,
+    /// Pattern, assembly, one sparse Cholesky (symbolic and numeric) of the stiffness and
+    /// one solve per step (s).
     floor_s: f64,
+    /// (setup_s + wall_s) / floor_s.
     ratio_to_floor: f64,
     factor_s: f64,
     solve_s: f64,
     assembly_s: f64,
     constitutive_s: f64,
     error: Option<f64>,
-    /// The process's peak resident memory so far (GiB).
+    /// Peak resident memory of the process during the solve (GiB).
     peak_rss_gib: Option<f64>,
+    /// viscoplastic (`rates`) or elastic (`rates-elastic`).
     family: &'static str,
 }
 
@@ -58,16 +62,23 @@ impl SpeedCsv {
             setup_s: t.setup_s,
             repeats: r.repeats,
             floor_s: floor_of(r),
-            ratio_to_floor: run.ratio_to_floor().unwrap_or(f64::NAN),
+            ratio_to_floor: ratio(r),
             factor_s: t.factor_s,
             solve_s: t.solve_s,
             assembly_s: t.assembly_s,
             constitutive_s: t.constitutive_s,
             error: r.error,
             peak_rss_gib: run.peak_rss_gib,
-            family: r.family,
+            family: r.family.label,
         }
     }
+}
+
+/// Set-up plus time loop over the floor.
+fn ratio(r: &SpeedRun) -> f64 {
+    r.run
+        .ratio_to_floor()
+        .expect("study speed measures the floor of every run")
 }
 
 /// The floor of a speed run (always measured by the study).
@@ -81,6 +92,30 @@ fn runs_of(res: &SpeedResult, m: Method, so: SolverKind) -> impl Iterator<Item =
     res.rows
         .iter()
         .filter(move |r| r.run.method == m && r.run.solver == so)
+}
+
+/// The runs of one family, cone and solver.
+fn family_runs<'a>(
+    res: &'a SpeedResult,
+    family: &'a Family,
+    m: Method,
+    so: SolverKind,
+) -> impl Iterator<Item = &'a SpeedRun> {
+    runs_of(res, m, so).filter(move |r| std::ptr::eq(r.family, family))
+}
+
+/// Exponent p of time ~ dofs^p over the runs with at least 1e4 dofs (below, fixed costs
+/// dominate), and its label.
+fn exponent_label(name: &str, points: &[(f64, f64)]) -> String {
+    let big: Vec<&(f64, f64)> = points.iter().filter(|p| p.0 >= 1e4).collect();
+    let fit = crate::study::rates::fit(
+        &big.iter().map(|p| p.0).collect::<Vec<_>>(),
+        &big.iter().map(|p| p.1).collect::<Vec<_>>(),
+    );
+    match fit {
+        Some(f) => format!("{name}: time ~ dofs^{:.2}", f.rate),
+        None => name.to_string(),
+    }
 }
 
 /// The solver and cone pairs plotted, with their colours.
@@ -128,62 +163,53 @@ fn work_precision(res: &SpeedResult, d: &Path) -> Result<()> {
     )
 }
 
-/// Wall time against dofs with the fitted exponents, and the floor.
+/// Newton's set-up plus time loop and the floor against dofs, per family and cone, with
+/// the fitted exponents in the legend.
 fn time_vs_dofs(res: &SpeedResult, d: &Path) -> Result<()> {
     let mut series = Vec::new();
-    for (m, so, c) in COMBOS {
-        let rows: Vec<_> = runs_of(res, m, so).collect();
-        if rows.is_empty() {
-            continue;
+    for (f, family) in FAMILIES.iter().enumerate() {
+        for (k, m) in [Method::Mortar, Method::Nts].into_iter().enumerate() {
+            let points: Vec<(f64, f64)> = family_runs(res, family, m, SolverKind::Newton)
+                .map(|r| (r.run.dofs as f64, r.run.time_loop_s + r.run.timings.setup_s))
+                .collect();
+            series.push(Series {
+                label: exponent_label(&format!("{}, {m}, newton", family.label), &points),
+                points,
+                markers: true,
+                line: true,
+                color: 2 * f + k,
+                thin: false,
+            });
         }
-        let x: Vec<f64> = rows.iter().map(|r| r.run.dofs as f64).collect();
-        let y: Vec<f64> = rows.iter().map(|r| r.run.time_loop_s).collect();
-        // Exponent over the levels with at least 1e4 dofs (below, fixed costs dominate).
-        let big: Vec<usize> = (0..x.len()).filter(|&i| x[i] >= 1e4).collect();
-        let fit = crate::study::rates::fit(
-            &big.iter().map(|&i| x[i]).collect::<Vec<_>>(),
-            &big.iter().map(|&i| y[i]).collect::<Vec<_>>(),
-        );
-        let label = match fit {
-            Some(f) => format!("{m}, {so}: time ~ dofs^{:.2}", f.rate),
-            None => format!("{m}, {so}"),
-        };
+        let floor: Vec<(f64, f64)> = family_runs(res, family, Method::Mortar, SolverKind::Newton)
+            .map(|r| (r.run.dofs as f64, floor_of(r)))
+            .collect();
         series.push(Series {
-            label,
-            points: x.iter().copied().zip(y.iter().copied()).collect(),
-            markers: true,
+            label: exponent_label(&format!("{}, floor (Cholesky)", family.label), &floor),
+            points: floor,
+            markers: false,
             line: true,
-            color: c,
-            thin: so == SolverKind::Paper,
+            color: 2 * f,
+            thin: true,
         });
     }
-    let floor: Vec<(f64, f64)> = runs_of(res, Method::Mortar, SolverKind::Newton)
-        .map(|r| (r.run.dofs as f64, floor_of(r)))
-        .collect();
-    series.push(Series {
-        label: "floor (mortar): assembly + 1 factorization + 2 solves per step".into(),
-        points: floor,
-        markers: false,
-        line: true,
-        color: 2,
-        thin: true,
-    });
     plot::loglog(
         &d.join("time_vs_dofs.png"),
-        "speed: wall time against dofs",
+        "speed: newton (set-up + time loop) and the floor against dofs, 4 steps",
         "free dofs",
         "wall time (s)",
-        &series,
+        &series.into_iter().filter(|s| !s.points.is_empty()).collect::<Vec<_>>(),
         &[],
     )
 }
 
-/// The README: what the study measures, the plots, the table, newton against paper.
+/// The README: what the study measures, the ratio to the floor per family and cone, the
+/// plots, the table, newton against paper.
 fn readme(res: &SpeedResult) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "# Study `speed`\n\nWhat each accuracy costs on the `rates` scene (h1/h2 = 1.4142, {} time steps). Every run's time loop is compared with the floor measured in the same run on the same KKT matrix: assembling it once, one numeric factorization, and two triangular solves per time step. The one-off set-up per mesh (pattern, entry-to-slot map, symbolic analysis) is in neither and is shown apart. Runs below {} dofs are timed {} times, solver and floor alternately, and the fastest of each is kept (single timings of 0.01-0.1 s scatter by a factor 2 on this shared 2-core machine). Errors are in the theorem norm against a matching-mesh reference at level {} ({} dofs), shown where the reference is at least 3 levels finer. `peak RSS` is the process's peak so far. Regenerate with `cargo run --release -- study speed` ({:.0} s).\n",
+        "# Study `speed`\n\nWhat each accuracy costs, on two families of the same non-matching meshes (h1/h2 = 1.4142, h_upper = 0.28 at level 0, every level splits each triangle in 4), {} time steps: `rates` (viscoplastic, about half the domain flows) and `rates-elastic` (no yield stress). Each run's cost, the solver's set-up (pattern, symbolic analysis) plus its time loop, is compared with the floor measured on the same mesh: what the problem cannot avoid, from scratch: the elastic stiffness's pattern and values, one sparse Cholesky of it (faer, AMD ordering, symbolic and numeric; shifted by 1e-8 of its mean diagonal so that a body held only by contact does not make it singular), and one solve (two triangular solves) per time step. Runs below {} dofs are timed {} times, solver and floor alternately, and the fastest of each is kept (single timings of 0.01-0.1 s scatter by a factor 2 on this shared 2-core machine). Errors (viscoplastic family) are in the theorem norm against a matching-mesh reference at level {} ({} dofs), shown where the reference is at least 3 levels finer. `peak RSS` is the process's peak during the solve (reset before it). Regenerate with `cargo run --release -- study speed` ({:.0} s).\n",
         crate::study::speed::STEPS,
         crate::study::speed::REPEATS.0,
         crate::study::speed::REPEATS.1,
@@ -191,20 +217,44 @@ fn readme(res: &SpeedResult) -> String {
         res.reference_dofs,
         res.wall_s
     );
+    s.push_str("| family | cone | newton / floor from 1e4 dofs (smallest - largest) | at the largest run |\n|---|---|---|---|\n");
+    for family in &FAMILIES {
+        for m in [Method::Mortar, Method::Nts] {
+            let runs: Vec<&SpeedRun> = family_runs(res, family, m, SolverKind::Newton)
+                .filter(|r| r.run.dofs >= 10_000)
+                .collect();
+            let ratios: Vec<f64> = runs.iter().map(|r| ratio(r)).collect();
+            if let Some(last) = runs.last() {
+                let _ = writeln!(
+                    s,
+                    "| {} | {m} | {:.2} - {:.2} | {:.2} at {} dofs ({:.1} s, floor {:.1} s) |",
+                    family.label,
+                    ratios.iter().copied().fold(f64::INFINITY, f64::min),
+                    ratios.iter().copied().fold(0.0, f64::max),
+                    ratio(last),
+                    last.run.dofs,
+                    last.run.time_loop_s + last.run.timings.setup_s,
+                    floor_of(last)
+                );
+            }
+        }
+    }
     let _ = writeln!(
         s,
-        "![work precision](work_precision.png)\n\n![time against dofs](time_vs_dofs.png)\n"
+        "\n![work precision](work_precision.png)\n\n![time against dofs](time_vs_dofs.png)\n"
     );
     s.push_str(&table(res));
     for m in [Method::Mortar, Method::Nts] {
         let finest = crate::study::speed::PAPER_LEVELS.iter().max().unwrap();
-        let at_finest = |so| runs_of(res, m, so).find(|r| r.run.level == *finest);
+        let at_finest = |so| {
+            family_runs(res, &FAMILIES[0], m, so).find(|r| r.run.level == *finest)
+        };
         if let (Some(a), Some(b)) = (at_finest(SolverKind::Newton), at_finest(SolverKind::Paper)) {
             let _ = writeln!(
                 s,
-                "\n{m}, level {finest}: newton {:.3} s ({:.2} x the floor), paper {:.3} s at the same final tolerance: newton is {:.1} x faster.",
+                "\n{m}, level {finest}: newton {:.3} s ({:.2} x the floor), paper {:.3} s at the same final tolerance: newton's time loop is {:.1} x faster.",
                 a.run.time_loop_s,
-                a.run.time_loop_s / floor_of(a),
+                ratio(a),
                 b.run.time_loop_s,
                 b.run.time_loop_s / a.run.time_loop_s
             );
@@ -222,14 +272,14 @@ fn table(res: &SpeedResult) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "| family | method | solver | level | dofs | iterations | factorizations | time loop (s) | floor (s) | ratio to floor | set-up (s) | factorizations (s) | solves (s) | assembly (s) | constitutive (s) | peak RSS (GiB) | error |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+        "| family | method | solver | level | dofs | iterations | factorizations | time loop (s) | floor (s) | (set-up + loop) / floor | set-up (s) | factorizations (s) | solves (s) | assembly (s) | constitutive (s) | peak RSS (GiB) | error |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for r in &res.rows {
         let (run, t) = (&r.run, &r.run.timings);
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.2} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {} | {} |",
-            r.family,
+            r.family.label,
             run.method,
             run.solver,
             run.level,
@@ -238,7 +288,7 @@ fn table(res: &SpeedResult) -> String {
             t.factorizations,
             run.time_loop_s,
             floor_of(r),
-            run.time_loop_s / floor_of(r),
+            ratio(r),
             t.setup_s,
             t.factor_s,
             t.solve_s,

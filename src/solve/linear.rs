@@ -1,20 +1,35 @@
 //! Sparse linear algebra on a fixed pattern: the values are refilled in place, the symbolic
-//! analysis is done once, and numeric factorizations are timed.
+//! analysis is done once, and numeric factorizations are timed. Two symmetric
+//! factorizations, both faer's supernodal Cholesky with its fill-reducing (AMD) ordering:
+//! LL^T of a positive definite matrix and LDL^T of a quasi-definite one (the contact KKT
+//! matrix), with dynamic regularization of the pivots that vanish.
 
 use crate::error::{Error, Result};
 use crate::fe::Pattern;
-use faer::Side;
-use faer::sparse::linalg::solvers::{Llt, Lu, SymbolicLlt, SymbolicLu};
-use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::perm::PermRef;
+use faer::sparse::linalg::amd;
+use faer::sparse::linalg::cholesky::{
+    LdltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
+};
+use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat};
+use faer::{Conj, Par, Side};
 use std::time::Instant;
+
+/// An LDL^T factorization (values and the one symbolic analysis they belong to).
+struct Ldlt {
+    values: Vec<f64>,
+}
 
 /// A square sparse matrix with a fixed pattern and a reusable symbolic factorization.
 pub struct SparseSystem {
     /// The matrix (values refilled by the caller through [`SparseSystem::values_mut`]).
     mat: SparseColMat<usize, f64>,
-    symbolic_lu: Option<SymbolicLu<usize>>,
+    symbolic_ldlt: Option<SymbolicCholesky<usize>>,
     symbolic_llt: Option<SymbolicLlt<usize>>,
-    lu: Option<Lu<usize, f64>>,
+    ldlt: Option<Ldlt>,
     llt: Option<Llt<usize, f64>>,
     /// Seconds spent in numeric factorizations.
     pub factor_s: f64,
@@ -40,9 +55,9 @@ impl SparseSystem {
         let mat = SparseColMat::new(sym, vec![0.0; pattern.nnz()]);
         SparseSystem {
             mat,
-            symbolic_lu: None,
+            symbolic_ldlt: None,
             symbolic_llt: None,
-            lu: None,
+            ldlt: None,
             llt: None,
             factor_s: 0.0,
             symbolic_s: 0.0,
@@ -56,33 +71,98 @@ impl SparseSystem {
         self.mat.val_mut()
     }
 
-    /// The symbolic analysis of the LU factorization (once per pattern; timed apart from
-    /// the numeric factorizations).
-    pub fn analyze_lu(&mut self) -> Result<()> {
-        if self.symbolic_lu.is_none() {
-            let t = Instant::now();
-            self.symbolic_lu = Some(
-                SymbolicLu::try_new(self.mat.symbolic())
-                    .map_err(|e| Error::NotConverged(format!("symbolic LU failed: {e:?}")))?,
-            );
-            self.symbolic_s += t.elapsed().as_secs_f64();
+    /// The symbolic analysis of the LDL^T factorization (once per pattern; timed apart from
+    /// the numeric factorizations). The ordering is faer's AMD of the whole pattern, except
+    /// that every row k >= `n_primal` (a multiplier) is moved to just after the last of its
+    /// neighbours < `n_primal`: its pivot is then a Schur complement -C S^{-1} C^T, non-zero,
+    /// where AMD would eliminate it first on a zero diagonal. It adds about one column of
+    /// fill per multiplier.
+    pub fn analyze_ldlt(&mut self, n_primal: usize) -> Result<()> {
+        if self.symbolic_ldlt.is_some() {
+            return Ok(());
         }
+        let t = Instant::now();
+        let n = self.mat.nrows();
+        let symbolic = self.mat.symbolic();
+        let (mut fwd, mut inv) = (vec![0usize; n], vec![0usize; n]);
+        let nnz = symbolic.row_idx().len();
+        let mut buffer = MemBuffer::try_new(amd::order_scratch::<usize>(n, nnz))
+            .map_err(|_| Error::NotConverged("out of memory in the ordering".into()))?;
+        amd::order(&mut fwd, &mut inv, symbolic, Default::default(), MemStack::new(&mut buffer))
+            .map_err(|e| Error::NotConverged(format!("ordering failed: {e:?}")))?;
+        // Multipliers after their last primal neighbour (rows of column k hold the
+        // neighbours: the pattern is symmetric).
+        let mut after: Vec<Vec<usize>> = vec![Vec::new(); n];
+        let mut unattached = Vec::new();
+        for k in n_primal..n {
+            let last = symbolic
+                .row_idx_of_col(k)
+                .filter(|&r| r < n_primal)
+                .max_by_key(|&r| inv[r]);
+            match last {
+                Some(r) => after[r].push(k),
+                None => unattached.push(k),
+            }
+        }
+        let mut order = Vec::with_capacity(n);
+        for &r in fwd.iter().filter(|&&r| r < n_primal) {
+            order.push(r);
+            order.extend_from_slice(&after[r]);
+        }
+        order.extend(unattached);
+        let mut order_inv = vec![0usize; n];
+        for (position, &k) in order.iter().enumerate() {
+            order_inv[k] = position;
+        }
+        let perm = PermRef::new_checked(&order, &order_inv, n);
+        self.symbolic_ldlt = Some(
+            factorize_symbolic_cholesky(
+                symbolic,
+                Side::Lower,
+                SymmetricOrdering::Custom(perm),
+                Default::default(),
+            )
+            .map_err(|e| Error::NotConverged(format!("symbolic LDLT failed: {e:?}")))?,
+        );
+        self.symbolic_s += t.elapsed().as_secs_f64();
         Ok(())
     }
 
-    /// LU factorization with partial pivoting (any invertible matrix).
-    pub fn factor_lu(&mut self) -> Result<()> {
-        self.analyze_lu()?;
+    /// LDL^T factorization of the symmetric matrix whose lower triangle is `values` (in
+    /// pattern order; the upper triangle is not read). `signs` are the expected pivot signs
+    /// (+1 displacement rows, -1 multiplier rows); a pivot of the wrong sign or below `eps`
+    /// in magnitude is replaced by `delta` with its expected sign (faer's dynamic
+    /// regularization), so the factorization is that of a nearby matrix: callers refine.
+    pub fn factor_ldlt(&mut self, values: &[f64], signs: &[i8], eps: f64, delta: f64) -> Result<()> {
+        let symbolic = self.symbolic_ldlt.as_ref().expect("analyze_ldlt before factor_ldlt");
         let t = Instant::now();
-        let lu = Lu::try_new_with_symbolic(self.symbolic_lu.clone().unwrap(), self.mat.as_ref())
-            .map_err(|e| {
-                Error::NotConverged(format!(
-                    "the linearized system is singular ({e:?}): is a body free to move?"
-                ))
-            })?;
+        let mut l_values = self.ldlt.take().map(|f| f.values).unwrap_or_default();
+        l_values.resize(symbolic.len_val(), 0.0);
+        let par = Par::Seq;
+        let mut buffer = MemBuffer::try_new(
+            symbolic.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()),
+        )
+        .map_err(|_| Error::NotConverged("out of memory in the LDLT".into()))?;
+        let mat = SparseColMatRef::new(self.mat.symbolic(), values);
+        let regularization = LdltRegularization {
+            dynamic_regularization_signs: Some(signs),
+            dynamic_regularization_delta: delta,
+            dynamic_regularization_epsilon: eps,
+        };
+        symbolic
+            .factorize_numeric_ldlt(
+                &mut l_values,
+                mat,
+                Side::Lower,
+                regularization,
+                par,
+                MemStack::new(&mut buffer),
+                Default::default(),
+            )
+            .map_err(|e| Error::NotConverged(format!("LDLT failed: {e:?}")))?;
         self.factor_s += t.elapsed().as_secs_f64();
         self.factorizations += 1;
-        self.lu = Some(lu);
+        self.ldlt = Some(Ldlt { values: l_values });
         self.llt = None;
         Ok(())
     }
@@ -111,7 +191,7 @@ impl SparseSystem {
         self.factor_s += t.elapsed().as_secs_f64();
         self.factorizations += 1;
         self.llt = Some(llt);
-        self.lu = None;
+        self.ldlt = None;
         Ok(())
     }
 
@@ -130,8 +210,16 @@ impl SparseSystem {
         let n = rhs.len() / k;
         self.solves.set(self.solves.get() + k);
         let m = faer::MatMut::from_column_major_slice_mut(rhs, n, k);
-        if let Some(lu) = &self.lu {
-            lu.solve_in_place(m);
+        if let Some(ldlt) = &self.ldlt {
+            let symbolic = self.symbolic_ldlt.as_ref().expect("factored");
+            let mut buffer =
+                MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(k, Par::Seq));
+            LdltRef::new(symbolic, &ldlt.values).solve_in_place_with_conj(
+                Conj::No,
+                m,
+                Par::Seq,
+                MemStack::new(&mut buffer),
+            );
         } else if let Some(llt) = &self.llt {
             llt.solve_in_place(m);
         } else {
@@ -157,7 +245,7 @@ impl SparseSystem {
 
     /// Whether a factorization is available.
     pub fn is_factored(&self) -> bool {
-        self.lu.is_some() || self.llt.is_some()
+        self.ldlt.is_some() || self.llt.is_some()
     }
 
     /// Solve `A x = b` with the current values of A by GMRES, right-preconditioned with

@@ -1,10 +1,18 @@
 //! The default solver: exact implicit return map per triangle, consistent tangent, and a
 //! semismooth Newton (primal-dual active set) treatment of the contact rows, on the KKT
-//! system `[K C^T; C_A 0]` whose pattern (all rows present) and symbolic LU are fixed per
-//! mesh. One factorization serves many iterations and steps: each Newton system is solved
-//! by GMRES preconditioned with the last factorization, corrected exactly (Woodbury) for
-//! the contact rows whose active set changed since; it is refactorized only when GMRES
+//! system `[K C^T; C_A 0]` whose pattern (all rows present) and symbolic analysis are fixed
+//! per mesh. One factorization serves many iterations and steps: each Newton system is
+//! solved by GMRES preconditioned with the last factorization, corrected exactly (Woodbury)
+//! for the contact rows whose active set changed since; it is refactorized only when GMRES
 //! needs many iterations (the tangent moved far from the factored one).
+//!
+//! The factorization is symmetric: an LDL^T of `[K_s c C_A^T; c C_A 0]` (K_s the stiffness,
+//! or the symmetric part of the consistent tangent; inactive rows eliminated exactly, see
+//! [`Newton::solve_factored`]), ordered by AMD with every multiplier moved after its
+//! displacements, so that its pivot is a non-zero Schur complement. It costs about one
+//! Cholesky of the stiffness (the KKT matrix's sparse LU cost 3-7x that) and is exact for
+//! elastic bodies: GMRES then stops after one iteration. The non-symmetric part of a
+//! viscoplastic tangent is left to GMRES (2-3 iterations per Newton step, measured).
 
 use super::linear::SparseSystem;
 use super::{Problem, Settings, State, StepReport, StepSolver, inf_norm};
@@ -36,13 +44,54 @@ pub struct Newton<'a> {
     setup_s: f64,
     /// Active set of the factored matrix.
     factored_active: Vec<bool>,
-    /// Whether the factored matrix has the elastic stiffness.
-    factored_elastic: bool,
     /// The elastic stiffness in pattern order (contact entries zero).
     elastic_values: Vec<f64>,
     /// Columns A0^{-1} e_{n+i} of the factored matrix, computed when row i changes.
     w_columns: Vec<Option<Vec<f64>>>,
+    /// Lower triangle of the symmetric matrix handed to the LDL^T (pattern order).
+    symmetric_values: Vec<f64>,
+    /// Expected pivot signs: +1 on displacement rows, -1 on multiplier rows.
+    signs: Vec<i8>,
+    /// Scale s_i = 1/|C_i| of multiplier row i in the factored matrix (1/length for mortar
+    /// rows, 1 for node-on-segment ones): every factored contact row has the norm c.
+    row_scale: Vec<f64>,
+    /// GMRES iterations of the first solve after the last factorization.
+    fresh_iterations: usize,
 }
+
+/// Pivots expected positive but below 1e-13 c (a body held only by contact, eliminated
+/// before its contact rows) are replaced by 1e-8 c: a low-rank change GMRES removes.
+const PIVOT_THRESHOLD: (f64, f64) = (1e-13, 1e-8);
+
+/// The tangent whose element stiffness is the symmetric part of that of `d`: the element
+/// stiffness is |T| B^T D S B (S halves the engineering shear), so the symmetric part of
+/// D S is taken and S undone. Where that is not positive definite (a strongly
+/// non-symmetric tangent), the elastic tangent `elastic`: the factored stiffness stays
+/// positive definite, and GMRES handles the difference.
+fn symmetric_tangent(d: &Matrix3<f64>, elastic: &Matrix3<f64>) -> Matrix3<f64> {
+    if d == elastic {
+        return *d;
+    }
+    let s = Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, 0.5));
+    let ds = d * s;
+    let sym = 0.5 * (ds + ds.transpose());
+    let scale = (elastic * s).norm();
+    if sym.symmetric_eigenvalues().min() > 1e-8 * scale {
+        let s_inv = Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, 2.0));
+        sym * s_inv
+    } else {
+        *elastic
+    }
+}
+
+/// Iterates whose merit the non-monotone line search remembers.
+const MERIT_MEMORY: usize = 3;
+
+/// GMRES iterations allowed right after a factorization (the non-symmetric part of a
+/// viscoplastic tangent is all that is left for it).
+const FRESH_BUDGET: usize = 40;
+
+
 
 /// Accumulated times of the solver's parts.
 #[derive(Default)]
@@ -74,21 +123,29 @@ fn fill_contact_rows(
     }
 }
 
+/// Shift added to the stiffness diagonal for the floor's Cholesky, relative to its mean
+/// diagonal: it makes the stiffness of a body held only by contact positive definite and
+/// changes nothing the floor measures (its cost).
+pub const FLOOR_SHIFT: f64 = 1e-8;
+
 /// See [`super::floor_time`].
 pub fn floor_time(p: &Problem, steps: usize) -> Result<f64> {
-    let mut nw = Newton::new(p, &super::Settings::default())?;
     let t0 = std::time::Instant::now();
-    let tangents = p.model.elastic_tangents();
-    let m = p.rows.len();
-    let c = nw.c_scale;
-    let vals = nw.system.values_mut();
-    vals.iter_mut().for_each(|v| *v = 0.0);
-    p.model.add_tangent(&tangents, &nw.slots, vals);
-    fill_contact_rows(vals, &nw.row_slots, &nw.diag_slots, c, &vec![true; m]);
-    nw.system.factor_lu()?;
-    let mut rhs = vec![1.0; nw.n + m];
+    let model = &p.model;
+    let n = model.n_free;
+    let (pattern, slots) = model.stiffness_pattern(&[], n);
+    let mut system = SparseSystem::new(&pattern);
+    let vals = system.values_mut();
+    model.add_tangent(&model.elastic_tangents(), &slots, vals);
+    let diagonal: Vec<usize> = (0..n).map(|i| pattern.slot(i, i)).collect();
+    let shift = FLOOR_SHIFT * diagonal.iter().map(|&s| vals[s]).sum::<f64>() / n.max(1) as f64;
+    for &s in &diagonal {
+        vals[s] += shift;
+    }
+    system.factor_llt()?;
+    let mut rhs = vec![1.0; n];
     for _ in 0..steps {
-        nw.system.solve(&mut rhs);
+        system.solve(&mut rhs);
     }
     Ok(t0.elapsed().as_secs_f64())
 }
@@ -134,7 +191,16 @@ impl<'a> Newton<'a> {
         }
         let c_scale = diag.iter().sum::<f64>() / n.max(1) as f64;
         let mut system = SparseSystem::new(&pattern);
-        system.analyze_lu()?;
+        system.analyze_ldlt(n)?;
+        let signs = (0..n + m).map(|i| if i < n { 1 } else { -1 }).collect();
+        let row_scale = p
+            .rows
+            .iter()
+            .map(|r| {
+                let norm: f64 = r.entries.iter().map(|&(_, v)| v * v).sum::<f64>().sqrt();
+                if norm > 0.0 { 1.0 / norm } else { 1.0 }
+            })
+            .collect();
         Ok(Newton {
             p,
             settings: *settings,
@@ -148,9 +214,12 @@ impl<'a> Newton<'a> {
             clock: Default::default(),
             setup_s: t_setup.elapsed().as_secs_f64(),
             factored_active: vec![true; m],
-            factored_elastic: false,
             elastic_values: vals,
             w_columns: vec![None; m],
+            symmetric_values: Vec::new(),
+            signs,
+            row_scale,
+            fresh_iterations: 0,
         })
     }
 }
@@ -170,10 +239,15 @@ struct RowUpdate {
     capacitance: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
 }
 
-/// Largest number of stored entries of W (columns A0^{-1} e_{n+i}) before a refactorization
-/// is preferred: 3e8 doubles = 2.4 GB (at 1.1e6 dofs, the 240 rows that change in the first
-/// step; the LU there takes about 12 GB).
-const MAX_CORRECTION_ENTRIES: usize = 300_000_000;
+/// Largest number of new columns W_i = A0^{-1} e_{n+i} computed for one update before a
+/// refactorization is preferred: a blocked solve of 16 columns costs about 5 single solves,
+/// a factorization 8-15 (measured from 1e5 to 1.1e6 dofs: see the speed report). Counted in
+/// columns, not seconds, so that the results do not depend on the machine's load.
+const MAX_NEW_COLUMNS: usize = 32;
+
+/// Largest number of stored entries of W before a refactorization is preferred: 2e8
+/// doubles = 1.6 GB.
+const MAX_CORRECTION_ENTRIES: usize = 200_000_000;
 
 impl Newton<'_> {
     /// Difference row D_i = s_i c (C_i - e_{n+i}) applied to `y`.
@@ -186,32 +260,28 @@ impl Newton<'_> {
     }
 
     /// Make the columns W_i = A0^{-1} e_{n+i} of `rows` available (one blocked solve for
-    /// those missing) and factor the capacitance matrix. None when W would be too large.
-    fn row_update(&mut self, active: &[bool], all_columns: bool) -> Option<RowUpdate> {
+    /// those missing) and factor the capacitance matrix. None when a refactorization is
+    /// cheaper ([`MAX_NEW_COLUMNS`]) or W would be too large.
+    fn row_update(&mut self, active: &[bool]) -> Option<RowUpdate> {
         let big_n = self.n + self.p.rows.len();
         let rows: Vec<usize> = (0..active.len())
             .filter(|&i| active[i] != self.factored_active[i])
             .collect();
-        let wanted: Vec<usize> = if all_columns {
-            (0..active.len()).collect()
-        } else {
-            rows.clone()
-        };
-        if wanted.len() * big_n > MAX_CORRECTION_ENTRIES {
-            return None;
-        }
-        let missing: Vec<usize> = wanted
+        let missing: Vec<usize> = rows
             .iter()
             .copied()
             .filter(|&i| self.w_columns[i].is_none())
             .collect();
+        if missing.len() > MAX_NEW_COLUMNS || rows.len() * big_n > MAX_CORRECTION_ENTRIES {
+            return None;
+        }
         if !missing.is_empty() {
             let mut block = vec![0.0; big_n * missing.len()];
             for (j, &i) in missing.iter().enumerate() {
                 block[j * big_n + self.n + i] = 1.0;
             }
             timed(&self.clock.solve, || {
-                self.system.solve_many(&mut block, missing.len())
+                self.solve_factored(&mut block, missing.len())
             });
             for (j, &i) in missing.iter().enumerate() {
                 self.w_columns[i] = Some(block[j * big_n..(j + 1) * big_n].to_vec());
@@ -238,8 +308,73 @@ impl Newton<'_> {
 
     /// Apply the corrected inverse of [`RowUpdate`] to `v` in place.
     fn precondition(&self, update: &RowUpdate, v: &mut [f64]) {
-        self.system.solve(v);
+        self.solve_factored(v, 1);
         self.correct(update, v);
+    }
+
+    /// Factorize the symmetric counterpart of the Newton matrix with the symmetric part of
+    /// `tangents` and the active set `active` (see the module's notes).
+    fn factor(&mut self, tangents: &[Matrix3<f64>], active: &[bool]) -> Result<()> {
+        let clock = std::rc::Rc::clone(&self.clock);
+        let c = self.c_scale;
+        let mut vals = std::mem::take(&mut self.symmetric_values);
+        timed(&clock.assembly, || {
+            vals.clear();
+            vals.extend_from_slice(&self.elastic_values);
+            let symmetric: Vec<Matrix3<f64>> = (self.p.model.elements.iter().zip(tangents))
+                .map(|(e, d)| symmetric_tangent(d, &self.p.model.materials[e.body].elastic.matrix()))
+                .collect();
+            self.p.model.add_tangent_change(&symmetric, &self.slots, &mut vals);
+            for (i, row) in self.row_slots.iter().enumerate() {
+                let s = self.row_scale[i];
+                for &(rs, _, _, v) in row {
+                    vals[rs] = if active[i] { c * s * v } else { 0.0 };
+                }
+                vals[self.diag_slots[i]] = if active[i] {
+                    0.0
+                } else {
+                    -c * s * s
+                };
+            }
+        });
+        let (eps, delta) = PIVOT_THRESHOLD;
+        let result = self.system.factor_ldlt(&vals, &self.signs, eps * c, delta * c);
+        self.symmetric_values = vals;
+        result?;
+        self.stale = false;
+        self.factored_active = active.to_vec();
+        self.w_columns.iter_mut().for_each(|w| *w = None);
+        Ok(())
+    }
+
+    /// Solve with the factored Newton matrix A0 (`k` right-hand sides, column after column,
+    /// in place). A0 has the columns c C_i^T of every row and, on an inactive row, c on the
+    /// diagonal only: x_{n+i} = b_{n+i} / c is known, its columns move to the right-hand side,
+    /// and the rest is the symmetric system the LDL^T factored (rows scaled by s_i).
+    fn solve_factored(&self, v: &mut [f64], k: usize) {
+        let (n, m) = (self.n, self.p.rows.len());
+        let big_n = n + m;
+        for col in v.chunks_mut(big_n).take(k) {
+            for i in 0..m {
+                let b = col[n + i];
+                if self.factored_active[i] {
+                    col[n + i] = self.row_scale[i] * b;
+                } else {
+                    if b != 0.0 {
+                        for &(_, _, eq, coef) in &self.row_slots[i] {
+                            col[eq] -= coef * b;
+                        }
+                    }
+                    col[n + i] = -self.row_scale[i] * b;
+                }
+            }
+        }
+        self.system.solve_many(v, k);
+        for col in v.chunks_mut(big_n).take(k) {
+            for i in 0..m {
+                col[n + i] *= self.row_scale[i];
+            }
+        }
     }
 
     /// Turn `v = A0^{-1} b` into `A^{-1} b` (the Woodbury correction of [`RowUpdate`]).
@@ -361,43 +496,19 @@ impl Newton<'_> {
     fn solve_newton_system(
         &mut self,
         rhs: &mut Vec<f64>,
+        tangents: &[Matrix3<f64>],
         active: &[bool],
-        elastic_now: bool,
         distance: &Distance,
     ) -> Result<bool> {
         let clock = std::rc::Rc::clone(&self.clock);
-        let (n, m) = (self.n, self.p.rows.len());
         let reusable = self.system.is_factored() && !self.stale;
-        // While only the active set is searched on an unchanged (elastic) stiffness, the
-        // residual is at round-off and the right-hand side lives on the contact rows:
-        // A0^{-1} b = W b_c with all columns W = A0^{-1} e_{n+i} (one blocked solve), and
-        // the Woodbury correction makes it exact: no sparse solve per iteration.
-        let exact =
-            self.factored_elastic && elastic_now && distance.residual <= 1e-2 * self.settings.tol;
-        if reusable && exact {
-            if let Some(update) = self.row_update(active, true) {
-                timed(&clock.solve, || {
-                    let mut x = vec![0.0; n + m];
-                    for i in 0..m {
-                        let w = self.w_columns[i].as_ref().expect("all columns computed");
-                        for (xj, wj) in x.iter_mut().zip(w) {
-                            *xj += rhs[n + i] * wj;
-                        }
-                    }
-                    self.correct(&update, &mut x);
-                    *rhs = x;
-                });
-                return Ok(false);
-            }
-        }
+        // GMRES is worth it while its solves cost less than a fresh factorization (about
+        // 10 solves here): cap it at 10 iterations and refactor next time when it used more
+        // than 5 and more than the fresh factorization needed. The rule counts iterations,
+        // not seconds, so the results do not depend on the machine's load.
+        let budget = 10;
         if reusable {
-            if let Some(update) = self.row_update(active, false) {
-                // GMRES is worth it while its solves cost less than a fresh factorization
-                // (about 10-25 solves here, measured from 7e3 to 1e5 dofs): cap it at 10
-                // iterations and refactor next time when it used more than 5. The rule
-                // counts iterations, not seconds, so the results do not depend on the
-                // machine's load.
-                let budget = 10;
+            if let Some(update) = self.row_update(active) {
                 let forcing = self.forcing_term(distance);
                 let rhs0 = rhs.clone();
                 let result = timed(&clock.solve, || {
@@ -405,18 +516,27 @@ impl Newton<'_> {
                         .gmres(rhs, forcing, budget, &|v| self.precondition(&update, v))
                 });
                 if let Some(its) = result {
-                    self.stale = 2 * its > budget;
+                    self.stale = 2 * its > budget && its > self.fresh_iterations + 1;
                     return Ok(false);
                 }
                 rhs.copy_from_slice(&rhs0);
             }
         }
-        self.system.factor_lu()?;
-        self.stale = false;
-        self.factored_elastic = elastic_now;
-        self.factored_active = active.to_vec();
-        self.w_columns.iter_mut().for_each(|w| *w = None);
-        timed(&clock.solve, || self.system.solve(rhs));
+        self.factor(tangents, active)?;
+        let forcing = self.forcing_term(distance);
+        let update = self
+            .row_update(active)
+            .expect("no row changed since the factorization");
+        let its = timed(&clock.solve, || {
+            self.system
+                .gmres(rhs, forcing, FRESH_BUDGET, &|v| self.precondition(&update, v))
+        })
+        .ok_or_else(|| {
+            Error::NotConverged(format!(
+                "GMRES preconditioned by a fresh factorization did not reach {forcing:.1e} in {FRESH_BUDGET} iterations"
+            ))
+        })?;
+        self.fresh_iterations = its;
         Ok(true)
     }
 
@@ -441,15 +561,19 @@ impl Newton<'_> {
 
     /// Backtracking along `step` on the merit |r|^2 + |min(lambda, -c g)|^2: full steps near
     /// the solution, shorter ones when a large step flips many triangles between elastic
-    /// and viscoplastic (stiff k E / lambda) or many contact rows. Returns the best trial
-    /// with its evaluation (the next iteration's residual).
+    /// and viscoplastic (stiff k E / lambda) or many contact rows. Non-monotone (Grippo,
+    /// Lampariello and Lucidi 1986): a trial is compared with `reference`, the largest merit
+    /// of the step's last [`MERIT_MEMORY`] iterates, not the current one: the active-set
+    /// steps raise the merit on their way (measured: monotone backtracking halved every
+    /// step of the first contact search, which then took 10 iterations instead of 5).
+    /// Returns the best trial with its evaluation (the next iteration's residual).
     fn line_search(
         &self,
         data: &StepData,
         u: &[f64],
         lambda: &[f64],
         step: &[f64],
-        merit0: f64,
+        reference: f64,
     ) -> (Vec<f64>, Vec<f64>, Evaluation) {
         let (n, c) = (self.n, self.c_scale);
         let trial = |alpha: f64| -> (Vec<f64>, Vec<f64>) {
@@ -470,7 +594,7 @@ impl Newton<'_> {
             let (ut, lt) = trial(alpha);
             let ev = self.evaluate(data, &ut, &lt);
             let merit = self.merit(&ev, &lt);
-            let done = merit <= (1.0 - 1e-4 * alpha) * merit0;
+            let done = merit <= (1.0 - 1e-4 * alpha) * reference;
             if best.as_ref().is_none_or(|b| merit < b.0) {
                 best = Some((merit, (ut, lt), ev));
             }
@@ -500,14 +624,10 @@ impl StepSolver for Newton<'_> {
         let mut last_active: Option<Vec<bool>> = None;
         let (mut changes, mut iterations, mut factorizations) = (0, 0, 0);
         let mut evaluation = self.evaluate(&data, &u, &lambda);
+        let mut merits: Vec<f64> = Vec::new();
         loop {
             let ev = &evaluation;
             let active: Vec<bool> = (0..m).map(|i| lambda[i] + c * ev.gaps[i] >= 0.0).collect();
-            let elastic_now = model
-                .elements
-                .iter()
-                .zip(&ev.tangents)
-                .all(|(e, d)| *d == model.materials[e.body].elastic.matrix());
             let distance = Distance {
                 residual: inf_norm(&ev.residual) / ev.scale,
                 complementarity: (0..m)
@@ -558,7 +678,8 @@ impl StepSolver for Newton<'_> {
                     self.settings.tol
                 )));
             }
-            let merit0 = self.merit(ev, &lambda);
+            merits.push(self.merit(ev, &lambda));
+            let reference = merits.iter().rev().take(MERIT_MEMORY).fold(0.0f64, |a, &b| a.max(b));
             let mut step: Vec<f64> = ev
                 .residual
                 .iter()
@@ -573,10 +694,10 @@ impl StepSolver for Newton<'_> {
                 .collect();
             debug_assert_eq!(step.len(), n + m);
             self.assemble_kkt(&ev.tangents, &active);
-            if self.solve_newton_system(&mut step, &active, elastic_now, &distance)? {
+            if self.solve_newton_system(&mut step, &ev.tangents, &active, &distance)? {
                 factorizations += 1;
             }
-            (u, lambda, evaluation) = self.line_search(&data, &u, &lambda, &step, merit0);
+            (u, lambda, evaluation) = self.line_search(&data, &u, &lambda, &step, reference);
             last_active = Some(active);
             iterations += 1;
         }
