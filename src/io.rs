@@ -4,6 +4,7 @@
 use crate::error::{Error, Result};
 use crate::fe::Model;
 use crate::material::von_mises;
+use crate::metrics::ContactNode;
 use crate::solve::State;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -28,8 +29,10 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
 }
 
 /// ParaView-readable unstructured grid of both bodies at `state`: point data
-/// `displacement`, cell data `stress` (s11 s22 s12), `von_mises` and `body` (1 or 2).
-pub fn vtu(model: &Model, state: &State) -> String {
+/// `displacement`, `pressure` and `normal_jump` (at the slave nodes of Gamma_C from
+/// `contact`, zero elsewhere), cell data `stress` (s11 s22 s12), `von_mises` and `body`
+/// (1 or 2).
+pub fn vtu(model: &Model, state: &State, contact: &[ContactNode]) -> String {
     let np = model.n_nodes;
     let nc = model.elements.len();
     let mut s = String::new();
@@ -61,6 +64,20 @@ pub fn vtu(model: &Model, state: &State) -> String {
     for g in 0..np {
         let _ = writeln!(s, "{:e} {:e} 0", state.u[2 * g], state.u[2 * g + 1]);
     }
+    let (mut pressure, mut jump) = (vec![0.0; np], vec![0.0; np]);
+    for c in contact {
+        pressure[c.node] = c.pressure;
+        jump[c.node] = c.normal_jump;
+    }
+    for (name, values) in [("pressure", &pressure), ("normal_jump", &jump)] {
+        let _ = writeln!(
+            s,
+            "</DataArray>\n<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">"
+        );
+        for v in values {
+            let _ = writeln!(s, "{v:e}");
+        }
+    }
     s.push_str("</DataArray>\n</PointData>\n<CellData Scalars=\"von_mises\">\n<DataArray type=\"Float64\" Name=\"stress\" NumberOfComponents=\"3\" ComponentName0=\"s11\" ComponentName1=\"s22\" ComponentName2=\"s12\" format=\"ascii\">\n");
     for sg in &state.sigma {
         let _ = writeln!(s, "{:e} {:e} {:e}", sg[0], sg[1], sg[2]);
@@ -74,6 +91,19 @@ pub fn vtu(model: &Model, state: &State) -> String {
         let _ = writeln!(s, "{}", e.body + 1);
     }
     s.push_str("</DataArray>\n</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
+    s
+}
+
+/// A ParaView collection (.pvd) of the time series: one (time, file name) per step, the
+/// files relative to the .pvd's folder.
+pub fn pvd(steps: &[(f64, String)]) -> String {
+    let mut s = String::from(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n",
+    );
+    for (time, file) in steps {
+        let _ = writeln!(s, "<DataSet timestep=\"{time:e}\" group=\"\" part=\"0\" file=\"{file}\"/>");
+    }
+    s.push_str("</Collection>\n</VTKFile>\n");
     s
 }
 

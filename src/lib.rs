@@ -17,6 +17,7 @@ pub mod io;
 pub mod material;
 pub mod mesh;
 pub mod metrics;
+pub mod progress;
 pub mod quadrature;
 pub mod report;
 pub mod scene;

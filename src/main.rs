@@ -3,6 +3,7 @@
 use anyhow::Context;
 use clap::{Parser, Subcommand};
 use contact_rates::case::{Case, PeakMemory, RunSummary};
+use contact_rates::progress::Progress;
 use contact_rates::contact::Method;
 use contact_rates::report;
 use contact_rates::scene::Scene;
@@ -75,6 +76,9 @@ enum Command {
         /// step, from scratch) and report the solver's cost as a multiple of it.
         #[arg(long)]
         floor: bool,
+        /// Write every K-th time step (and the last) to the time series.
+        #[arg(long, value_name = "K", default_value_t = 1)]
+        every: usize,
     },
 }
 
@@ -113,6 +117,7 @@ fn run() -> anyhow::Result<()> {
             tol,
             set,
             floor,
+            every,
         } => {
             let method = Method::parse(&method).with_context(|| {
                 format!("--method: unknown cone '{method}'; use mortar (K_h^pi) or nts (K_h^I)")
@@ -139,6 +144,7 @@ fn run() -> anyhow::Result<()> {
                 out,
                 params: parse_sets(&set)?,
                 floor,
+                every,
             })
         }
     }
@@ -190,14 +196,20 @@ struct SolveRequest {
     params: Vec<(String, f64)>,
     /// Measure the floor too.
     floor: bool,
+    /// Write every `every`-th step to the time series.
+    every: usize,
 }
 
-/// `solve`: one scene on one level with one cone and solver; solution.vtu and summary.csv.
+/// `solve`: one scene on one level with one cone and solver: the time series, contact.csv,
+/// solution.vtu and summary.csv.
 fn solve_one(req: &SolveRequest) -> anyhow::Result<()> {
     let scene = Scene::load(&req.scene)?;
     let steps = req.steps.unwrap_or(scene.steps);
     if steps == 0 {
         anyhow::bail!("--steps: the number of time steps must be at least 1");
+    }
+    if req.every == 0 {
+        anyhow::bail!("--every: write every K-th step with K >= 1, got 0");
     }
     // The output folder is checked (and created) before any computing.
     report::check_writable(&req.out.join("solution"))?;
@@ -206,16 +218,29 @@ fn solve_one(req: &SolveRequest) -> anyhow::Result<()> {
     for w in &case.warnings {
         eprintln!("warning: {w}");
     }
+    let mut series = report::run::Series::new(&req.out, &case.problem, req.every);
+    let progress = Progress::new(steps as u64, "solve");
     let memory = PeakMemory::start();
-    let sol = solve::solve(&case.problem, &req.settings, steps, false)?;
+    let solved = solve::solve_observed(&case.problem, &req.settings, steps, &mut |n, total, state, step| {
+        progress.tick(&format!("step {n} of {total}: {} iterations", step.iterations));
+        series.step(n, total, state)
+    });
+    progress.finish();
     let peak = memory.peak_gib();
+    let sol = match solved {
+        Ok(sol) => sol,
+        Err(e) => {
+            series.abandon();
+            return Err(e.into());
+        }
+    };
     let floor_s = match req.floor {
         true => Some(solve::floor_time(&case.problem, steps)?),
         false => None,
     };
     let run = RunSummary::new(&case, req.settings.kind, &sol, floor_s, peak);
     let wall_s = t0.elapsed().as_secs_f64();
-    report::run::write_run(&req.out, &case.problem.model, sol.last(), &run, wall_s)?;
+    series.finish(sol.last(), &run, wall_s)?;
     print!("{}", report::run::console(&run, wall_s, &req.out));
     Ok(())
 }

@@ -57,3 +57,61 @@ pub fn max_aspect_ratio(p: &Problem) -> f64 {
         })
         .fold(0.0, f64::max)
 }
+
+/// The contact result at one body-1 (slave) node of Gamma_C: what a contact user looks at.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactNode {
+    /// Piece of Gamma_C.
+    pub piece: usize,
+    /// Global node.
+    pub node: usize,
+    /// Arc length from the piece's start (length).
+    pub arc_length: f64,
+    /// Reference position (length).
+    pub position: [f64; 2],
+    /// Contact pressure: the node's multiplier over its lumped trace weight (force/length).
+    pub pressure: f64,
+    /// Normal jump [u.nu] with the other body's trace interpolated (length): positive where
+    /// the bodies interpenetrate, negative where they are apart.
+    pub normal_jump: f64,
+    /// Whether the node's constraint row holds as an equality (C u)_i = 0, to 1e-8 of the
+    /// row's size times max |u|: in contact in the discrete cone's sense.
+    pub active: bool,
+}
+
+/// The contact result at every slave node of Gamma_C, in row order (piece by piece, along
+/// each piece).
+pub fn contact_nodes(p: &Problem, s: &State) -> Vec<ContactNode> {
+    // normal_jumps lists each piece's slave nodes, then its master nodes.
+    let jumps = contact::normal_jumps(&p.interface, &s.u);
+    let mut first_of_piece = Vec::with_capacity(p.interface.pieces.len());
+    let mut k = 0;
+    for piece in &p.interface.pieces {
+        first_of_piece.push(k);
+        k += piece.slave_nodes.len() + piece.master_nodes.len();
+    }
+    let rows_u = contact::apply_rows(&p.rows, &s.u);
+    let u_max = crate::solve::inf_norm(&s.u).max(f64::MIN_POSITIVE);
+    p.rows
+        .iter()
+        .zip(&s.lambda)
+        .zip(&rows_u)
+        .map(|((row, &lambda), &cu)| {
+            let piece = &p.interface.pieces[row.piece];
+            let arc = piece.slave_s[row.i];
+            let size: f64 = row.entries.iter().map(|(_, v)| v.abs()).sum();
+            ContactNode {
+                piece: row.piece,
+                node: piece.slave_nodes[row.i],
+                arc_length: arc,
+                position: [
+                    piece.a[0] + arc * piece.tangent[0],
+                    piece.a[1] + arc * piece.tangent[1],
+                ],
+                pressure: if row.weight > 0.0 { lambda / row.weight } else { 0.0 },
+                normal_jump: jumps[first_of_piece[row.piece] + row.i].2,
+                active: cu.abs() <= 1e-8 * size * u_max,
+            }
+        })
+        .collect()
+}

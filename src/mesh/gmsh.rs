@@ -65,13 +65,13 @@ fn run_gmsh(args: &[String], out: &Path, what: &Path) -> Result<()> {
     })?;
     let text = String::from_utf8_lossy(&output.stdout).to_string()
         + &String::from_utf8_lossy(&output.stderr);
-    let errors: Vec<&str> = text.lines().filter(|l| l.starts_with("Error")).collect();
-    if !output.status.success() || !errors.is_empty() {
+    let has_errors = text.lines().any(|l| l.starts_with("Error"));
+    if !output.status.success() || has_errors {
         let _ = std::fs::remove_file(out);
-        let detail = if errors.is_empty() {
-            text.lines().last().unwrap_or("").to_string()
+        let detail = if has_errors {
+            summarize_errors(&text)
         } else {
-            errors.join(" | ")
+            text.lines().last().unwrap_or("").to_string()
         };
         return Err(Error::Input {
             file: what.to_path_buf(),
@@ -92,21 +92,58 @@ fn run_gmsh(args: &[String], out: &Path, what: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Most distinct gmsh error messages quoted in an error.
+const MAX_DISTINCT_ERRORS: usize = 3;
+
+/// gmsh's error lines as their distinct messages with counts, in order of first
+/// appearance, at most [`MAX_DISTINCT_ERRORS`] of them (gmsh repeats one error per element
+/// or edge: "Wrong mesh element size" 1040 times for a negative size).
+pub fn summarize_errors(text: &str) -> String {
+    let mut distinct: Vec<(String, usize)> = Vec::new();
+    for line in text.lines().filter(|l| l.starts_with("Error")) {
+        let message = line
+            .trim_start_matches("Error")
+            .trim_start()
+            .trim_start_matches(':')
+            .trim()
+            .to_string();
+        match distinct.iter_mut().find(|(m, _)| *m == message) {
+            Some(entry) => entry.1 += 1,
+            None => distinct.push((message, 1)),
+        }
+    }
+    let mut parts: Vec<String> = distinct
+        .iter()
+        .take(MAX_DISTINCT_ERRORS)
+        .map(|(m, n)| if *n > 1 { format!("'{m}' (x{n})") } else { format!("'{m}'") })
+        .collect();
+    if distinct.len() > MAX_DISTINCT_ERRORS {
+        parts.push(format!(
+            "and {} other messages",
+            distinct.len() - MAX_DISTINCT_ERRORS
+        ));
+    }
+    parts.join("; ")
+}
+
 /// Run gmsh with `args` writing the temporary file `tmp`, check that what it wrote parses
-/// (a failed run can leave a broken file), and only then publish it as `path`. Errors name
-/// `geo`; `what` and `fix` say what went wrong and how to fix it.
+/// (a failed run can leave a broken file), and only then publish it as `path`. `what` is
+/// shown on a terminal while gmsh runs; errors name `geo`, `bad` and `fix` say what went
+/// wrong and how to fix it.
 fn produce(
     args: &[String],
     tmp: &Path,
     path: &Path,
     geo: &Path,
-    what: &str,
-    fix: &str,
+    (what, bad, fix): (&str, &str, &str),
 ) -> Result<()> {
-    run_gmsh(args, tmp, geo)?;
+    let spinner = crate::progress::Progress::spinner(&format!("gmsh: {what}"));
+    let ran = run_gmsh(args, tmp, geo);
+    spinner.finish();
+    ran?;
     super::msh::read_msh(tmp).map_err(|e| {
         let _ = std::fs::remove_file(tmp);
-        Error::input(geo, "gmsh", format!("{what} ({e}){fix}"))
+        Error::input(geo, "gmsh", format!("{bad} ({e}){fix}"))
     })?;
     std::fs::rename(tmp, path).map_err(|e| Error::io(path, e))
 }
@@ -170,8 +207,11 @@ pub fn generate(geo: &Path, params: &[(String, f64)], level: usize) -> Result<Ge
                 &t,
                 &path_of(0),
                 geo,
-                "gmsh wrote an unusable mesh",
-                "; fix the .geo",
+                (
+                    &format!("meshing {stem} (level 0)"),
+                    "gmsh wrote an unusable mesh",
+                    "; fix the .geo",
+                ),
             )?;
             1
         }
@@ -191,8 +231,11 @@ pub fn generate(geo: &Path, params: &[(String, f64)], level: usize) -> Result<Ge
             &t,
             &path_of(l),
             geo,
-            "gmsh -refine wrote an unusable mesh",
-            "",
+            (
+                &format!("refining {stem} to level {l} of {level}"),
+                "gmsh -refine wrote an unusable mesh",
+                "",
+            ),
         )?;
     }
     Ok(GeneratedMesh {

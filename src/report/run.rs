@@ -1,11 +1,13 @@
-//! The output of `solve`: solution.vtu, summary.csv, and the lines printed on the console.
+//! The output of `solve`: the time series (solution_NNNN.vtu and solution.pvd), contact.csv,
+//! solution.vtu (the last step), summary.csv, and the lines printed on the console.
 
 use crate::case::RunSummary;
 use crate::contact::Method;
 use crate::error::Result;
 use crate::fe::Model;
 use crate::io::{self, csv_bytes, write_atomic};
-use crate::solve::{SolverKind, State};
+use crate::metrics::{ContactNode, contact_nodes};
+use crate::solve::{Problem, SolverKind, State};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -42,12 +44,101 @@ struct SummaryCsv<'a> {
     ratio_to_floor: Option<f64>,
 }
 
+/// One row of contact.csv: a slave node of Gamma_C at a written time step.
+#[derive(Serialize)]
+struct ContactCsv {
+    /// Time.
+    time: f64,
+    /// Piece of Gamma_C (from 0).
+    piece: usize,
+    /// Arc length along the piece from its start (length).
+    arc_length: f64,
+    x: f64,
+    y: f64,
+    /// Contact pressure (force/length).
+    pressure: f64,
+    /// Normal jump [u.nu] (length; > 0 interpenetration, < 0 apart).
+    normal_jump: f64,
+    /// Whether the node's constraint holds as an equality.
+    active: bool,
+}
+
+/// The time series of a `solve` run, written as the steps come: every `every`-th step and
+/// the last as `solution_NNNN.vtu` with its rows of contact.csv. [`Series::finish`] writes
+/// the collection `solution.pvd`, contact.csv, solution.vtu (the last step) and
+/// summary.csv; [`Series::abandon`] removes the step files of a run that failed.
+pub struct Series<'a> {
+    dir: &'a Path,
+    problem: &'a Problem,
+    every: usize,
+    written: Vec<(f64, String)>,
+    contact: Vec<ContactCsv>,
+    last_contact: Vec<ContactNode>,
+}
+
+impl<'a> Series<'a> {
+    /// A series of `problem`'s steps into `dir`, every `every`-th step (>= 1).
+    pub fn new(dir: &'a Path, problem: &'a Problem, every: usize) -> Self {
+        Series {
+            dir,
+            problem,
+            every: every.max(1),
+            written: Vec::new(),
+            contact: Vec::new(),
+            last_contact: Vec::new(),
+        }
+    }
+
+    /// Write step `n` of `steps` when it is due.
+    pub fn step(&mut self, n: usize, steps: usize, state: &State) -> Result<()> {
+        if n % self.every != 0 && n != steps {
+            return Ok(());
+        }
+        let nodes = contact_nodes(self.problem, state);
+        let name = format!("solution_{n:04}.vtu");
+        write_atomic(
+            &self.dir.join(&name),
+            io::vtu(&self.problem.model, state, &nodes).as_bytes(),
+        )?;
+        self.written.push((state.time, name));
+        self.contact.extend(nodes.iter().map(|c| ContactCsv {
+            time: state.time,
+            piece: c.piece,
+            arc_length: c.arc_length,
+            x: c.position[0],
+            y: c.position[1],
+            pressure: c.pressure,
+            normal_jump: c.normal_jump,
+            active: c.active,
+        }));
+        self.last_contact = nodes;
+        Ok(())
+    }
+
+    /// Write solution.pvd, contact.csv, solution.vtu (the final state `last`) and
+    /// summary.csv; `wall_s` is the whole run's wall time.
+    pub fn finish(self, last: &State, run: &RunSummary, wall_s: f64) -> Result<()> {
+        let model = &self.problem.model;
+        write_atomic(&self.dir.join("solution.pvd"), io::pvd(&self.written).as_bytes())?;
+        write_atomic(&self.dir.join("contact.csv"), &csv_bytes(&self.contact)?)?;
+        write_run(self.dir, model, last, &self.last_contact, run, wall_s)
+    }
+
+    /// Remove the step files written so far (the run failed).
+    pub fn abandon(self) {
+        for (_, name) in &self.written {
+            let _ = std::fs::remove_file(self.dir.join(name));
+        }
+    }
+}
+
 /// Write `dir/solution.vtu` (the final state) and `dir/summary.csv`; `wall_s` is the whole
 /// run's wall time.
 pub fn write_run(
     dir: &Path,
     model: &Model,
     last: &State,
+    contact: &[ContactNode],
     run: &RunSummary,
     wall_s: f64,
 ) -> Result<()> {
@@ -80,7 +171,7 @@ pub fn write_run(
         floor_s: run.floor_s,
         ratio_to_floor: run.ratio_to_floor(),
     };
-    write_atomic(&dir.join("solution.vtu"), io::vtu(model, last).as_bytes())?;
+    write_atomic(&dir.join("solution.vtu"), io::vtu(model, last, contact).as_bytes())?;
     write_atomic(&dir.join("summary.csv"), &csv_bytes(&[row])?)
 }
 

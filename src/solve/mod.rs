@@ -272,6 +272,31 @@ pub fn solve(
     solve_times(p, settings, &times, keep_history)
 }
 
+/// Called after every solved step with the step's number n (from 1), the number of steps,
+/// the state and its report; its time is left out of the solution's `wall_s`. An error
+/// stops the run.
+pub type StepObserver<'o> = dyn FnMut(usize, usize, &State, &StepReport) -> Result<()> + 'o;
+
+/// [`solve`] with `observer` called after every step (progress, a time series); only the
+/// initial and the final state are kept.
+pub fn solve_observed(
+    p: &Problem,
+    settings: &Settings,
+    steps: usize,
+    observer: &mut StepObserver,
+) -> Result<Solution> {
+    if steps == 0 {
+        return Err(Error::input(
+            &p.model.scene.file,
+            "steps",
+            "the number of time steps must be at least 1",
+        ));
+    }
+    let k = p.model.scene.final_time / steps as f64;
+    let times: Vec<f64> = (1..=steps).map(|n| n as f64 * k).collect();
+    run_steps(p, settings, &times, false, observer)
+}
+
 /// States before the last one used by the predictor (HISTORY + 1 points: polynomial
 /// extrapolation of degree HISTORY).
 const HISTORY: usize = 2;
@@ -282,6 +307,17 @@ pub fn solve_times(
     settings: &Settings,
     times: &[f64],
     keep_history: bool,
+) -> Result<Solution> {
+    run_steps(p, settings, times, keep_history, &mut |_, _, _, _| Ok(()))
+}
+
+/// The time loop of [`solve_times`] with an observer of every step.
+fn run_steps(
+    p: &Problem,
+    settings: &Settings,
+    times: &[f64],
+    keep_history: bool,
+    observer: &mut StepObserver,
 ) -> Result<Solution> {
     if times.is_empty() || times[0] <= 0.0 || times.windows(2).any(|w| w[1] <= w[0]) {
         return Err(Error::input(
@@ -317,6 +353,7 @@ pub fn solve_times(
     let mut prev = initial;
     // The last states before `prev` (newest first), for the predictor.
     let mut history: Vec<State> = Vec::new();
+    let mut observer_s = 0.0;
     for n in 1..=steps {
         let t = times[n - 1];
         let k = t - prev.time;
@@ -364,6 +401,9 @@ pub fn solve_times(
             )),
             other => other,
         })?;
+        let observed = Instant::now();
+        observer(n, steps, &state, &report)?;
+        observer_s += observed.elapsed().as_secs_f64();
         reports.push(report);
         if keep_history {
             states.push(state.clone());
@@ -378,7 +418,7 @@ pub fn solve_times(
     Ok(Solution {
         states,
         reports,
-        wall_s: start.elapsed().as_secs_f64() - timings.setup_s,
+        wall_s: start.elapsed().as_secs_f64() - timings.setup_s - observer_s,
         timings,
     })
 }

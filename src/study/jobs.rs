@@ -180,35 +180,4 @@ impl Solved {
     }
 }
 
-/// Progress reporting: one tick per solve; silent when stderr is not a terminal.
-pub struct Progress(indicatif::ProgressBar);
-
-impl Progress {
-    /// A bar of `n` jobs named `name`.
-    pub fn new(n: u64, name: &str) -> Self {
-        use std::io::IsTerminal;
-        let pb = if std::io::stderr().is_terminal() {
-            indicatif::ProgressBar::new(n)
-        } else {
-            indicatif::ProgressBar::hidden()
-        };
-        pb.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{prefix} [{bar:30}] {pos}/{len} {msg} ({elapsed})",
-            )
-            .unwrap()
-            .progress_chars("=> "),
-        );
-        pb.set_prefix(name.to_string());
-        Progress(pb)
-    }
-    /// One job done.
-    pub fn tick(&self, label: &str) {
-        self.0.set_message(label.to_string());
-        self.0.inc(1);
-    }
-    /// Clear the bar.
-    pub fn finish(&self) {
-        self.0.finish_and_clear();
-    }
-}
+pub use crate::progress::Progress;

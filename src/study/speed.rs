@@ -40,7 +40,7 @@ pub struct Family {
 
 /// The viscoplastic family (the `rates` scene) and the elastic one (`rates-elastic`: no
 /// yield stress, the same meshes). h_upper = 0.28 puts level 7 at 2.07e6 dofs.
-pub const FAMILIES: [Family; 2] = [
+pub static FAMILIES: [Family; 2] = [
     Family {
         scene: "rates",
         h_upper: 0.28,
