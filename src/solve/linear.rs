@@ -14,13 +14,56 @@ use faer::sparse::linalg::cholesky::{
     LdltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
 };
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat};
+use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Conj, Par, Side};
 use std::time::Instant;
 
 /// An LDL^T factorization (values and the one symbolic analysis they belong to).
 struct Ldlt {
     values: Vec<f64>,
+    /// The symmetric scaling W of the factored matrix W A W (see [`equilibrate`]).
+    scaling: Vec<f64>,
+}
+
+/// The symmetric (Jacobi) scaling w of the matrix whose lower triangle is `values`: w_j =
+/// 1/sqrt|a_jj|, and for a zero diagonal (an active multiplier row) 1 / the largest
+/// |a_ij| w_i of its row, so that W A W has unit diagonal or a largest entry of 1 in
+/// every row. Pivots can then be judged against one threshold whatever the units and the
+/// bodies' moduli.
+fn equilibrate(symbolic: SymbolicSparseColMatRef<'_, usize>, values: &[f64]) -> Vec<f64> {
+    let n = symbolic.ncols();
+    let mut diagonal = vec![0.0f64; n];
+    for j in 0..n {
+        for (s, i) in symbolic.row_idx_of_col(j).enumerate() {
+            if i == j {
+                diagonal[j] = values[symbolic.col_ptr()[j] + s].abs();
+            }
+        }
+    }
+    let mut w: Vec<f64> = diagonal
+        .iter()
+        .map(|&d| if d > 0.0 { 1.0 / d.sqrt() } else { 0.0 })
+        .collect();
+    let mut largest = vec![0.0f64; n];
+    for j in 0..n {
+        for (s, i) in symbolic.row_idx_of_col(j).enumerate() {
+            if i > j {
+                let a = values[symbolic.col_ptr()[j] + s].abs();
+                if diagonal[i] == 0.0 {
+                    largest[i] = largest[i].max(a * w[j]);
+                }
+                if diagonal[j] == 0.0 {
+                    largest[j] = largest[j].max(a * w[i]);
+                }
+            }
+        }
+    }
+    for j in 0..n {
+        if diagonal[j] == 0.0 {
+            w[j] = if largest[j] > 0.0 { 1.0 / largest[j] } else { 1.0 };
+        }
+    }
+    w
 }
 
 /// A square sparse matrix with a fixed pattern and a reusable symbolic factorization.
@@ -128,14 +171,24 @@ impl SparseSystem {
         Ok(())
     }
 
-    /// LDL^T factorization of the symmetric matrix whose lower triangle is `values` (in
-    /// pattern order; the upper triangle is not read). `signs` are the expected pivot signs
-    /// (+1 displacement rows, -1 multiplier rows); a pivot of the wrong sign or below `eps`
-    /// in magnitude is replaced by `delta` with its expected sign (faer's dynamic
-    /// regularization), so the factorization is that of a nearby matrix: callers refine.
-    pub fn factor_ldlt(&mut self, values: &[f64], signs: &[i8], eps: f64, delta: f64) -> Result<()> {
+    /// LDL^T factorization of the symmetric matrix A whose lower triangle is `values` (in
+    /// pattern order; the upper triangle is not read), scaled symmetrically first (W A W,
+    /// [`equilibrate`]). `signs` are the expected pivot signs (+1 displacement rows, -1
+    /// multiplier rows); a pivot of the scaled matrix of the wrong sign or below `eps` in
+    /// magnitude is replaced by `delta` with its expected sign (faer's dynamic
+    /// regularization): the factorization is then that of a nearby matrix (a low-rank
+    /// change), which callers refine.
+    pub fn factor_ldlt(&mut self, values: &mut [f64], signs: &[i8], eps: f64, delta: f64) -> Result<()> {
         let symbolic = self.symbolic_ldlt.as_ref().expect("analyze_ldlt before factor_ldlt");
         let t = Instant::now();
+        let pattern = self.mat.symbolic();
+        let scaling = equilibrate(pattern, values);
+        for j in 0..pattern.ncols() {
+            let start = pattern.col_ptr()[j];
+            for (s, i) in pattern.row_idx_of_col(j).enumerate() {
+                values[start + s] *= scaling[i] * scaling[j];
+            }
+        }
         let mut l_values = self.ldlt.take().map(|f| f.values).unwrap_or_default();
         l_values.resize(symbolic.len_val(), 0.0);
         let par = Par::Seq;
@@ -162,7 +215,10 @@ impl SparseSystem {
             .map_err(|e| Error::NotConverged(format!("LDLT failed: {e:?}")))?;
         self.factor_s += t.elapsed().as_secs_f64();
         self.factorizations += 1;
-        self.ldlt = Some(Ldlt { values: l_values });
+        self.ldlt = Some(Ldlt {
+            values: l_values,
+            scaling,
+        });
         self.llt = None;
         Ok(())
     }
@@ -209,19 +265,27 @@ impl SparseSystem {
         use faer::linalg::solvers::Solve;
         let n = rhs.len() / k;
         self.solves.set(self.solves.get() + k);
-        let m = faer::MatMut::from_column_major_slice_mut(rhs, n, k);
         if let Some(ldlt) = &self.ldlt {
+            // A^{-1} = W (W A W)^{-1} W.
+            let scale = |rhs: &mut [f64]| {
+                for col in rhs.chunks_mut(n) {
+                    col.iter_mut().zip(&ldlt.scaling).for_each(|(v, w)| *v *= w);
+                }
+            };
+            scale(rhs);
             let symbolic = self.symbolic_ldlt.as_ref().expect("factored");
             let mut buffer =
                 MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(k, Par::Seq));
+            let m = faer::MatMut::from_column_major_slice_mut(rhs, n, k);
             LdltRef::new(symbolic, &ldlt.values).solve_in_place_with_conj(
                 Conj::No,
                 m,
                 Par::Seq,
                 MemStack::new(&mut buffer),
             );
+            scale(rhs);
         } else if let Some(llt) = &self.llt {
-            llt.solve_in_place(m);
+            llt.solve_in_place(faer::MatMut::from_column_major_slice_mut(rhs, n, k));
         } else {
             panic!("solve before factor");
         }
