@@ -15,6 +15,9 @@ use crate::error::{Error, Result};
 use crate::fe::Pattern;
 use crate::material::Stress;
 
+/// The tightest stopping tolerance of the penalty-duality iteration (relative change).
+const INNER_TOL_FLOOR: f64 = 1e-15;
+
 /// How each contact subproblem is solved.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Inner {
@@ -31,6 +34,9 @@ pub struct FixedPoint<'a> {
     /// Mean diagonal of the stiffness (force/length): turns gaps into forces in the
     /// complementarity test.
     c_scale: f64,
+    /// Relative change of the penalty-duality iterates at which it stops (1e-3 of the
+    /// tolerance, tightened when the equations are not solved to the tolerance).
+    inner_tol: f64,
     inner: Inner,
     /// A + omega C^T W C (penalty-duality) or A (Clarabel), over free dofs.
     system: SparseSystem,
@@ -108,6 +114,7 @@ impl<'a> FixedPoint<'a> {
             q: vec![0.0; p.rows.len()],
             eta: None,
             c_scale: mean_diag,
+            inner_tol: 1e-3 * settings.tol,
             clarabel_s: 0.0,
             pattern_s,
         })
@@ -128,7 +135,7 @@ impl<'a> FixedPoint<'a> {
         let (omega, rho) = (self.omega, self.settings.rho);
         let w: Vec<f64> = p.rows.iter().map(|r| r.weight).collect();
         let mut u_old = u0.to_vec();
-        let tol = 1e-3 * self.settings.tol;
+        let tol = self.inner_tol;
         for it in 1..=100_000 {
             // (4.4): (A + omega C^T W C) u = b - C^T W q.
             let wq: Vec<f64> = self.q.iter().zip(&w).map(|(q, w)| q * w).collect();
@@ -361,7 +368,11 @@ impl StepSolver for FixedPoint<'_> {
                 // iterations sharpen eta); an exact fixed point, or one that stopped
                 // improving, has inaccurate contact subproblems.
                 let distance = residual.max(complementarity);
-                if change == 0.0 || settled_distance.is_some_and(|d| distance > 0.5 * d) {
+                if self.inner == Inner::PenaltyDuality && self.inner_tol > INNER_TOL_FLOOR {
+                    // The penalty-duality iteration stops on the change of its iterates:
+                    // ask it for more digits and solve the subproblem again.
+                    self.inner_tol = (self.inner_tol * 1e-2).max(INNER_TOL_FLOOR);
+                } else if change == 0.0 || settled_distance.is_some_and(|d| distance > 0.5 * d) {
                     return Err(Error::NotConverged(format!(
                         "the fixed point settled after {outer} iterations (relative change of k*eta {rel:.2e}) but the equilibrium residual {residual:.3e} and complementarity {complementarity:.3e} of (2.1) are not both below the tolerance {tol:.0e}: the contact subproblems were solved inaccurately"
                     )));

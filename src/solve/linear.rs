@@ -13,7 +13,7 @@ use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
     LdltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
 };
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::sparse::linalg::solvers::{Llt, Lu, SymbolicLlt, SymbolicLu};
 use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Conj, Par, Side};
 use std::time::Instant;
@@ -72,8 +72,10 @@ pub struct SparseSystem {
     mat: SparseColMat<usize, f64>,
     symbolic_ldlt: Option<SymbolicCholesky<usize>>,
     symbolic_llt: Option<SymbolicLlt<usize>>,
+    symbolic_lu: Option<SymbolicLu<usize>>,
     ldlt: Option<Ldlt>,
     llt: Option<Llt<usize, f64>>,
+    lu: Option<Lu<usize, f64>>,
     /// Seconds spent in numeric factorizations.
     pub factor_s: f64,
     /// Seconds spent in the one-off symbolic analysis (ordering, elimination tree).
@@ -100,8 +102,10 @@ impl SparseSystem {
             mat,
             symbolic_ldlt: None,
             symbolic_llt: None,
+            symbolic_lu: None,
             ldlt: None,
             llt: None,
+            lu: None,
             factor_s: 0.0,
             symbolic_s: 0.0,
             factorizations: 0,
@@ -220,7 +224,43 @@ impl SparseSystem {
             scaling,
         });
         self.llt = None;
+        self.lu = None;
         Ok(())
+    }
+
+    /// LU factorization with partial pivoting of the matrix itself (any invertible matrix;
+    /// its symbolic analysis is done on first use). 3-7x the cost of the LDL^T: the fallback
+    /// for a tangent too far from symmetric for GMRES.
+    pub fn factor_lu(&mut self) -> Result<()> {
+        if self.symbolic_lu.is_none() {
+            let t = Instant::now();
+            self.symbolic_lu = Some(
+                SymbolicLu::try_new(self.mat.symbolic())
+                    .map_err(|e| Error::NotConverged(format!("symbolic LU failed: {e:?}")))?,
+            );
+            self.symbolic_s += t.elapsed().as_secs_f64();
+        }
+        let t = Instant::now();
+        let lu = Lu::try_new_with_symbolic(
+            self.symbolic_lu.clone().expect("analyzed above"),
+            self.mat.as_ref(),
+        )
+        .map_err(|e| {
+            Error::NotConverged(format!(
+                "the linearized system is singular ({e:?}): is a body free to move?"
+            ))
+        })?;
+        self.factor_s += t.elapsed().as_secs_f64();
+        self.factorizations += 1;
+        self.lu = Some(lu);
+        self.ldlt = None;
+        self.llt = None;
+        Ok(())
+    }
+
+    /// Whether the last factorization is the LU of the matrix itself.
+    pub fn is_lu(&self) -> bool {
+        self.lu.is_some()
     }
 
     /// Cholesky factorization (symmetric positive definite matrices; lower triangle read).
@@ -248,6 +288,7 @@ impl SparseSystem {
         self.factorizations += 1;
         self.llt = Some(llt);
         self.ldlt = None;
+        self.lu = None;
         Ok(())
     }
 
@@ -284,6 +325,8 @@ impl SparseSystem {
                 MemStack::new(&mut buffer),
             );
             scale(rhs);
+        } else if let Some(lu) = &self.lu {
+            lu.solve_in_place(faer::MatMut::from_column_major_slice_mut(rhs, n, k));
         } else if let Some(llt) = &self.llt {
             llt.solve_in_place(faer::MatMut::from_column_major_slice_mut(rhs, n, k));
         } else {
@@ -309,7 +352,7 @@ impl SparseSystem {
 
     /// Whether a factorization is available.
     pub fn is_factored(&self) -> bool {
-        self.ldlt.is_some() || self.llt.is_some()
+        self.ldlt.is_some() || self.llt.is_some() || self.lu.is_some()
     }
 
     /// Solve `A x = b` with the current values of A by GMRES, right-preconditioned with

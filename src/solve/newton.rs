@@ -91,9 +91,10 @@ fn symmetric_tangent(d: &Matrix3<f64>, elastic: &Matrix3<f64>) -> Matrix3<f64> {
 /// Iterates whose merit the non-monotone line search remembers.
 const MERIT_MEMORY: usize = 3;
 
-/// GMRES iterations allowed right after a factorization (the non-symmetric part of a
-/// viscoplastic tangent is all that is left for it).
-const FRESH_BUDGET: usize = 40;
+/// GMRES iterations allowed right after a symmetric factorization (the non-symmetric part
+/// of a viscoplastic tangent is all that is left for it); beyond, the LU of the Newton
+/// matrix is used.
+const FRESH_BUDGET: usize = 20;
 
 
 
@@ -356,6 +357,11 @@ impl Newton<'_> {
     /// diagonal only: x_{n+i} = b_{n+i} / c is known, its columns move to the right-hand side,
     /// and the rest is the symmetric system the LDL^T factored (rows scaled by s_i).
     fn solve_factored(&self, v: &mut [f64], k: usize) {
+        if self.system.is_lu() {
+            // The LU is of A0 itself.
+            self.system.solve_many(v, k);
+            return;
+        }
         let (n, m) = (self.n, self.p.rows.len());
         let big_n = n + m;
         for col in v.chunks_mut(big_n).take(k) {
@@ -531,15 +537,22 @@ impl Newton<'_> {
         let update = self
             .row_update(active)
             .expect("no row changed since the factorization");
-        let its = timed(&clock.solve, || {
+        let rhs0 = rhs.clone();
+        let fresh = timed(&clock.solve, || {
             self.system
                 .gmres(rhs, forcing, FRESH_BUDGET, &|v| self.precondition(&update, v))
-        })
-        .ok_or_else(|| {
-            Error::NotConverged(format!(
-                "GMRES preconditioned by a fresh factorization did not reach {forcing:.1e} in {FRESH_BUDGET} iterations"
-            ))
-        })?;
+        });
+        let its = match fresh {
+            Some(its) => its,
+            None => {
+                // A tangent too far from symmetric (stiff viscosity, k E / lambda near 1e4):
+                // the LU of the Newton matrix itself, exact, as before issue 14.
+                rhs.copy_from_slice(&rhs0);
+                self.system.factor_lu()?;
+                timed(&clock.solve, || self.system.solve(rhs));
+                0
+            }
+        };
         self.fresh_iterations = its;
         Ok(true)
     }
