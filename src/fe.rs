@@ -92,17 +92,35 @@ pub struct Pattern {
 
 impl Pattern {
     /// Build from (row, col) pairs (duplicates allowed).
-    pub fn from_entries(n: usize, mut entries: Vec<(usize, usize)>) -> Self {
-        entries.sort_unstable_by_key(|&(r, c)| (c, r));
-        entries.dedup();
-        let mut col_ptr = vec![0usize; n + 1];
-        let mut row_idx = Vec::with_capacity(entries.len());
-        for &(r, c) in &entries {
-            col_ptr[c + 1] += 1;
-            row_idx.push(r);
+    pub fn from_entries(n: usize, entries: Vec<(usize, usize)>) -> Self {
+        // Bucket the rows by column (counting sort), then sort and deduplicate each short
+        // column: linear in the entries, where one sort of all (36 per triangle) cost about
+        // 1 s at 4e5 dofs.
+        let mut start = vec![0usize; n + 1];
+        for &(_, c) in &entries {
+            start[c + 1] += 1;
         }
         for c in 0..n {
-            col_ptr[c + 1] += col_ptr[c];
+            start[c + 1] += start[c];
+        }
+        let mut next = start.clone();
+        let mut rows = vec![0usize; entries.len()];
+        for &(r, c) in &entries {
+            rows[next[c]] = r;
+            next[c] += 1;
+        }
+        let mut col_ptr = vec![0usize; n + 1];
+        let mut row_idx = Vec::with_capacity(entries.len());
+        for c in 0..n {
+            let column = &mut rows[start[c]..start[c + 1]];
+            column.sort_unstable();
+            let first = row_idx.len();
+            for &r in column.iter() {
+                if row_idx.len() == first || row_idx.last() != Some(&r) {
+                    row_idx.push(r);
+                }
+            }
+            col_ptr[c + 1] = row_idx.len();
         }
         Pattern {
             n,

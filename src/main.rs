@@ -240,7 +240,7 @@ fn solve_one(req: &SolveRequest) -> anyhow::Result<()> {
     };
     let run = RunSummary::new(&case, req.settings.kind, &sol, floor_s, peak);
     let wall_s = t0.elapsed().as_secs_f64();
-    series.finish(sol.last(), &run, wall_s)?;
+    series.finish(&run, wall_s)?;
     print!("{}", report::run::console(&run, wall_s, &req.out));
     Ok(())
 }

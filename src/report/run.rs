@@ -3,8 +3,7 @@
 
 use crate::case::RunSummary;
 use crate::contact::Method;
-use crate::error::Result;
-use crate::fe::Model;
+use crate::error::{Error, Result};
 use crate::io::{self, csv_bytes, write_atomic};
 use crate::metrics::{ContactNode, contact_nodes};
 use crate::solve::{Problem, SolverKind, State};
@@ -115,13 +114,16 @@ impl<'a> Series<'a> {
         Ok(())
     }
 
-    /// Write solution.pvd, contact.csv, solution.vtu (the final state `last`) and
-    /// summary.csv; `wall_s` is the whole run's wall time.
-    pub fn finish(self, last: &State, run: &RunSummary, wall_s: f64) -> Result<()> {
-        let model = &self.problem.model;
+    /// Write solution.pvd, contact.csv, solution.vtu (the last step) and summary.csv;
+    /// `wall_s` is the whole run's wall time.
+    pub fn finish(self, run: &RunSummary, wall_s: f64) -> Result<()> {
         write_atomic(&self.dir.join("solution.pvd"), io::pvd(&self.written).as_bytes())?;
         write_atomic(&self.dir.join("contact.csv"), &csv_bytes(&self.contact)?)?;
-        write_run(self.dir, model, last, &self.last_contact, run, wall_s)
+        // The last step is always in the series: solution.vtu is a copy of its file.
+        let (_, last_file) = self.written.last().expect("the last step is always written");
+        let bytes = std::fs::read(self.dir.join(last_file)).map_err(|e| Error::io(self.dir, e))?;
+        write_atomic(&self.dir.join("solution.vtu"), &bytes)?;
+        write_summary(self.dir, run, wall_s)
     }
 
     /// Remove the step files written so far (the run failed).
@@ -132,16 +134,8 @@ impl<'a> Series<'a> {
     }
 }
 
-/// Write `dir/solution.vtu` (the final state) and `dir/summary.csv`; `wall_s` is the whole
-/// run's wall time.
-pub fn write_run(
-    dir: &Path,
-    model: &Model,
-    last: &State,
-    contact: &[ContactNode],
-    run: &RunSummary,
-    wall_s: f64,
-) -> Result<()> {
+/// Write `dir/summary.csv`; `wall_s` is the whole run's wall time.
+fn write_summary(dir: &Path, run: &RunSummary, wall_s: f64) -> Result<()> {
     let t = &run.timings;
     let row = SummaryCsv {
         scene: &run.scene,
@@ -171,7 +165,6 @@ pub fn write_run(
         floor_s: run.floor_s,
         ratio_to_floor: run.ratio_to_floor(),
     };
-    write_atomic(&dir.join("solution.vtu"), io::vtu(model, last, contact).as_bytes())?;
     write_atomic(&dir.join("summary.csv"), &csv_bytes(&[row])?)
 }
 

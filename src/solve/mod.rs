@@ -260,6 +260,11 @@ pub fn solve(
     steps: usize,
     keep_history: bool,
 ) -> Result<Solution> {
+    solve_times(p, settings, &uniform_times(p, steps)?, keep_history)
+}
+
+/// `steps` uniform time steps over [0, T]: t_1, ..., t_N = T.
+fn uniform_times(p: &Problem, steps: usize) -> Result<Vec<f64>> {
     if steps == 0 {
         return Err(Error::input(
             &p.model.scene.file,
@@ -268,8 +273,7 @@ pub fn solve(
         ));
     }
     let k = p.model.scene.final_time / steps as f64;
-    let times: Vec<f64> = (1..=steps).map(|n| n as f64 * k).collect();
-    solve_times(p, settings, &times, keep_history)
+    Ok((1..=steps).map(|n| n as f64 * k).collect())
 }
 
 /// Called after every solved step with the step's number n (from 1), the number of steps,
@@ -285,16 +289,7 @@ pub fn solve_observed(
     steps: usize,
     observer: &mut StepObserver,
 ) -> Result<Solution> {
-    if steps == 0 {
-        return Err(Error::input(
-            &p.model.scene.file,
-            "steps",
-            "the number of time steps must be at least 1",
-        ));
-    }
-    let k = p.model.scene.final_time / steps as f64;
-    let times: Vec<f64> = (1..=steps).map(|n| n as f64 * k).collect();
-    run_steps(p, settings, &times, false, observer)
+    run_steps(p, settings, &uniform_times(p, steps)?, false, observer)
 }
 
 /// States before the last one used by the predictor (HISTORY + 1 points: polynomial
