@@ -146,8 +146,9 @@ fn check_parameters(scene: &Scene, params: &[(String, f64)]) -> Result<()> {
     Ok(())
 }
 
-/// Peak resident memory of a solve per free dof (bytes): measured by `study speed` with
-/// newton (4 steps) at 1e5-2e6 dofs, 2.3-3.3 KB, plus a margin for the mesh and the model.
+/// Peak resident memory of a solve per free dof (bytes): measured with newton (4 steps)
+/// at 1.4e5-2.2e6 dofs, 2.6-3.4 KB (whole `solve` process at 5.5e5 dofs: 3.0 KB; `study
+/// speed`'s solve peak at 2.2e6: 3.4 KB), rounded up for the mesh and the model.
 pub const BYTES_PER_DOF: f64 = 4.0e3;
 
 /// The machine's memory (bytes), from /proc/meminfo.
