@@ -132,14 +132,18 @@ fn check_parameters(scene: &Scene, params: &[(String, f64)]) -> Result<()> {
             return Err(Error::input(
                 &scene.file,
                 field,
-                format!("{name} = {value} is not a finite number; give a finite value (--set {name}=VALUE or the scene's [parameters])"),
+                format!(
+                    "{name} = {value} is not a finite number; give a finite value (--set {name}=VALUE or the scene's [parameters])"
+                ),
             ));
         }
         if name.starts_with('h') && *value <= 0.0 {
             return Err(Error::input(
                 &scene.file,
                 field,
-                format!("{name} = {value} is a mesh size and must be positive; give a size > 0 (the scene's default is in its [parameters])"),
+                format!(
+                    "{name} = {value} is a mesh size and must be positive; give a size > 0 (the scene's default is in its [parameters])"
+                ),
             ));
         }
     }
@@ -173,7 +177,10 @@ fn check_memory(scene: &Scene, params: &[(String, f64)], level: usize) -> Result
         return Ok(());
     }
     let gib = |b: f64| b / (1024.0 * 1024.0 * 1024.0);
-    let fits = (0..level).rev().find(|&l| bytes(l) <= available).unwrap_or(0);
+    let fits = (0..level)
+        .rev()
+        .find(|&l| bytes(l) <= available)
+        .unwrap_or(0);
     Err(Error::input(
         &scene.file,
         "level",

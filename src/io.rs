@@ -101,7 +101,10 @@ pub fn pvd(steps: &[(f64, String)]) -> String {
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n",
     );
     for (time, file) in steps {
-        let _ = writeln!(s, "<DataSet timestep=\"{time:e}\" group=\"\" part=\"0\" file=\"{file}\"/>");
+        let _ = writeln!(
+            s,
+            "<DataSet timestep=\"{time:e}\" group=\"\" part=\"0\" file=\"{file}\"/>"
+        );
     }
     s.push_str("</Collection>\n</VTKFile>\n");
     s

@@ -3,8 +3,8 @@
 use anyhow::Context;
 use clap::{Parser, Subcommand};
 use contact_rates::case::{Case, PeakMemory, RunSummary};
-use contact_rates::progress::Progress;
 use contact_rates::contact::Method;
+use contact_rates::progress::Progress;
 use contact_rates::report;
 use contact_rates::scene::Scene;
 use contact_rates::solve::{self, Settings, SolverKind};
@@ -221,10 +221,18 @@ fn solve_one(req: &SolveRequest) -> anyhow::Result<()> {
     let mut series = report::run::Series::new(&req.out, &case.problem, req.every);
     let progress = Progress::new(steps as u64, "solve");
     let memory = PeakMemory::start();
-    let solved = solve::solve_observed(&case.problem, &req.settings, steps, &mut |n, total, state, step| {
-        progress.tick(&format!("step {n} of {total}: {} iterations", step.iterations));
-        series.step(n, total, state)
-    });
+    let solved = solve::solve_observed(
+        &case.problem,
+        &req.settings,
+        steps,
+        &mut |n, total, state, step| {
+            progress.tick(&format!(
+                "step {n} of {total}: {} iterations",
+                step.iterations
+            ));
+            series.step(n, total, state)
+        },
+    );
     progress.finish();
     let peak = memory.peak_gib();
     let sol = match solved {

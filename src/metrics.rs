@@ -108,7 +108,11 @@ pub fn contact_nodes(p: &Problem, s: &State) -> Vec<ContactNode> {
                     piece.a[0] + arc * piece.tangent[0],
                     piece.a[1] + arc * piece.tangent[1],
                 ],
-                pressure: if row.weight > 0.0 { lambda / row.weight } else { 0.0 },
+                pressure: if row.weight > 0.0 {
+                    lambda / row.weight
+                } else {
+                    0.0
+                },
                 normal_jump: jumps[first_of_piece[row.piece] + row.i].2,
                 active: cu.abs() <= 1e-8 * size * u_max,
             }

@@ -27,7 +27,11 @@ fn fails_short(out: &Output, needles: &[&str]) {
     assert_eq!(out.status.code(), Some(1), "exit code; stderr: {err}");
     assert!(!err.contains("panicked"), "panic: {err}");
     assert!(err.lines().count() <= 3, "at most a few lines: {err}");
-    assert!(err.len() <= 600, "a short message ({} bytes): {err}", err.len());
+    assert!(
+        err.len() <= 600,
+        "a short message ({} bytes): {err}",
+        err.len()
+    );
     for n in needles {
         assert!(err.contains(n), "message lacks '{n}': {err}");
     }
@@ -63,8 +67,17 @@ fn solve_writes_contact_csv_and_a_paraview_time_series() {
         let out = dir.path().join("out");
         let o = run(
             &[
-                "solve", "--scene", "patch", "--method", method, "--level", "1", "--steps", "4",
-                "--out", out.to_str().unwrap(),
+                "solve",
+                "--scene",
+                "patch",
+                "--method",
+                method,
+                "--level",
+                "1",
+                "--steps",
+                "4",
+                "--out",
+                out.to_str().unwrap(),
             ],
             &[],
         );
@@ -74,7 +87,16 @@ fn solve_writes_contact_csv_and_a_paraview_time_series() {
         let header: Vec<String> = rdr.headers().unwrap().iter().map(String::from).collect();
         assert_eq!(
             header,
-            ["time", "piece", "arc_length", "x", "y", "pressure", "normal_jump", "active"]
+            [
+                "time",
+                "piece",
+                "arc_length",
+                "x",
+                "y",
+                "pressure",
+                "normal_jump",
+                "active"
+            ]
         );
         let rows: Vec<csv::StringRecord> = rdr.records().map(|r| r.unwrap()).collect();
         let f = |r: &csv::StringRecord, i: usize| r[i].parse::<f64>().unwrap();
@@ -85,7 +107,11 @@ fn solve_writes_contact_csv_and_a_paraview_time_series() {
             let at: Vec<&csv::StringRecord> = rows.iter().filter(|r| f(r, 0) == t).collect();
             let p_max = at.iter().map(|r| f(r, 5)).fold(0.0, f64::max);
             for r in &at {
-                assert!(f(r, 5) >= -1e-9 * p_max, "{method} t = {t}: pressure {}", f(r, 5));
+                assert!(
+                    f(r, 5) >= -1e-9 * p_max,
+                    "{method} t = {t}: pressure {}",
+                    f(r, 5)
+                );
                 if f(r, 5) > 1e-8 * p_max {
                     assert_eq!(&r[7], "true", "{method} t = {t}: pressure > 0 but inactive");
                 }
@@ -122,7 +148,12 @@ fn solve_writes_contact_csv_and_a_paraview_time_series() {
             let vtu = std::fs::read_to_string(file).unwrap();
             let n = number_of_points(&vtu);
             let pressure = point_array(&vtu, "pressure");
-            assert_eq!(pressure.len(), n, "{}: one pressure per point", file.display());
+            assert_eq!(
+                pressure.len(),
+                n,
+                "{}: one pressure per point",
+                file.display()
+            );
             assert_eq!(point_array(&vtu, "normal_jump").len(), n);
             let csv_max = rows
                 .iter()
@@ -130,7 +161,10 @@ fn solve_writes_contact_csv_and_a_paraview_time_series() {
                 .map(|r| f(r, 5))
                 .fold(0.0, f64::max);
             let vtu_max = pressure.iter().copied().fold(0.0, f64::max);
-            assert!((vtu_max - csv_max).abs() <= 1e-12 * csv_max, "{vtu_max} {csv_max}");
+            assert!(
+                (vtu_max - csv_max).abs() <= 1e-12 * csv_max,
+                "{vtu_max} {csv_max}"
+            );
         }
         // solution.vtu is the last step.
         let last = std::fs::read_to_string(out.join("solution.vtu")).unwrap();
@@ -146,7 +180,14 @@ fn every_kth_step_and_the_last() {
     let out = dir.path().join("out");
     let o = run(
         &[
-            "solve", "--scene", "patch", "--steps", "5", "--every", "2", "--out",
+            "solve",
+            "--scene",
+            "patch",
+            "--steps",
+            "5",
+            "--every",
+            "2",
+            "--out",
             out.to_str().unwrap(),
         ],
         &[],
@@ -158,7 +199,14 @@ fn every_kth_step_and_the_last() {
         .filter_map(|l| l.split("file=\"").nth(1))
         .map(|s| s.trim_end_matches("\"/>"))
         .collect();
-    assert_eq!(files, ["solution_0002.vtu", "solution_0004.vtu", "solution_0005.vtu"]);
+    assert_eq!(
+        files,
+        [
+            "solution_0002.vtu",
+            "solution_0004.vtu",
+            "solution_0005.vtu"
+        ]
+    );
 }
 
 /// Sizes that are not finite or not positive are refused before gmsh runs (a fake gmsh
@@ -176,7 +224,12 @@ fn sizes_that_are_not_finite_or_not_positive_are_refused_before_meshing() {
         let set = format!("h_upper={value}");
         let o = run(
             &[
-                "solve", "--scene", "rates", "--set", &set, "--out",
+                "solve",
+                "--scene",
+                "rates",
+                "--set",
+                &set,
+                "--out",
                 dir.path().join("o").to_str().unwrap(),
             ],
             &[],
@@ -193,12 +246,24 @@ fn a_level_beyond_the_machines_memory_is_refused_with_the_largest_that_fits() {
     let t = std::time::Instant::now();
     let o = run(
         &[
-            "solve", "--scene", "rates", "--level", "12", "--out",
+            "solve",
+            "--scene",
+            "rates",
+            "--level",
+            "12",
+            "--out",
             dir.path().join("o").to_str().unwrap(),
         ],
         &[],
     );
-    fails_short(&o, &["rates.toml: level: level 12 needs about", "GiB", "the largest level that fits is"]);
+    fails_short(
+        &o,
+        &[
+            "rates.toml: level: level 12 needs about",
+            "GiB",
+            "the largest level that fits is",
+        ],
+    );
     assert!(t.elapsed().as_secs_f64() < 30.0, "refused before refining");
 }
 
@@ -230,10 +295,26 @@ fn gmsh_errors_are_summarised() {
     let path = format!("{}:/usr/bin:/bin", bin.display());
     let cache = dir.path().join("cache");
     let o = run(
-        &["solve", "--scene", "rates", "--out", dir.path().join("o").to_str().unwrap()],
-        &[("PATH", &path), ("CONTACT_RATES_CACHE", cache.to_str().unwrap())],
+        &[
+            "solve",
+            "--scene",
+            "rates",
+            "--out",
+            dir.path().join("o").to_str().unwrap(),
+        ],
+        &[
+            ("PATH", &path),
+            ("CONTACT_RATES_CACHE", cache.to_str().unwrap()),
+        ],
     );
-    fails_short(&o, &["two_blocks.geo", "gmsh failed", "'Wrong mesh element size lc = -1' (x1040)"]);
+    fails_short(
+        &o,
+        &[
+            "two_blocks.geo",
+            "gmsh failed",
+            "'Wrong mesh element size lc = -1' (x1040)",
+        ],
+    );
 }
 
 /// A cached mesh that does not parse is regenerated with a one-line warning.
@@ -244,12 +325,24 @@ fn a_broken_cache_entry_heals_itself() {
     let env = [("CONTACT_RATES_CACHE", cache.to_str().unwrap())];
     let solve = |out: &Path| {
         run(
-            &["solve", "--scene", "rates", "--steps", "1", "--out", out.to_str().unwrap()],
+            &[
+                "solve",
+                "--scene",
+                "rates",
+                "--steps",
+                "1",
+                "--out",
+                out.to_str().unwrap(),
+            ],
             &env,
         )
     };
     let first = solve(&dir.path().join("a"));
-    assert!(first.status.success(), "{}", String::from_utf8_lossy(&first.stderr));
+    assert!(
+        first.status.success(),
+        "{}",
+        String::from_utf8_lossy(&first.stderr)
+    );
     let cached: Vec<PathBuf> = std::fs::read_dir(&cache)
         .unwrap()
         .flatten()
@@ -264,8 +357,16 @@ fn a_broken_cache_entry_heals_itself() {
     assert!(second.status.success(), "{err}");
     let warnings: Vec<&str> = err.lines().filter(|l| l.starts_with("warning")).collect();
     assert_eq!(warnings.len(), 1, "{err}");
-    assert!(warnings[0].contains("did not parse; regenerating it"), "{err}");
-    assert_eq!(std::fs::read_to_string(&cached[0]).unwrap(), text, "regenerated identically");
-    let summary = |d: &str| std::fs::read_to_string(dir.path().join(d).join("contact.csv")).unwrap();
+    assert!(
+        warnings[0].contains("did not parse; regenerating it"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(&cached[0]).unwrap(),
+        text,
+        "regenerated identically"
+    );
+    let summary =
+        |d: &str| std::fs::read_to_string(dir.path().join(d).join("contact.csv")).unwrap();
     assert_eq!(summary("a"), summary("b"));
 }

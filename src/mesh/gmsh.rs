@@ -115,7 +115,13 @@ pub fn summarize_errors(text: &str) -> String {
     let mut parts: Vec<String> = distinct
         .iter()
         .take(MAX_DISTINCT_ERRORS)
-        .map(|(m, n)| if *n > 1 { format!("'{m}' (x{n})") } else { format!("'{m}'") })
+        .map(|(m, n)| {
+            if *n > 1 {
+                format!("'{m}' (x{n})")
+            } else {
+                format!("'{m}'")
+            }
+        })
         .collect();
     if distinct.len() > MAX_DISTINCT_ERRORS {
         parts.push(format!(

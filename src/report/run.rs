@@ -117,10 +117,16 @@ impl<'a> Series<'a> {
     /// Write solution.pvd, contact.csv, solution.vtu (the last step) and summary.csv;
     /// `wall_s` is the whole run's wall time.
     pub fn finish(self, run: &RunSummary, wall_s: f64) -> Result<()> {
-        write_atomic(&self.dir.join("solution.pvd"), io::pvd(&self.written).as_bytes())?;
+        write_atomic(
+            &self.dir.join("solution.pvd"),
+            io::pvd(&self.written).as_bytes(),
+        )?;
         write_atomic(&self.dir.join("contact.csv"), &csv_bytes(&self.contact)?)?;
         // The last step is always in the series: solution.vtu is a copy of its file.
-        let (_, last_file) = self.written.last().expect("the last step is always written");
+        let (_, last_file) = self
+            .written
+            .last()
+            .expect("the last step is always written");
         let bytes = std::fs::read(self.dir.join(last_file)).map_err(|e| Error::io(self.dir, e))?;
         write_atomic(&self.dir.join("solution.vtu"), &bytes)?;
         write_summary(self.dir, run, wall_s)

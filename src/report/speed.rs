@@ -198,7 +198,10 @@ fn time_vs_dofs(res: &SpeedResult, d: &Path) -> Result<()> {
         "speed: newton (set-up + time loop) and the floor against dofs, 4 steps",
         "free dofs",
         "wall time (s)",
-        &series.into_iter().filter(|s| !s.points.is_empty()).collect::<Vec<_>>(),
+        &series
+            .into_iter()
+            .filter(|s| !s.points.is_empty())
+            .collect::<Vec<_>>(),
         &[],
     )
 }
@@ -246,9 +249,7 @@ fn readme(res: &SpeedResult) -> String {
     s.push_str(&table(res));
     for m in [Method::Mortar, Method::Nts] {
         let finest = crate::study::speed::PAPER_LEVELS.iter().max().unwrap();
-        let at_finest = |so| {
-            family_runs(res, &FAMILIES[0], m, so).find(|r| r.run.level == *finest)
-        };
+        let at_finest = |so| family_runs(res, &FAMILIES[0], m, so).find(|r| r.run.level == *finest);
         if let (Some(a), Some(b)) = (at_finest(SolverKind::Newton), at_finest(SolverKind::Paper)) {
             let _ = writeln!(
                 s,

@@ -60,7 +60,11 @@ fn equilibrate(symbolic: SymbolicSparseColMatRef<'_, usize>, values: &[f64]) -> 
     }
     for j in 0..n {
         if diagonal[j] == 0.0 {
-            w[j] = if largest[j] > 0.0 { 1.0 / largest[j] } else { 1.0 };
+            w[j] = if largest[j] > 0.0 {
+                1.0 / largest[j]
+            } else {
+                1.0
+            };
         }
     }
     w
@@ -135,8 +139,14 @@ impl SparseSystem {
         let nnz = symbolic.row_idx().len();
         let mut buffer = MemBuffer::try_new(amd::order_scratch::<usize>(n, nnz))
             .map_err(|_| Error::NotConverged("out of memory in the ordering".into()))?;
-        amd::order(&mut fwd, &mut inv, symbolic, Default::default(), MemStack::new(&mut buffer))
-            .map_err(|e| Error::NotConverged(format!("ordering failed: {e:?}")))?;
+        amd::order(
+            &mut fwd,
+            &mut inv,
+            symbolic,
+            Default::default(),
+            MemStack::new(&mut buffer),
+        )
+        .map_err(|e| Error::NotConverged(format!("ordering failed: {e:?}")))?;
         // Multipliers after their last primal neighbour (rows of column k hold the
         // neighbours: the pattern is symmetric).
         let mut after: Vec<Vec<usize>> = vec![Vec::new(); n];
@@ -182,8 +192,17 @@ impl SparseSystem {
     /// magnitude is replaced by `delta` with its expected sign (faer's dynamic
     /// regularization): the factorization is then that of a nearby matrix (a low-rank
     /// change), which callers refine.
-    pub fn factor_ldlt(&mut self, values: &mut [f64], signs: &[i8], eps: f64, delta: f64) -> Result<()> {
-        let symbolic = self.symbolic_ldlt.as_ref().expect("analyze_ldlt before factor_ldlt");
+    pub fn factor_ldlt(
+        &mut self,
+        values: &mut [f64],
+        signs: &[i8],
+        eps: f64,
+        delta: f64,
+    ) -> Result<()> {
+        let symbolic = self
+            .symbolic_ldlt
+            .as_ref()
+            .expect("analyze_ldlt before factor_ldlt");
         let t = Instant::now();
         let pattern = self.mat.symbolic();
         let scaling = equilibrate(pattern, values);
@@ -315,8 +334,7 @@ impl SparseSystem {
             };
             scale(rhs);
             let symbolic = self.symbolic_ldlt.as_ref().expect("factored");
-            let mut buffer =
-                MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(k, Par::Seq));
+            let mut buffer = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(k, Par::Seq));
             let m = faer::MatMut::from_column_major_slice_mut(rhs, n, k);
             LdltRef::new(symbolic, &ldlt.values).solve_in_place_with_conj(
                 Conj::No,

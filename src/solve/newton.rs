@@ -96,8 +96,6 @@ const MERIT_MEMORY: usize = 3;
 /// matrix is used.
 const FRESH_BUDGET: usize = 20;
 
-
-
 /// Accumulated times of the solver's parts.
 #[derive(Default)]
 struct Clock {
@@ -327,19 +325,19 @@ impl Newton<'_> {
             vals.clear();
             vals.extend_from_slice(&self.elastic_values);
             let symmetric: Vec<Matrix3<f64>> = (self.p.model.elements.iter().zip(tangents))
-                .map(|(e, d)| symmetric_tangent(d, &self.p.model.materials[e.body].elastic.matrix()))
+                .map(|(e, d)| {
+                    symmetric_tangent(d, &self.p.model.materials[e.body].elastic.matrix())
+                })
                 .collect();
-            self.p.model.add_tangent_change(&symmetric, &self.slots, &mut vals);
+            self.p
+                .model
+                .add_tangent_change(&symmetric, &self.slots, &mut vals);
             for (i, row) in self.row_slots.iter().enumerate() {
                 let s = self.row_scale[i];
                 for &(rs, _, _, v) in row {
                     vals[rs] = if active[i] { c * s * v } else { 0.0 };
                 }
-                vals[self.diag_slots[i]] = if active[i] {
-                    0.0
-                } else {
-                    -c * s * s
-                };
+                vals[self.diag_slots[i]] = if active[i] { 0.0 } else { -c * s * s };
             }
         });
         let (eps, delta) = PIVOT_THRESHOLD;
@@ -539,8 +537,9 @@ impl Newton<'_> {
             .expect("no row changed since the factorization");
         let rhs0 = rhs.clone();
         let fresh = timed(&clock.solve, || {
-            self.system
-                .gmres(rhs, forcing, FRESH_BUDGET, &|v| self.precondition(&update, v))
+            self.system.gmres(rhs, forcing, FRESH_BUDGET, &|v| {
+                self.precondition(&update, v)
+            })
         });
         let its = match fresh {
             Some(its) => its,
@@ -696,7 +695,11 @@ impl StepSolver for Newton<'_> {
                 )));
             }
             merits.push(self.merit(ev, &lambda));
-            let reference = merits.iter().rev().take(MERIT_MEMORY).fold(0.0f64, |a, &b| a.max(b));
+            let reference = merits
+                .iter()
+                .rev()
+                .take(MERIT_MEMORY)
+                .fold(0.0f64, |a, &b| a.max(b));
             let mut step: Vec<f64> = ev
                 .residual
                 .iter()

@@ -80,7 +80,11 @@ pub const REPEATS: (usize, usize) = (30_000, 7);
 /// Solve `case` with `kind` and measure the floor, `repeats` times alternately: the
 /// solution (deterministic) of the first run with the fastest run's timings, the fastest
 /// floor, and the largest peak memory of the solves.
-fn timed_runs(case: &Case, kind: SolverKind, repeats: usize) -> Result<(Solution, f64, Option<f64>)> {
+fn timed_runs(
+    case: &Case,
+    kind: SolverKind,
+    repeats: usize,
+) -> Result<(Solution, f64, Option<f64>)> {
     let memory = PeakMemory::start();
     let (mut best, _) = solve_case(case, kind, STEPS)?;
     let peak = memory.peak_gib();
@@ -131,7 +135,11 @@ pub fn run() -> Result<SpeedResult> {
                     }
                     // The paper's solver takes seconds where newton takes milliseconds: one run.
                     let small = case.problem.model.n_free < REPEATS.0;
-                    let repeats = if kind == SolverKind::Newton && small { REPEATS.1 } else { 1 };
+                    let repeats = if kind == SolverKind::Newton && small {
+                        REPEATS.1
+                    } else {
+                        1
+                    };
                     let (sol, floor_s, peak) = timed_runs(&case, kind, repeats)?;
                     rows.push(SpeedRun {
                         run: RunSummary::new(&case, kind, &sol, Some(floor_s), peak),
@@ -148,7 +156,12 @@ pub fn run() -> Result<SpeedResult> {
         }
     }
     let family = &FAMILIES[0];
-    let rcase = Case::build(&Scene::load(family.scene)?, REFERENCE_LEVEL, Method::Mortar, &sizes(family, true))?;
+    let rcase = Case::build(
+        &Scene::load(family.scene)?,
+        REFERENCE_LEVEL,
+        Method::Mortar,
+        &sizes(family, true),
+    )?;
     let (rsol, _) = solve_case(&rcase, SolverKind::Newton, STEPS)?;
     for (i, case, sol) in &kept {
         rows[*i].error = Some(super::theorem_distance(case, sol, &rcase, &rsol));
