@@ -383,11 +383,7 @@ pub fn verify_exact(
         .flat_map(|p| {
             (0..=400).map(move |k| {
                 let s = p.length * k as f64 / 400.0;
-                (
-                    [p.a[0] + s * p.tangent[0], p.a[1] + s * p.tangent[1]],
-                    p.normal,
-                    p.tangent,
-                )
+                (p.point(s), p.normal, p.tangent)
             })
         })
         .collect();

@@ -95,6 +95,18 @@ pub struct Row {
     pub weight: f64,
 }
 
+impl Row {
+    /// Contact pressure of the multiplier `lambda` of this row: the nodal force over the
+    /// lumped trace weight (force/length; 0 where the weight vanishes).
+    pub fn pressure(&self, lambda: f64) -> f64 {
+        if self.weight > 0.0 {
+            lambda / self.weight
+        } else {
+            0.0
+        }
+    }
+}
+
 /// Chain edges (pairs of global nodes) into polylines; error if branched.
 fn chains(edges: &[[usize; 2]], what: &str, file: &std::path::Path) -> Result<Vec<Vec<usize>>> {
     use std::collections::HashMap;
@@ -312,6 +324,14 @@ impl Interface {
 }
 
 impl Piece {
+    /// The point at arc length `s` from the start (length).
+    pub fn point(&self, s: f64) -> [f64; 2] {
+        [
+            self.a[0] + s * self.tangent[0],
+            self.a[1] + s * self.tangent[1],
+        ]
+    }
+
     /// The matrix P (rows: body-1 nodes, columns: body-2 nodes) mapping body-2 trace
     /// values to the body-1 trace values of I_h^1 (nts) or pi_h^1 (mortar), dense.
     pub fn transfer(&self, method: Method) -> Vec<Vec<f64>> {

@@ -104,15 +104,8 @@ pub fn contact_nodes(p: &Problem, s: &State) -> Vec<ContactNode> {
                 piece: row.piece,
                 node: piece.slave_nodes[row.i],
                 arc_length: arc,
-                position: [
-                    piece.a[0] + arc * piece.tangent[0],
-                    piece.a[1] + arc * piece.tangent[1],
-                ],
-                pressure: if row.weight > 0.0 {
-                    lambda / row.weight
-                } else {
-                    0.0
-                },
+                position: piece.point(arc),
+                pressure: row.pressure(lambda),
                 normal_jump: jumps[first_of_piece[row.piece] + row.i].2,
                 active: cu.abs() <= 1e-8 * size * u_max,
             }

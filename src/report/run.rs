@@ -3,7 +3,7 @@
 
 use crate::case::RunSummary;
 use crate::contact::Method;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::io::{self, csv_bytes, write_atomic};
 use crate::metrics::{ContactNode, contact_nodes};
 use crate::solve::{Problem, SolverKind, State};
@@ -63,8 +63,8 @@ struct ContactCsv {
 }
 
 /// The time series of a `solve` run, written as the steps come: every `every`-th step and
-/// the last as `solution_NNNN.vtu` with its rows of contact.csv. [`Series::finish`] writes
-/// the collection `solution.pvd`, contact.csv, solution.vtu (the last step) and
+/// the last as `solution_NNNN.vtu` (the last also as solution.vtu) with its rows of
+/// contact.csv. [`Series::finish`] writes the collection `solution.pvd`, contact.csv and
 /// summary.csv; [`Series::abandon`] removes the step files of a run that failed.
 pub struct Series<'a> {
     dir: &'a Path,
@@ -88,17 +88,18 @@ impl<'a> Series<'a> {
         }
     }
 
-    /// Write step `n` of `steps` when it is due.
+    /// Write step `n` of `steps` when it is due (the last one also as solution.vtu).
     pub fn step(&mut self, n: usize, steps: usize, state: &State) -> Result<()> {
         if n % self.every != 0 && n != steps {
             return Ok(());
         }
         let nodes = contact_nodes(self.problem, state);
         let name = format!("solution_{n:04}.vtu");
-        write_atomic(
-            &self.dir.join(&name),
-            io::vtu(&self.problem.model, state, &nodes).as_bytes(),
-        )?;
+        let vtu = io::vtu(&self.problem.model, state, &nodes);
+        write_atomic(&self.dir.join(&name), vtu.as_bytes())?;
+        if n == steps {
+            write_atomic(&self.dir.join("solution.vtu"), vtu.as_bytes())?;
+        }
         self.written.push((state.time, name));
         self.contact.extend(nodes.iter().map(|c| ContactCsv {
             time: state.time,
@@ -114,21 +115,14 @@ impl<'a> Series<'a> {
         Ok(())
     }
 
-    /// Write solution.pvd, contact.csv, solution.vtu (the last step) and summary.csv;
-    /// `wall_s` is the whole run's wall time.
+    /// Write solution.pvd, contact.csv and summary.csv; `wall_s` is the whole run's wall
+    /// time.
     pub fn finish(self, run: &RunSummary, wall_s: f64) -> Result<()> {
         write_atomic(
             &self.dir.join("solution.pvd"),
             io::pvd(&self.written).as_bytes(),
         )?;
         write_atomic(&self.dir.join("contact.csv"), &csv_bytes(&self.contact)?)?;
-        // The last step is always in the series: solution.vtu is a copy of its file.
-        let (_, last_file) = self
-            .written
-            .last()
-            .expect("the last step is always written");
-        let bytes = std::fs::read(self.dir.join(last_file)).map_err(|e| Error::io(self.dir, e))?;
-        write_atomic(&self.dir.join("solution.vtu"), &bytes)?;
         write_summary(self.dir, run, wall_s)
     }
 

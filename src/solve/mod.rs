@@ -243,14 +243,17 @@ pub fn distance_to_solution(p: &Problem, state: &State, f_ext: &[f64], c: f64) -
     contact::add_transpose(&p.rows, &state.lambda, &mut r);
     let residual = inf_norm(&p.model.restrict(&r)) / scale;
     let gaps = contact::apply_rows(&p.rows, &state.u);
-    let complementarity = state
-        .lambda
+    (residual, complementarity(&state.lambda, &gaps, c) / scale)
+}
+
+/// The complementarity max_i |min(lambda_i, -c g_i)| of multipliers and constraint values
+/// (force): zero exactly when lambda >= 0, g <= 0 and lambda g = 0.
+pub fn complementarity(lambda: &[f64], gaps: &[f64], c: f64) -> f64 {
+    lambda
         .iter()
-        .zip(&gaps)
+        .zip(gaps)
         .map(|(l, g)| l.min(-c * g).abs())
         .fold(0.0f64, f64::max)
-        / scale;
-    (residual, complementarity)
 }
 
 /// Solve the history on `steps` uniform steps over [0, T]; zero initial state.

@@ -75,13 +75,7 @@ fn slave_gaps(
             .filter(|j| j.0 == pi)
             .take(piece.slave_nodes.len())
         {
-            out.push((
-                [
-                    piece.a[0] + j.1 * piece.tangent[0],
-                    piece.a[1] + j.1 * piece.tangent[1],
-                ],
-                if -j.2 > floor { -j.2 } else { 0.0 },
-            ));
+            out.push((piece.point(j.1), if -j.2 > floor { -j.2 } else { 0.0 }));
         }
     }
     out
@@ -130,10 +124,7 @@ impl TruthPressure<'_> {
         match self {
             TruthPressure::Profile(f, _) => eval_pl(&f[piece_index], s),
             TruthPressure::Exact(ex, t) => {
-                let x = [
-                    piece.a[0] + s * piece.tangent[0],
-                    piece.a[1] + s * piece.tangent[1],
-                ];
+                let x = piece.point(s);
                 ex.pressure_at(piece.normal, x[0], x[1], *t)
                     .unwrap_or(f64::NAN)
             }
@@ -161,12 +152,7 @@ impl TruthPressure<'_> {
                 // 2001 samples; an edge is a sign change of p / max p - gap / max gap (both
                 // vanish there: p on one side, the gap on the other), found by bisection.
                 let n = 2000;
-                let x_of = |s: f64| {
-                    [
-                        piece.a[0] + s * piece.tangent[0],
-                        piece.a[1] + s * piece.tangent[1],
-                    ]
-                };
+                let x_of = |s: f64| piece.point(s);
                 let gap = |s: f64| {
                     let x = x_of(s);
                     ex.gap_at(piece.normal, x[0], x[1], *t).unwrap_or(0.0)

@@ -18,7 +18,7 @@ use super::exact_error::{
     ExactComparison, ExactDifference, exact_profiles, max_exact_displacement,
 };
 use super::file::{StudyFile, Threshold};
-use super::jobs::{self, Job, JobId, Mode, Progress, Solved};
+use super::jobs::{self, Job, JobId, Mode, Solved};
 use super::quantity::{Differences, Quantity};
 use super::rates::{self, Fit, LevelError, Verdict};
 use crate::analytical::{Exact, Field};
@@ -26,6 +26,7 @@ use crate::case::Case;
 use crate::contact::Method;
 use crate::error::{Error, Result};
 use crate::metrics;
+use crate::progress::Progress;
 use crate::scene::Scene;
 use crate::solve::{Settings, Solution, inf_norm};
 use rayon::prelude::*;
@@ -912,12 +913,12 @@ fn profiles(case: &Case, sol: &Solution, label: Source, out: &mut Measured) {
         }
     }
     for (pi, sv, jump) in crate::contact::normal_jumps(&p.interface, &s.u) {
-        let pc = &p.interface.pieces[pi];
+        let at = p.interface.pieces[pi].point(sv);
         // Gap = -[u.nu]: positive where the bodies separate.
         out.gap.push(ProfilePoint {
             label,
-            x: pc.a[0] + sv * pc.tangent[0],
-            y: pc.a[1] + sv * pc.tangent[1],
+            x: at[0],
+            y: at[1],
             value: -jump,
         });
     }

@@ -174,19 +174,7 @@ pub fn pressure_profile(p: &Problem, s: &State) -> Vec<Vec<([f64; 2], f64)>> {
     let mut out: Vec<Vec<([f64; 2], f64)>> = vec![Vec::new(); p.interface.pieces.len()];
     for (row, l) in p.rows.iter().zip(&s.lambda) {
         let piece = &p.interface.pieces[row.piece];
-        let x = piece.slave_s[row.i];
-        let pos = [
-            piece.a[0] + x * piece.tangent[0],
-            piece.a[1] + x * piece.tangent[1],
-        ];
-        out[row.piece].push((
-            pos,
-            if row.weight > 0.0 {
-                l / row.weight
-            } else {
-                0.0
-            },
-        ));
+        out[row.piece].push((piece.point(piece.slave_s[row.i]), row.pressure(*l)));
     }
     out
 }

@@ -146,10 +146,7 @@ pub fn exact_profiles(p: &Problem, exact: &Exact, t: f64) -> Vec<([f64; 2], f64,
         let n = piece.normal;
         for k in 0..=400 {
             let s = piece.length * k as f64 / 400.0;
-            let x = [
-                piece.a[0] + s * piece.tangent[0],
-                piece.a[1] + s * piece.tangent[1],
-            ];
+            let x = piece.point(s);
             let pressure = exact.pressure_at(n, x[0], x[1], t).unwrap_or(f64::NAN);
             let gap = exact.gap_at(n, x[0], x[1], t).unwrap_or(f64::NAN);
             out.push((x, pressure, gap));

@@ -179,5 +179,3 @@ impl Solved {
         self.0[id].take().expect("each job is taken once")
     }
 }
-
-pub use crate::progress::Progress;
