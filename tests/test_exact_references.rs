@@ -38,9 +38,9 @@ fn quick_exact_study_meets_the_thresholds_and_its_quadrature_is_converged() {
             r.method,
             r.rate(),
             r.stderr(),
-            r.levels_used
+            r.assessment.used
         );
-        assert_eq!(r.levels_used, vec![0, 1, 2]);
+        assert_eq!(r.assessment.used, vec![0, 1, 2]);
         assert_eq!(
             r.pass,
             Some(true),

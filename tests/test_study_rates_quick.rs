@@ -20,11 +20,11 @@ fn quick_rates_study_meets_the_theorem_thresholds() {
             r.method,
             r.rate(),
             r.stderr(),
-            r.levels_used,
+            r.assessment.used,
             r.threshold
         );
         assert_eq!(
-            r.levels_used.len(),
+            r.assessment.used.len(),
             3,
             "all quick levels are asymptotic and unflagged"
         );
@@ -89,13 +89,13 @@ fn quick_rates_study_meets_the_theorem_thresholds() {
             (
                 a.rate().to_bits(),
                 a.stderr().to_bits(),
-                &a.levels_used,
+                &a.assessment.used,
                 a.pass
             ),
             (
                 b.rate().to_bits(),
                 b.stderr().to_bits(),
-                &b.levels_used,
+                &b.assessment.used,
                 b.pass
             )
         );

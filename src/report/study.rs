@@ -56,18 +56,19 @@ impl RateCsv {
             quantity: r.quantity,
             rate: r.rate(),
             stderr: r.stderr(),
-            levels_used: join(&r.levels_used),
+            levels_used: join(&r.assessment.used),
             threshold: r.threshold.map(Threshold::value),
             pass: r.pass,
-            rate_dofs: r.rate_dofs,
+            rate_dofs: r.rate_dofs(),
             successive: successive(r),
-            verdict: r.verdict.name(),
+            verdict: r.assessment.verdict.name(),
         }
     }
 }
 
 fn successive(r: &RateRow) -> String {
-    r.successive
+    r.assessment
+        .successive
         .iter()
         .map(|s| s.map_or("-".into(), |s| format!("{s:.3}")))
         .collect::<Vec<_>>()
@@ -83,7 +84,7 @@ fn threshold_text(t: Threshold, digits: usize) -> String {
 }
 
 fn fmt_rate(r: &RateRow) -> String {
-    match (r.verdict, r.fit) {
+    match (r.assessment.verdict, r.assessment.fit) {
         (Verdict::Fitted, Some(f)) => format!("{:.3} ± {:.3}", f.rate, f.stderr),
         (Verdict::PreAsymptotic, Some(f)) => {
             format!("{:.3} ± {:.3} (pre-asymptotic)", f.rate, f.stderr)
@@ -169,10 +170,10 @@ fn error_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
         // The study's fitted line over the levels used.
         let used: Vec<f64> = rows
             .iter()
-            .filter(|r| rate.levels_used.contains(&r.level))
+            .filter(|r| rate.assessment.used.contains(&r.level))
             .map(|r| r.h)
             .collect();
-        if let Some(fit) = rate.fit.filter(|_| used.len() >= 2) {
+        if let Some(fit) = rate.assessment.fit.filter(|_| used.len() >= 2) {
             let hs = [
                 used.iter().copied().fold(f64::INFINITY, f64::min),
                 used.iter().copied().fold(0.0, f64::max),
@@ -367,8 +368,8 @@ fn readme(res: &StudyResult) -> String {
             r.method,
             r.quantity,
             fmt_rate(r),
-            join(&r.levels_used),
-            fmt3(r.rate_dofs.unwrap_or(f64::NAN)),
+            join(&r.assessment.used),
+            fmt3(r.rate_dofs().unwrap_or(f64::NAN)),
             successive(r),
             r.threshold
                 .map(|t| threshold_text(t, 2))
@@ -500,8 +501,8 @@ pub fn console(res: &StudyResult, dir: &Path) -> String {
             r.quantity.name(),
             fmt3(r.rate()),
             fmt3(r.stderr()),
-            join(&r.levels_used),
-            r.verdict.name(),
+            join(&r.assessment.used),
+            r.assessment.verdict.name(),
             r.threshold
                 .map(|t| format!(
                     " threshold {}: {}",
@@ -595,7 +596,7 @@ fn contact_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
 
 /// A rate or the verdict that replaces it, short.
 fn verdict_text(r: &RateRow) -> String {
-    match (r.verdict, r.fit) {
+    match (r.assessment.verdict, r.assessment.fit) {
         (Verdict::Fitted, Some(f)) => format!("{:.2}", f.rate),
         (Verdict::PreAsymptotic, Some(f)) => format!("{:.2} (pre-asymptotic)", f.rate),
         (Verdict::RoundOff, _) => "exact".into(),
@@ -669,7 +670,7 @@ fn cones_compared(s: &mut String, res: &StudyResult) {
             res.rates
                 .iter()
                 .find(|r| r.method == m && r.quantity == q)
-                .map(|r| r.verdict)
+                .map(|r| r.assessment.verdict)
         };
         for &q in &quantities {
             let (Some(a), Some(b)) = (error_of(Method::Mortar, q), error_of(Method::Nts, q)) else {
@@ -756,7 +757,7 @@ fn alignment(s: &mut String, res: &StudyResult) {
             let fitted: Vec<f64> = rows
                 .iter()
                 .flatten()
-                .filter_map(|r| r.fit.map(|f| f.rate))
+                .filter_map(|r| r.assessment.fit.map(|f| f.rate))
                 .collect();
             let spread = if fitted.len() >= 2 {
                 let (lo, hi) = fitted
@@ -776,7 +777,7 @@ fn alignment(s: &mut String, res: &StudyResult) {
         rates
             .iter()
             .find(|r| r.method == m && r.quantity == Quantity::L2Pressure)
-            .and_then(|r| r.successive.last().copied().flatten())
+            .and_then(|r| r.assessment.successive.last().copied().flatten())
     };
     let _ = writeln!(s);
     for &m in &res.file.methods {

@@ -20,7 +20,7 @@ use super::exact_error::{
 use super::file::{StudyFile, Threshold};
 use super::jobs::{self, Job, JobId, Mode, Solved};
 use super::quantity::{Differences, Quantity};
-use super::rates::{self, Fit, LevelError, Verdict};
+use super::rates::{self, Assessment, Fit, LevelError};
 use crate::analytical::{Exact, Field};
 use crate::case::Case;
 use crate::contact::Method;
@@ -63,34 +63,27 @@ pub struct RateRow {
     pub method: Method,
     /// Quantity.
     pub quantity: Quantity,
-    /// What the errors support: a rate, a flagged rate, or why there is none.
-    pub verdict: Verdict,
-    /// Least-squares fit of log(error) against log(h), if the levels used allow one.
-    pub fit: Option<Fit>,
-    /// Exactly the levels in the fit.
-    pub levels_used: Vec<usize>,
-    /// Levels whose error is at round-off (never fitted).
-    pub roundoff_levels: Vec<usize>,
-    /// Levels left out for being within 5x of the truth's own error in this quantity.
-    pub near_truth_levels: Vec<usize>,
+    /// What the errors support (a rate, a flagged rate, or why there is none), the fit over
+    /// exactly the levels used, and the levels left out.
+    pub assessment: Assessment,
     /// What the error must satisfy (the `theorem` quantity only).
     pub threshold: Option<Threshold>,
     /// Whether it does.
     pub pass: Option<bool>,
-    /// Rate against dofs (error ~ dofs^-rate_dofs).
-    pub rate_dofs: Option<f64>,
-    /// Successive rates between neighbouring levels; None where either is at round-off.
-    pub successive: Vec<Option<f64>>,
 }
 
 impl RateRow {
     /// The fitted rate in h, NaN when there is none.
     pub fn rate(&self) -> f64 {
-        self.fit.map_or(f64::NAN, |f| f.rate)
+        self.assessment.fit.map_or(f64::NAN, |f| f.rate)
     }
     /// Its standard error, NaN when there is none.
     pub fn stderr(&self) -> f64 {
-        self.fit.map_or(f64::NAN, |f| f.stderr)
+        self.assessment.fit.map_or(f64::NAN, |f| f.stderr)
+    }
+    /// Rate against dofs (error ~ dofs^-rate_dofs), over the same levels.
+    pub fn rate_dofs(&self) -> Option<f64> {
+        self.assessment.fit_dofs.map(|f| -f.rate)
     }
 }
 
@@ -276,7 +269,7 @@ impl StudyResult {
                     r.method,
                     r.quantity,
                     r.rate(),
-                    join(&r.levels_used)
+                    join(&r.assessment.used)
                 )),
             })
             .collect()
@@ -977,15 +970,9 @@ fn fit_rates(sf: &StudyFile, errors: &[ErrorRow], truth: &Truth) -> Vec<RateRow>
             out.push(RateRow {
                 method,
                 quantity,
-                verdict: a.verdict,
-                fit: a.fit,
-                levels_used: a.used,
-                roundoff_levels: a.roundoff,
-                near_truth_levels: a.near_truth,
+                assessment: a,
                 threshold,
                 pass,
-                rate_dofs: a.fit_dofs.map(|f| -f.rate),
-                successive: a.successive,
             });
         }
     }
