@@ -3,6 +3,7 @@
 //! penalty-duality iteration, and a Clarabel QP cross-check (both in [`fixed_point`]).
 
 pub mod fixed_point;
+pub mod interface;
 pub mod linear;
 pub mod newton;
 

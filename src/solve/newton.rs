@@ -1,20 +1,16 @@
 //! The default solver: exact implicit return map per triangle, consistent tangent, and a
-//! semismooth Newton (primal-dual active set) treatment of the contact rows, on the KKT
-//! system `[K C^T; C_A 0]` whose pattern (all rows present) and symbolic analysis are fixed
-//! per mesh. One factorization serves many iterations and steps: each Newton system is
-//! solved by GMRES preconditioned with the last factorization, corrected exactly (Woodbury)
-//! for the contact rows whose active set changed since; it is refactorized only when GMRES
-//! needs many iterations (the tangent moved far from the factored one).
-//!
-//! The factorization is symmetric: an LDL^T of `[K_s c C_A^T; c C_A 0]` (K_s the stiffness,
-//! or the symmetric part of the consistent tangent; inactive rows eliminated exactly, see
-//! [`Newton::solve_factored`]), ordered by AMD with every multiplier moved after its
-//! displacements, so that its pivot is a non-zero Schur complement. It costs about one
-//! Cholesky of the stiffness (the KKT matrix's sparse LU cost 3-7x that) and is exact for
-//! elastic bodies: GMRES then stops after one iteration. The non-symmetric part of a
-//! viscoplastic tangent is left to GMRES (2-3 iterations per Newton step, measured).
+//! semismooth Newton (primal-dual active set) treatment of the contact rows. Every Newton
+//! system `[K_t c C^T; c C_A 0]` is solved by GMRES preconditioned with the exact solve of
+//! `[K_s c C^T; c C_A 0]` for the current active set (see [`super::interface`]): K_s is the
+//! stiffness or the symmetric part of an earlier consistent tangent, factorized once with
+//! the contact interface's unknowns last, so that a change of the active set costs a dense
+//! solve on the interface and never a sparse refactorization. The sparse matrix is
+//! refactorized only when GMRES needs many iterations (the tangent moved far from the
+//! factored one). For elastic bodies K_s = K_t: GMRES stops after one iteration and the
+//! whole run factorizes the stiffness once, like the floor.
 
-use super::linear::SparseSystem;
+use super::interface::{ActiveSet, InterfaceFactorization};
+use super::linear::{SparseSystem, gmres};
 use super::{Problem, Settings, State, StepReport, StepSolver, inf_norm};
 use super::{Timings, timed};
 use crate::contact;
@@ -29,43 +25,46 @@ pub struct Newton<'a> {
     p: &'a Problem,
     settings: Settings,
     n: usize,
+    /// Slots of each triangle's 6 x 6 entries in the stiffness pattern.
     slots: Vec<[usize; 36]>,
-    /// Per row: (slot in row n+i, slot in column n+i) for each free entry, and the free eq.
-    row_slots: Vec<Vec<(usize, usize, usize, f64)>>,
-    diag_slots: Vec<usize>,
-    system: SparseSystem,
+    /// The current tangent stiffness K_t (for GMRES's products).
+    stiffness: SparseSystem,
+    /// The contact rows over the free unknowns: (equation, coefficient).
+    rows: Vec<Vec<(usize, f64)>>,
+    factorization: InterfaceFactorization,
+    /// The dense interface system of the last active set.
+    active_set: Option<ActiveSet>,
+    /// Which factorization preconditions GMRES.
+    preconditioner: Preconditioner,
+    /// The KKT matrix for its LU, built on first need.
+    kkt: Option<KktMatrix>,
     /// The factorization is too old to precondition well: refactor at the next iteration.
     stale: bool,
-
     /// Scale turning gaps into forces in the complementarity function (force/length).
     c_scale: f64,
     clock: std::rc::Rc<Clock>,
     /// Seconds building the pattern, slot maps and symbolic analysis (once per mesh).
     setup_s: f64,
-    /// Active set of the factored matrix.
-    factored_active: Vec<bool>,
-    /// The elastic stiffness in pattern order (contact entries zero).
+    /// The elastic stiffness in pattern order.
     elastic_values: Vec<f64>,
-    /// Columns A0^{-1} e_{n+i} of the factored matrix, computed when row i changes.
-    w_columns: Vec<Option<Vec<f64>>>,
-    /// Lower triangle of the symmetric matrix handed to the LDL^T (pattern order).
+    /// Lower triangle of the symmetric stiffness handed to the LDL^T (pattern order).
     symmetric_values: Vec<f64>,
-    /// Expected pivot signs: +1 on displacement rows, -1 on multiplier rows.
-    signs: Vec<i8>,
-    /// Scale s_i = 1/|C_i| of multiplier row i in the factored matrix (1/length for mortar
-    /// rows, 1 for node-on-segment ones): every factored contact row has the norm c.
-    row_scale: Vec<f64>,
     /// GMRES iterations of the first solve after the last factorization.
     fresh_iterations: usize,
+    /// Contact rows the active-set prediction changed (summed over rounds and iterations).
+    predicted_changes: usize,
 }
 
-/// Pivots of the scaled matrix (unit diagonal) expected positive but below 1e-8 are
-/// replaced by 1e-6: a body held only by contact and eliminated before its contact rows
-/// leaves a round-off pivot for its rigid mode, and the replacement is a low-rank change
-/// GMRES removes. Measured on `rates` at 4.5e5 dofs (upper block held vertically only by
-/// contact): a threshold of 1e-13 c on the unscaled matrix missed that pivot (GMRES 4-6
-/// iterations per Newton step instead of 1-2, 16 s instead of 12 s), 1e-9 c caught it.
-const PIVOT_THRESHOLD: (f64, f64) = (1e-8, 1e-6);
+/// The factorization GMRES is preconditioned with.
+#[derive(PartialEq)]
+enum Preconditioner {
+    /// None yet.
+    None,
+    /// The stiffness's LDL^T with the interface last, any active set.
+    Interface,
+    /// The LU of the KKT matrix with this active set.
+    KktLu(Vec<bool>),
+}
 
 /// The tangent whose element stiffness is the symmetric part of that of `d`: the element
 /// stiffness is |T| B^T D S B (S halves the engineering shear), so the symmetric part of
@@ -88,6 +87,10 @@ fn symmetric_tangent(d: &Matrix3<f64>, elastic: &Matrix3<f64>) -> Matrix3<f64> {
     }
 }
 
+/// Rounds of the active-set prediction per Newton iteration (see [`Newton::newton_step`]):
+/// the primal-dual active set method can cycle on a matrix that is not an M-matrix.
+const MAX_PREDICTIONS: usize = 20;
+
 /// Iterates whose merit the non-monotone line search remembers.
 const MERIT_MEMORY: usize = 3;
 
@@ -105,24 +108,68 @@ struct Clock {
     contact: Cell<f64>,
 }
 
-/// Write the contact rows and columns of the KKT values: column n+i holds c C_i^T; row n+i
-/// holds c C_i and 0 on the diagonal when row i is active, 0 and c when it is inactive.
-/// The multiplier unknowns are lambda / c and the contact rows are scaled by c, so every
-/// entry has the size of the stiffness in any units: unscaled, an LU of [K C^T; C 0] in
-/// lengths x 1e3, moduli x 1e6 solved to 1e-9 only.
-fn fill_contact_rows(
-    vals: &mut [f64],
-    row_slots: &[Vec<(usize, usize, usize, f64)>],
-    diag_slots: &[usize],
-    c: f64,
-    active: &[bool],
-) {
-    for (i, row) in row_slots.iter().enumerate() {
-        for &(rs, cs, _, v) in row {
-            vals[cs] = c * v;
-            vals[rs] = if active[i] { c * v } else { 0.0 };
+/// The Newton matrix itself, `[K_t c C^T; c C_A 0]` with `c` on the diagonal of inactive
+/// rows, assembled for its sparse LU: the fallback when the tangent is too far from
+/// symmetric for GMRES (stiff viscosity, k E / lambda near 1e4). Built on first need.
+struct KktMatrix {
+    system: SparseSystem,
+    slots: Vec<[usize; 36]>,
+    /// Per row: (slot in row n+i, slot in column n+i, coefficient) for each free entry.
+    row_slots: Vec<Vec<(usize, usize, f64)>>,
+    diag_slots: Vec<usize>,
+}
+
+impl KktMatrix {
+    fn new(p: &Problem, rows: &[Vec<(usize, f64)>]) -> Self {
+        let n = p.model.n_free;
+        let m = rows.len();
+        let mut extra = Vec::new();
+        for (i, r) in rows.iter().enumerate() {
+            for &(eq, _) in r {
+                extra.push((n + i, eq));
+                extra.push((eq, n + i));
+            }
+            extra.push((n + i, n + i));
         }
-        vals[diag_slots[i]] = if active[i] { 0.0 } else { c };
+        let (pattern, slots): (Pattern, _) = p.model.stiffness_pattern(&extra, n + m);
+        let row_slots = rows
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                r.iter()
+                    .map(|&(eq, v)| (pattern.slot(n + i, eq), pattern.slot(eq, n + i), v))
+                    .collect()
+            })
+            .collect();
+        let diag_slots = (0..m).map(|i| pattern.slot(n + i, n + i)).collect();
+        KktMatrix {
+            system: SparseSystem::new(&pattern),
+            slots,
+            row_slots,
+            diag_slots,
+        }
+    }
+
+    /// Assemble the Newton matrix of `tangents` and `active` (contact rows scaled by `c`:
+    /// every entry has the size of the stiffness) and factorize it.
+    fn factor(
+        &mut self,
+        p: &Problem,
+        tangents: &[Matrix3<f64>],
+        active: &[bool],
+        c: f64,
+    ) -> Result<()> {
+        let vals = self.system.values_mut();
+        vals.iter_mut().for_each(|v| *v = 0.0);
+        p.model.add_tangent(tangents, &self.slots, vals);
+        for (i, row) in self.row_slots.iter().enumerate() {
+            for &(rs, cs, v) in row {
+                vals[cs] = c * v;
+                vals[rs] = if active[i] { c * v } else { 0.0 };
+            }
+            vals[self.diag_slots[i]] = if active[i] { 0.0 } else { c };
+        }
+        self.system.factor_lu()
     }
 }
 
@@ -154,173 +201,79 @@ pub fn floor_time(p: &Problem, steps: usize) -> Result<f64> {
 }
 
 impl<'a> Newton<'a> {
-    /// Set up the KKT pattern and the symbolic analysis for `p`.
+    /// Set up the stiffness pattern and the symbolic analysis for `p`.
     pub fn new(p: &'a Problem, settings: &Settings) -> Result<Self> {
         let t_setup = std::time::Instant::now();
         let n = p.model.n_free;
-        let m = p.rows.len();
-        let mut extra = Vec::new();
-        for (i, r) in p.rows.iter().enumerate() {
-            for &(d, _) in &r.entries {
-                let eq = p.model.equation[d];
-                extra.push((n + i, eq));
-                extra.push((eq, n + i));
-            }
-            extra.push((n + i, n + i));
-        }
-        let (pattern, slots): (Pattern, _) = p.model.stiffness_pattern(&extra, n + m);
-        let row_slots = p
-            .rows
-            .iter()
-            .enumerate()
-            .map(|(i, r)| {
-                r.entries
-                    .iter()
-                    .map(|&(d, v)| {
-                        let eq = p.model.equation[d];
-                        (pattern.slot(n + i, eq), pattern.slot(eq, n + i), eq, v)
-                    })
-                    .collect()
-            })
-            .collect();
-        let diag_slots = (0..m).map(|i| pattern.slot(n + i, n + i)).collect();
-        // Stiffness scale: the mean diagonal of the elastic stiffness.
-        let mut diag = vec![0.0; n];
-        let tangents = p.model.elastic_tangents();
-        let mut vals = vec![0.0; pattern.nnz()];
-        p.model.add_tangent(&tangents, &slots, &mut vals);
-        for (i, d) in diag.iter_mut().enumerate() {
-            *d = vals[pattern.slot(i, i)];
-        }
-        let c_scale = diag.iter().sum::<f64>() / n.max(1) as f64;
-        let mut system = SparseSystem::new(&pattern);
-        system.analyze_ldlt(n)?;
-        let signs = (0..n + m).map(|i| if i < n { 1 } else { -1 }).collect();
-        let row_scale = p
+        let (pattern, slots) = p.model.stiffness_pattern(&[], n);
+        let rows: Vec<Vec<(usize, f64)>> = p
             .rows
             .iter()
             .map(|r| {
-                let norm: f64 = r.entries.iter().map(|&(_, v)| v * v).sum::<f64>().sqrt();
-                if norm > 0.0 { 1.0 / norm } else { 1.0 }
+                r.entries
+                    .iter()
+                    .map(|&(d, v)| (p.model.equation[d], v))
+                    .filter(|&(eq, _)| eq != FIXED)
+                    .collect()
             })
             .collect();
+        let mut stiffness = SparseSystem::new(&pattern);
+        let vals = stiffness.values_mut();
+        p.model
+            .add_tangent(&p.model.elastic_tangents(), &slots, vals);
+        let elastic_values = vals.to_vec();
+        // Stiffness scale: the mean diagonal of the elastic stiffness.
+        let c_scale = (0..n)
+            .map(|i| elastic_values[pattern.slot(i, i)])
+            .sum::<f64>()
+            / n.max(1) as f64;
+        let factorization = InterfaceFactorization::new(&pattern, &rows)?;
         Ok(Newton {
             p,
             settings: *settings,
             n,
             slots,
-            row_slots,
-            diag_slots,
-            system,
+            stiffness,
+            rows,
+            factorization,
+            active_set: None,
+            preconditioner: Preconditioner::None,
+            kkt: None,
             stale: false,
             c_scale,
             clock: Default::default(),
             setup_s: t_setup.elapsed().as_secs_f64(),
-            factored_active: vec![true; m],
-            elastic_values: vals,
-            w_columns: vec![None; m],
+            elastic_values,
             symmetric_values: Vec::new(),
-            signs,
-            row_scale,
             fresh_iterations: 0,
-        })
-    }
-}
-
-/// An exact correction of the last factorization for the contact rows whose active or
-/// inactive form changed since it was computed (Sherman-Morrison-Woodbury on replaced rows):
-/// with A0 the factored KKT matrix and A = A0 + E_R D_R^T (rows n+i, i in R, replaced),
-/// A^{-1} = A0^{-1} - W (I + D_R^T W)^{-1} D_R^T A0^{-1}, W = A0^{-1} E_R. A change of the
-/// active set then costs one blocked solve for the new columns of W and a small dense LU
-/// instead of a sparse refactorization; GMRES is left with the tangent's changes only.
-struct RowUpdate {
-    /// Contact rows i in R.
-    rows: Vec<usize>,
-    /// Sign s_i: +1 when row i is active now and was inactive in A0, -1 the other way.
-    signs: Vec<f64>,
-    /// LU of the capacitance matrix I + D_R^T W (r x r).
-    capacitance: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
-}
-
-/// Largest number of new columns W_i = A0^{-1} e_{n+i} computed for one update before a
-/// refactorization is preferred. Measured: at 1.1e5 dofs a blocked solve of 37 columns
-/// took 0.23 s, one solve 0.03 s, one LDL^T 0.21-0.27 s; at 4.4e5 dofs 14 columns took
-/// 0.52 s, one solve 0.14 s, one LDL^T 1.4-1.6 s. Counted in columns, not seconds, so that
-/// the results do not depend on the machine's load.
-const MAX_NEW_COLUMNS: usize = 32;
-
-/// Largest number of stored entries of W before a refactorization is preferred: 2e8
-/// doubles = 1.6 GB.
-const MAX_CORRECTION_ENTRIES: usize = 200_000_000;
-
-impl Newton<'_> {
-    /// Difference row D_i = s_i c (C_i - e_{n+i}) applied to `y`.
-    fn d_dot(&self, i: usize, sign: f64, y: &[f64]) -> f64 {
-        let dot: f64 = self.row_slots[i]
-            .iter()
-            .map(|&(_, _, eq, v)| v * y[eq])
-            .sum();
-        sign * self.c_scale * (dot - y[self.n + i])
-    }
-
-    /// Make the columns W_i = A0^{-1} e_{n+i} of `rows` available (one blocked solve for
-    /// those missing) and factor the capacitance matrix. None when a refactorization is
-    /// cheaper ([`MAX_NEW_COLUMNS`]) or W would be too large.
-    fn row_update(&mut self, active: &[bool]) -> Option<RowUpdate> {
-        let big_n = self.n + self.p.rows.len();
-        let rows: Vec<usize> = (0..active.len())
-            .filter(|&i| active[i] != self.factored_active[i])
-            .collect();
-        let missing: Vec<usize> = rows
-            .iter()
-            .copied()
-            .filter(|&i| self.w_columns[i].is_none())
-            .collect();
-        if missing.len() > MAX_NEW_COLUMNS || rows.len() * big_n > MAX_CORRECTION_ENTRIES {
-            return None;
-        }
-        if !missing.is_empty() {
-            let mut block = vec![0.0; big_n * missing.len()];
-            for (j, &i) in missing.iter().enumerate() {
-                block[j * big_n + self.n + i] = 1.0;
-            }
-            timed(&self.clock.solve, || {
-                self.solve_factored(&mut block, missing.len())
-            });
-            for (j, &i) in missing.iter().enumerate() {
-                self.w_columns[i] = Some(block[j * big_n..(j + 1) * big_n].to_vec());
-            }
-        }
-        let signs: Vec<f64> = rows
-            .iter()
-            .map(|&i| if active[i] { 1.0 } else { -1.0 })
-            .collect();
-        let r = rows.len();
-        let capacitance = (r > 0).then(|| {
-            let cap = nalgebra::DMatrix::from_fn(r, r, |a, b| {
-                let w = self.w_columns[rows[b]].as_ref().expect("computed above");
-                (a == b) as u8 as f64 + self.d_dot(rows[a], signs[a], w)
-            });
-            cap.lu()
-        });
-        Some(RowUpdate {
-            rows,
-            signs,
-            capacitance,
+            predicted_changes: 0,
         })
     }
 
-    /// Apply the corrected inverse of [`RowUpdate`] to `v` in place.
-    fn precondition(&self, update: &RowUpdate, v: &mut [f64]) {
-        self.solve_factored(v, 1);
-        self.correct(update, v);
+    /// `y = A x` for the Newton matrix A of the current tangent and `active`.
+    fn kkt_product(&self, active: &[bool], x: &[f64], y: &mut [f64]) {
+        let (n, c) = (self.n, self.c_scale);
+        let (xu, xl) = x.split_at(n);
+        let (yu, yl) = y.split_at_mut(n);
+        self.stiffness.matvec(xu, yu);
+        for (i, row) in self.rows.iter().enumerate() {
+            let xi = c * xl[i];
+            if xi != 0.0 {
+                for &(eq, v) in row {
+                    yu[eq] += v * xi;
+                }
+            }
+            yl[i] = if active[i] {
+                c * row.iter().map(|&(eq, v)| v * xu[eq]).sum::<f64>()
+            } else {
+                c * xl[i]
+            };
+        }
     }
 
-    /// Factorize the symmetric counterpart of the Newton matrix with the symmetric part of
-    /// `tangents` and the active set `active` (see the module's notes).
-    fn factor(&mut self, tangents: &[Matrix3<f64>], active: &[bool]) -> Result<()> {
+    /// Factorize the symmetric counterpart K_s of the tangent stiffness (see the module).
+    fn factor(&mut self, tangents: &[Matrix3<f64>]) -> Result<()> {
         let clock = std::rc::Rc::clone(&self.clock);
-        let c = self.c_scale;
         let mut vals = std::mem::take(&mut self.symmetric_values);
         timed(&clock.assembly, || {
             vals.clear();
@@ -333,80 +286,89 @@ impl Newton<'_> {
             self.p
                 .model
                 .add_tangent_change(&symmetric, &self.slots, &mut vals);
-            for (i, row) in self.row_slots.iter().enumerate() {
-                let s = self.row_scale[i];
-                for &(rs, _, _, v) in row {
-                    vals[rs] = if active[i] { c * s * v } else { 0.0 };
-                }
-                vals[self.diag_slots[i]] = if active[i] { 0.0 } else { -c * s * s };
-            }
         });
-        let (eps, delta) = PIVOT_THRESHOLD;
-        let result = self.system.factor_ldlt(&mut vals, &self.signs, eps, delta);
+        let result = self.factorization.factor(&mut vals, self.c_scale);
         self.symmetric_values = vals;
         result?;
+        self.active_set = None;
         self.stale = false;
-        self.factored_active = active.to_vec();
-        self.w_columns.iter_mut().for_each(|w| *w = None);
+        self.preconditioner = Preconditioner::Interface;
         Ok(())
     }
 
-    /// Solve with the factored Newton matrix A0 (`k` right-hand sides, column after column,
-    /// in place). A0 has the columns c C_i^T of every row and, on an inactive row, c on the
-    /// diagonal only: x_{n+i} = b_{n+i} / c is known, its columns move to the right-hand side,
-    /// and the rest is the symmetric system the LDL^T factored (rows scaled by s_i).
-    fn solve_factored(&self, v: &mut [f64], k: usize) {
-        if self.system.is_lu() {
-            // The LU is of A0 itself.
-            self.system.solve_many(v, k);
-            return;
+    /// The dense interface system of `active` (kept while the active set stays).
+    fn prepare_active_set(&mut self, active: &[bool]) -> Result<()> {
+        if self
+            .active_set
+            .as_ref()
+            .is_none_or(|s| s.active() != active)
+        {
+            self.active_set = Some(self.factorization.active_set(active, self.c_scale)?);
         }
-        let (n, m) = (self.n, self.p.rows.len());
-        let big_n = n + m;
-        for col in v.chunks_mut(big_n).take(k) {
-            for i in 0..m {
-                let b = col[n + i];
-                if self.factored_active[i] {
-                    col[n + i] = self.row_scale[i] * b;
-                } else {
-                    if b != 0.0 {
-                        for &(_, _, eq, coef) in &self.row_slots[i] {
-                            col[eq] -= coef * b;
-                        }
-                    }
-                    col[n + i] = -self.row_scale[i] * b;
-                }
+        Ok(())
+    }
+
+    /// Apply the current preconditioner to `v` in place.
+    fn precondition(&self, v: &mut [f64]) {
+        match &self.preconditioner {
+            Preconditioner::Interface => {
+                let set = self.active_set.as_ref().expect("prepared");
+                self.factorization.solve(set, self.c_scale, v);
             }
-        }
-        self.system.solve_many(v, k);
-        for col in v.chunks_mut(big_n).take(k) {
-            for i in 0..m {
-                col[n + i] *= self.row_scale[i];
+            Preconditioner::KktLu(_) => {
+                self.kkt.as_ref().expect("factored").system.solve(v);
             }
+            Preconditioner::None => unreachable!("a factorization precedes GMRES"),
         }
     }
 
-    /// Turn `v = A0^{-1} b` into `A^{-1} b` (the Woodbury correction of [`RowUpdate`]).
-    fn correct(&self, update: &RowUpdate, v: &mut [f64]) {
-        if let Some(cap) = &update.capacitance {
-            let z = nalgebra::DVector::from_iterator(
-                update.rows.len(),
-                update
-                    .rows
-                    .iter()
-                    .zip(&update.signs)
-                    .map(|(&i, &s)| self.d_dot(i, s, v)),
-            );
-            let t = cap
-                .solve(&z)
-                .unwrap_or_else(|| nalgebra::DVector::zeros(z.len()));
-            for (b, &i) in update.rows.iter().enumerate() {
-                let w = self.w_columns[i].as_ref().expect("computed in row_update");
-                for (vj, wj) in v.iter_mut().zip(w) {
-                    *vj -= t[b] * wj;
+    /// GMRES on the Newton system of `active` from the initial guess `x0` (`rhs` in, step
+    /// out), preconditioned by the current factorization; None (and `rhs` untouched) when
+    /// it misses `forcing` in `budget` iterations.
+    fn krylov(
+        &self,
+        rhs: &mut [f64],
+        x0: Option<&[f64]>,
+        active: &[bool],
+        forcing: f64,
+        budget: usize,
+    ) -> Option<usize> {
+        timed(&self.clock.solve, || {
+            let product = |x: &[f64], y: &mut [f64]| self.kkt_product(active, x, y);
+            let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let Some(x0) = x0 else {
+                let rhs0 = rhs.to_vec();
+                let its = gmres(&product, rhs, forcing, budget, &|v| self.precondition(v));
+                if its.is_none() {
+                    rhs.copy_from_slice(&rhs0);
                 }
+                return its;
+            };
+            // Solve for the correction of x0: A e = b - A x0, to the same |b|-relative
+            // tolerance.
+            let mut residual = vec![0.0; rhs.len()];
+            product(x0, &mut residual);
+            residual
+                .iter_mut()
+                .zip(&*rhs)
+                .for_each(|(r, b)| *r = b - *r);
+            let (b_norm, r_norm) = (norm(rhs), norm(&residual));
+            if r_norm <= forcing * b_norm {
+                rhs.copy_from_slice(x0);
+                return Some(0);
             }
-        }
+            let its = gmres(
+                &product,
+                &mut residual,
+                forcing * b_norm / r_norm,
+                budget,
+                &|v| self.precondition(v),
+            )?;
+            for ((x, e), x0) in rhs.iter_mut().zip(&residual).zip(x0) {
+                *x = x0 + e;
+            }
+            Some(its)
+        })
     }
 }
 
@@ -477,84 +439,146 @@ impl Newton<'_> {
                 .sum::<f64>()
     }
 
-    /// Write the KKT values of the current tangents and active set into the system: the
-    /// elastic stiffness (assembled once) plus the viscoplastic triangles' changes, and
-    /// the contact rows.
-    fn assemble_kkt(&mut self, tangents: &[Matrix3<f64>], active: &[bool]) {
+    /// Write the current tangent stiffness into the matrix GMRES multiplies with: the
+    /// elastic stiffness (assembled once) plus the viscoplastic triangles' changes.
+    fn assemble_tangent(&mut self, tangents: &[Matrix3<f64>]) {
         let clock = std::rc::Rc::clone(&self.clock);
         timed(&clock.assembly, || {
-            let vals = self.system.values_mut();
+            let vals = self.stiffness.values_mut();
             vals.copy_from_slice(&self.elastic_values);
             self.p.model.add_tangent_change(tangents, &self.slots, vals);
-            fill_contact_rows(
-                vals,
-                &self.row_slots,
-                &self.diag_slots,
-                self.c_scale,
-                active,
-            );
         });
     }
 
-    /// Solve the Newton system in place (`rhs` in, step out). Every iteration is a full
-    /// semismooth Newton step with the current consistent tangent and active set. Its
-    /// linear system is solved by GMRES preconditioned with the last factorization (of an
-    /// older matrix: the tangent changes little between iterations and steps), corrected
-    /// exactly for the contact rows whose active set changed since; the matrix is
-    /// refactorized only when GMRES needs many iterations. Returns whether it factorized.
-    fn solve_newton_system(
+    /// The Newton step at the iterate of `ev` and `lambda`, and the active set it was
+    /// computed with. Every iteration is a full semismooth Newton step with the current
+    /// consistent tangent. Its active set is the one the factorized linear model predicts:
+    /// starting from `active` (the semismooth rule at the iterate), the model's step is
+    /// solved on the interface, the rule applied to the resulting multipliers and gaps,
+    /// and so on until the set repeats ([`MAX_PREDICTIONS`] at most): each round is a
+    /// dense solve on the interface, where each outer iteration costs a sparse solve and a
+    /// return map over the mesh. For elastic bodies the model is exact and a step ends in
+    /// one iteration. The linear system is then solved by GMRES from the model's step,
+    /// preconditioned with the last factorization (of an older tangent: it changes little
+    /// between iterations and steps); the stiffness is refactorized only when GMRES needs
+    /// many iterations. Returns (step, active set, whether it factorized).
+    fn newton_step(
         &mut self,
-        rhs: &mut Vec<f64>,
-        tangents: &[Matrix3<f64>],
-        active: &[bool],
+        ev: &Evaluation,
+        lambda: &[f64],
+        active: Vec<bool>,
         distance: &Distance,
-    ) -> Result<bool> {
-        let clock = std::rc::Rc::clone(&self.clock);
-        let reusable = self.system.is_factored() && !self.stale;
+    ) -> Result<(Vec<f64>, Vec<bool>, bool)> {
         // GMRES is worth it while its solves cost less than a fresh factorization (about
         // 10 solves here): cap it at 10 iterations and refactor next time when it used more
         // than 5 and more than the fresh factorization needed. The rule counts iterations,
         // not seconds, so the results do not depend on the machine's load.
         let budget = 10;
-        if reusable {
-            if let Some(update) = self.row_update(active) {
-                let forcing = self.forcing_term(distance);
-                let rhs0 = rhs.clone();
-                let result = timed(&clock.solve, || {
-                    self.system
-                        .gmres(rhs, forcing, budget, &|v| self.precondition(&update, v))
-                });
-                if let Some(its) = result {
-                    self.stale = 2 * its > budget && its > self.fresh_iterations + 1;
-                    return Ok(false);
-                }
-                rhs.copy_from_slice(&rhs0);
+        let forcing = self.forcing_term(distance);
+        self.assemble_tangent(&ev.tangents);
+        let reusable = match &self.preconditioner {
+            Preconditioner::Interface => true,
+            Preconditioner::KktLu(a) => *a == active,
+            Preconditioner::None => false,
+        };
+        if reusable && !self.stale {
+            let (set, x0, flips) = self.predicted_step(ev, lambda, active.clone())?;
+            self.predicted_changes += flips;
+            let mut rhs = self.right_hand_side(ev, lambda, &set);
+            if let Some(its) = self.krylov(&mut rhs, x0.as_deref(), &set, forcing, budget) {
+                let its = its + x0.is_some() as usize;
+                self.stale = 2 * its > budget && its > self.fresh_iterations + 1;
+                return Ok((rhs, set, false));
             }
         }
-        self.factor(tangents, active)?;
-        let forcing = self.forcing_term(distance);
-        let update = self
-            .row_update(active)
-            .expect("no row changed since the factorization");
-        let rhs0 = rhs.clone();
-        let fresh = timed(&clock.solve, || {
-            self.system.gmres(rhs, forcing, FRESH_BUDGET, &|v| {
-                self.precondition(&update, v)
-            })
-        });
-        let its = match fresh {
-            Some(its) => its,
+        self.factor(&ev.tangents)?;
+        let (set, x0, flips) = self.predicted_step(ev, lambda, active)?;
+        self.predicted_changes += flips;
+        let mut rhs = self.right_hand_side(ev, lambda, &set);
+        let its = match self.krylov(&mut rhs, x0.as_deref(), &set, forcing, FRESH_BUDGET) {
+            Some(its) => its + x0.is_some() as usize,
             None => {
                 // A tangent too far from symmetric (stiff viscosity, k E / lambda near 1e4):
-                // the LU of the Newton matrix itself, exact, as before issue 14.
-                rhs.copy_from_slice(&rhs0);
-                self.system.factor_lu()?;
-                timed(&clock.solve, || self.system.solve(rhs));
+                // the LU of the Newton matrix itself, exact.
+                let (p, c) = (self.p, self.c_scale);
+                let rows = &self.rows;
+                let kkt = self.kkt.get_or_insert_with(|| KktMatrix::new(p, rows));
+                kkt.factor(p, &ev.tangents, &set, c)?;
+                timed(&self.clock.solve, || kkt.system.solve(&mut rhs));
+                self.preconditioner = Preconditioner::KktLu(set.clone());
                 0
             }
         };
         self.fresh_iterations = its;
-        Ok(true)
+        Ok((rhs, set, true))
+    }
+
+    /// The Newton right-hand side of the active set `set`: minus the residual, and per
+    /// contact row -c g_i (active) or -lambda_i (inactive).
+    fn right_hand_side(&self, ev: &Evaluation, lambda: &[f64], set: &[bool]) -> Vec<f64> {
+        let mut rhs: Vec<f64> = ev.residual.iter().map(|v| -v).collect();
+        rhs.extend(self.right_hand_side_rows(ev, lambda, set));
+        rhs
+    }
+
+    /// The active set the factorized model predicts from `active`, the model's step for
+    /// it (None when the preconditioner is not the interface factorization: the set is
+    /// then `active`), and how many rows changed on the way. See [`Newton::newton_step`].
+    fn predicted_step(
+        &mut self,
+        ev: &Evaluation,
+        lambda: &[f64],
+        mut active: Vec<bool>,
+    ) -> Result<(Vec<bool>, Option<Vec<f64>>, usize)> {
+        if self.preconditioner != Preconditioner::Interface {
+            return Ok((active, None, 0));
+        }
+        let (c, m) = (self.c_scale, lambda.len());
+        let minus_residual: Vec<f64> = ev.residual.iter().map(|v| -v).collect();
+        let condensed = timed(&self.clock.solve, || {
+            self.factorization.condense(&minus_residual)
+        });
+        let (mut round, mut flips) = (0, 0);
+        let (x_interface, y) = loop {
+            self.prepare_active_set(&active)?;
+            let set = self.active_set.as_ref().expect("prepared");
+            let factorization = &self.factorization;
+            let g = self.right_hand_side_rows(ev, lambda, &active);
+            let mut load = condensed.load.clone();
+            for i in (0..m).filter(|&i| !active[i]) {
+                factorization.subtract_row(i, g[i], &mut load);
+            }
+            let (x_interface, y_active) = factorization.interface_solve(set, &load, &g);
+            let mut y: Vec<f64> = g.iter().map(|gi| gi / c).collect();
+            for (&r, v) in set.rows().iter().zip(y_active) {
+                y[r] = v;
+            }
+            let next: Vec<bool> = (0..m)
+                .map(|i| {
+                    let gap = ev.gaps[i] + factorization.row_product(i, &x_interface);
+                    lambda[i] + c * y[i] + c * gap >= 0.0
+                })
+                .collect();
+            round += 1;
+            if next == active || round == MAX_PREDICTIONS {
+                break (x_interface, y);
+            }
+            flips += next.iter().zip(&active).filter(|(a, b)| a != b).count();
+            active = next;
+        };
+        let mut step = timed(&self.clock.solve, || {
+            self.factorization.expand(condensed, &x_interface)
+        });
+        step.extend(y);
+        Ok((active, Some(step), flips))
+    }
+
+    /// The contact rows' part of [`Newton::right_hand_side`].
+    fn right_hand_side_rows(&self, ev: &Evaluation, lambda: &[f64], set: &[bool]) -> Vec<f64> {
+        let c = self.c_scale;
+        (0..set.len())
+            .map(|i| if set[i] { -c * ev.gaps[i] } else { -lambda[i] })
+            .collect()
     }
 
     /// Inexact Newton: the linear solve needs only to beat the equilibrium residual
@@ -641,6 +665,7 @@ impl StepSolver for Newton<'_> {
         let mut lambda = guess.lambda.clone();
         let mut last_active: Option<Vec<bool>> = None;
         let (mut changes, mut iterations, mut factorizations) = (0, 0, 0);
+        let predicted_before = self.predicted_changes;
         let mut evaluation = self.evaluate(&data, &u, &lambda);
         let mut merits: Vec<f64> = Vec::new();
         loop {
@@ -677,7 +702,7 @@ impl StepSolver for Newton<'_> {
                     iterations,
                     outer_iterations: iterations,
                     residual: res,
-                    active_set_changes: changes,
+                    active_set_changes: changes + self.predicted_changes - predicted_before,
                     reason,
                 };
                 return Ok((state, report));
@@ -699,38 +724,32 @@ impl StepSolver for Newton<'_> {
                 .rev()
                 .take(MERIT_MEMORY)
                 .fold(0.0f64, |a, &b| a.max(b));
-            let mut step: Vec<f64> = ev
-                .residual
-                .iter()
-                .map(|v| -v)
-                .chain((0..m).map(|i| {
-                    if active[i] {
-                        -c * ev.gaps[i]
-                    } else {
-                        -lambda[i]
-                    }
-                }))
-                .collect();
+            let (step, set, factorized) = self.newton_step(ev, &lambda, active, &distance)?;
             debug_assert_eq!(step.len(), n + m);
-            self.assemble_kkt(&ev.tangents, &active);
-            if self.solve_newton_system(&mut step, &ev.tangents, &active, &distance)? {
-                factorizations += 1;
-            }
+            factorizations += factorized as usize;
             (u, lambda, evaluation) = self.line_search(&data, &u, &lambda, &step, reference);
-            last_active = Some(active);
+            last_active = Some(set);
             iterations += 1;
         }
     }
 
     fn timings(&self) -> Timings {
+        let (kkt_factor_s, kkt_factorizations, kkt_solves) =
+            self.kkt.as_ref().map_or((0.0, 0, 0), |k| {
+                (
+                    k.system.factor_s,
+                    k.system.factorizations,
+                    k.system.solves.get(),
+                )
+            });
         Timings {
             assembly_s: self.clock.assembly.get(),
-            factor_s: self.system.factor_s,
+            factor_s: self.factorization.factor_s.get() + kkt_factor_s,
             solve_s: self.clock.solve.get(),
             constitutive_s: self.clock.constitutive.get(),
             contact_s: self.clock.contact.get(),
-            factorizations: self.system.factorizations,
-            solves: self.system.solves.get(),
+            factorizations: self.factorization.factorizations + kkt_factorizations,
+            solves: self.factorization.solves.get() + kkt_solves,
             setup_s: self.setup_s,
         }
     }

@@ -1,0 +1,597 @@
+//! The stiffness factorized with the contact interface's unknowns last, and every active
+//! set solved on the interface alone.
+//!
+//! The contact rows C touch only the b unknowns on Gamma_C (b ~ sqrt(n)). Ordered last, a
+//! sparse LDL^T of the stiffness ends in a dense b x b block whose L D L^T is the Schur
+//! complement S of the stiffness onto the interface. The Newton system of any active set A,
+//!
+//! ```text
+//! [ K       c C^T ] [x]   [f]        (inactive rows: c y_i = g_i)
+//! [ c C_A   0     ] [y] = [g_A]
+//! ```
+//!
+//! is then one forward substitution, a dense saddle-point solve on the interface
+//! `[S c C_A^T; c C_A 0]` (b + |A| unknowns, one dense LU per active set) and one back
+//! substitution: the sparse matrix is factorized once per tangent and never per active set.
+//! (The KKT matrix's LDL^T it replaces was refactorized two or three times per run, at
+//! every large change of the active set; measured in issue 14.)
+//!
+//! A body held only by contact has a singular stiffness, but its rigid mode lives on the
+//! interface: the factorized matrix is K + sigma P_I^T P_I (sigma the stiffness scale on
+//! the interface diagonal), positive definite, and S = (its trailing block) - sigma I is
+//! exact; the saddle-point system is regular as soon as the active rows hold the body.
+//!
+//! Written by hand on top of faer's supernodal LDL^T (its public supernode values): faer
+//! solves with the whole factor only, and this needs the forward and back substitutions
+//! apart, with the interface solve in between.
+
+use crate::error::{Error, Result};
+use crate::fe::Pattern;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::linalg::solvers::{PartialPivLu, SolveCore};
+use faer::linalg::triangular_solve::{
+    solve_unit_lower_triangular_in_place, solve_unit_upper_triangular_in_place,
+};
+use faer::perm::PermRef;
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::amd;
+use faer::sparse::linalg::cholesky::supernodal::{SupernodalLdltRef, SymbolicSupernodalCholesky};
+use faer::sparse::linalg::cholesky::{
+    CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+    factorize_symbolic_cholesky,
+};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::{Accum, Conj, Mat, MatMut, MatRef, Par, Side};
+use std::cell::Cell;
+use std::time::Instant;
+
+/// A contact row restricted to the free unknowns: (interface index, equation, coefficient).
+type InterfaceRow = Vec<(usize, usize, f64)>;
+
+/// The factorization of one symmetric stiffness with the interface last (see the module).
+pub struct InterfaceFactorization {
+    n: usize,
+    /// Free equations on Gamma_C, in the order of the trailing block.
+    interface: Vec<usize>,
+    /// Contact rows over the interface.
+    rows: Vec<InterfaceRow>,
+    /// 1 / |C_i| (Euclidean norm of row i; 1 for an empty row): scales the multiplier rows
+    /// of the dense saddle-point matrix to the size of the stiffness.
+    row_scale: Vec<f64>,
+    /// Position of each equation in the elimination order.
+    position: Vec<usize>,
+    symbolic: SymbolicCholesky<usize>,
+    /// Pattern of the stiffness (lower triangle read) and the slots of the interface
+    /// unknowns' diagonal entries.
+    pattern: SymbolicSparseColMat<usize>,
+    interface_diagonal: Vec<usize>,
+    numeric: Option<Numeric>,
+    /// Seconds in numeric work: sparse LDL^T, interface block, dense LUs.
+    pub factor_s: Cell<f64>,
+    /// Seconds in the symbolic analysis (ordering, elimination tree), once per mesh.
+    pub symbolic_s: f64,
+    /// Sparse numeric factorizations.
+    pub factorizations: usize,
+    /// Right-hand sides solved.
+    pub solves: Cell<usize>,
+}
+
+/// The numeric part: values of the factor and the interface's dense blocks.
+struct Numeric {
+    /// Values of the supernodal L (unit diagonal) with D on its diagonal.
+    values: Vec<f64>,
+    /// Symmetric scaling W (equation order): W (K + sigma P^T P) W was factorized.
+    scaling: Vec<f64>,
+    /// The trailing b x b block of L (unit lower triangular) and of D.
+    l_interface: Mat<f64>,
+    d_interface: Vec<f64>,
+    /// S: the Schur complement of the stiffness onto the interface (b x b, force/length).
+    schur: Mat<f64>,
+}
+
+/// Whether an LU's pivots are all above 1e-12 of the largest (an empty matrix is regular).
+fn is_regular(lu: &PartialPivLu<f64>) -> bool {
+    let u = lu.U();
+    let diagonal = (0..u.nrows()).map(|i| u[(i, i)].abs());
+    let (small, large) = diagonal.fold((f64::INFINITY, 0.0f64), |(s, l), v| (s.min(v), l.max(v)));
+    u.nrows() == 0 || small > 1e-12 * large
+}
+
+/// A load after the forward substitution (see [`InterfaceFactorization::condense`]).
+pub struct Condensed {
+    /// The forward-substituted, scaled and permuted load.
+    y: Vec<f64>,
+    /// What the interface sees of the load: `f_I - K_Ir K_rr^{-1} f_r` (force, b values).
+    pub load: Vec<f64>,
+}
+
+/// The dense interface system of one active set, factorized.
+pub struct ActiveSet {
+    active: Vec<bool>,
+    /// Active rows, in order.
+    rows: Vec<usize>,
+    lu: PartialPivLu<f64>,
+}
+
+impl ActiveSet {
+    /// The active rows, in order.
+    pub fn rows(&self) -> &[usize] {
+        &self.rows
+    }
+
+    /// The active set this system was built for.
+    pub fn active(&self) -> &[bool] {
+        &self.active
+    }
+}
+
+/// Pivots of the scaled stiffness (unit diagonal) below this are replaced by
+/// [`PIVOT_REPLACEMENT`]: only a body with a rigid mode contact does not control can
+/// produce one (its problem is singular); GMRES then sees the difference.
+const PIVOT_EPSILON: f64 = 1e-12;
+const PIVOT_REPLACEMENT: f64 = 1e-6;
+
+impl InterfaceFactorization {
+    /// Order the stiffness with pattern `pattern` (n x n, both triangles) with the interface
+    /// of `rows` (contact rows as (equation, coefficient)) last, and analyze it.
+    pub fn new(pattern: &Pattern, rows: &[Vec<(usize, f64)>]) -> Result<Self> {
+        let t = Instant::now();
+        let n = pattern.n;
+        let mut on_interface = vec![false; n];
+        for row in rows {
+            for &(eq, _) in row {
+                on_interface[eq] = true;
+            }
+        }
+        let interface: Vec<usize> = (0..n).filter(|&e| on_interface[e]).collect();
+        let mut local = vec![usize::MAX; n];
+        for (l, &e) in interface.iter().enumerate() {
+            local[e] = l;
+        }
+        let interface_rows: Vec<InterfaceRow> = rows
+            .iter()
+            .map(|r| r.iter().map(|&(eq, v)| (local[eq], eq, v)).collect())
+            .collect();
+        let row_scale = rows
+            .iter()
+            .map(|r| {
+                let norm = r.iter().map(|&(_, v)| v * v).sum::<f64>().sqrt();
+                if norm > 0.0 { 1.0 / norm } else { 1.0 }
+            })
+            .collect();
+        // AMD of the interior block, then the interface.
+        let interior: Vec<usize> = (0..n).filter(|&e| !on_interface[e]).collect();
+        let mut interior_index = vec![usize::MAX; n];
+        for (k, &e) in interior.iter().enumerate() {
+            interior_index[e] = k;
+        }
+        let (mut col_ptr, mut row_idx) = (vec![0usize], Vec::new());
+        for &e in &interior {
+            let rows_of_e = &pattern.row_idx[pattern.col_ptr[e]..pattern.col_ptr[e + 1]];
+            row_idx.extend(
+                rows_of_e
+                    .iter()
+                    .map(|&r| interior_index[r])
+                    .filter(|&r| r != usize::MAX),
+            );
+            col_ptr.push(row_idx.len());
+        }
+        let ni = interior.len();
+        let interior_pattern = SymbolicSparseColMat::new_checked(ni, ni, col_ptr, None, row_idx);
+        let (mut fwd, mut inv) = (vec![0usize; ni], vec![0usize; ni]);
+        let mut buffer = MemBuffer::try_new(amd::order_scratch::<usize>(
+            ni,
+            interior_pattern.row_idx().len(),
+        ))
+        .map_err(|_| Error::NotConverged("out of memory in the ordering".into()))?;
+        amd::order(
+            &mut fwd,
+            &mut inv,
+            interior_pattern.as_ref(),
+            Default::default(),
+            MemStack::new(&mut buffer),
+        )
+        .map_err(|e| Error::NotConverged(format!("ordering failed: {e:?}")))?;
+        let order: Vec<usize> = fwd
+            .iter()
+            .map(|&k| interior[k])
+            .chain(interface.iter().copied())
+            .collect();
+        let mut position = vec![0usize; n];
+        for (p, &e) in order.iter().enumerate() {
+            position[e] = p;
+        }
+        let full = SymbolicSparseColMat::new_checked(
+            n,
+            n,
+            pattern.col_ptr.clone(),
+            None,
+            pattern.row_idx.clone(),
+        );
+        let perm = PermRef::new_checked(&order, &position, n);
+        let symbolic = factorize_symbolic_cholesky(
+            full.as_ref(),
+            Side::Lower,
+            SymmetricOrdering::Custom(perm),
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                ..Default::default()
+            },
+        )
+        .map_err(|e| Error::NotConverged(format!("symbolic LDLT failed: {e:?}")))?;
+        let interface_diagonal = interface.iter().map(|&e| pattern.slot(e, e)).collect();
+        Ok(InterfaceFactorization {
+            n,
+            interface,
+            rows: interface_rows,
+            row_scale,
+            position,
+            symbolic,
+            pattern: full,
+            interface_diagonal,
+            numeric: None,
+            factor_s: Cell::new(0.0),
+            symbolic_s: t.elapsed().as_secs_f64(),
+            factorizations: 0,
+            solves: Cell::new(0),
+        })
+    }
+
+    /// Number of unknowns on the interface (b).
+    pub fn interface_len(&self) -> usize {
+        self.interface.len()
+    }
+
+    /// Stored entries of the factor L.
+    pub fn factor_entries(&self) -> usize {
+        self.supernodal().len_val()
+    }
+
+    fn supernodal(&self) -> &SymbolicSupernodalCholesky<usize> {
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(s) => s,
+            SymbolicCholeskyRaw::Simplicial(_) => unreachable!("supernodal forced in new"),
+        }
+    }
+
+    /// Factorize the symmetric positive (semi)definite stiffness whose lower triangle is
+    /// `values` (pattern order; overwritten: scaled and shifted). `shift` is sigma, the
+    /// stiffness scale (force/length) added on the interface diagonal.
+    pub fn factor(&mut self, values: &mut [f64], shift: f64) -> Result<()> {
+        let t = Instant::now();
+        for &s in &self.interface_diagonal {
+            values[s] += shift;
+        }
+        let pattern = self.pattern.as_ref();
+        let scaling: Vec<f64> = (0..self.n)
+            .map(|j| {
+                let d = values[pattern.col_ptr()[j]
+                    + pattern
+                        .row_idx_of_col(j)
+                        .position(|i| i == j)
+                        .expect("diagonal in pattern")];
+                if d > 0.0 { 1.0 / d.sqrt() } else { 1.0 }
+            })
+            .collect();
+        for j in 0..self.n {
+            let start = pattern.col_ptr()[j];
+            for (s, i) in pattern.row_idx_of_col(j).enumerate() {
+                values[start + s] *= scaling[i] * scaling[j];
+            }
+        }
+        let mut l_values = self.numeric.take().map(|f| f.values).unwrap_or_default();
+        l_values.resize(self.symbolic.len_val(), 0.0);
+        let mut buffer = MemBuffer::try_new(
+            self.symbolic
+                .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()),
+        )
+        .map_err(|_| Error::NotConverged("out of memory in the LDLT".into()))?;
+        let signs = vec![1i8; self.n];
+        self.symbolic
+            .factorize_numeric_ldlt(
+                &mut l_values,
+                SparseColMatRef::new(pattern, values),
+                Side::Lower,
+                LdltRegularization {
+                    dynamic_regularization_signs: Some(&signs),
+                    dynamic_regularization_delta: PIVOT_REPLACEMENT,
+                    dynamic_regularization_epsilon: PIVOT_EPSILON,
+                },
+                Par::Seq,
+                MemStack::new(&mut buffer),
+                Default::default(),
+            )
+            .map_err(|e| Error::NotConverged(format!("LDLT failed: {e:?}")))?;
+        let (l_interface, d_interface) = self.trailing_block(&l_values);
+        // S = W_I^{-1} L D L^T W_I^{-1} - sigma I.
+        let b = self.interface.len();
+        let w: Vec<f64> = self.interface.iter().map(|&e| scaling[e]).collect();
+        let ld = Mat::from_fn(b, b, |i, j| l_interface[(i, j)] * d_interface[j]);
+        let mut ldl = Mat::zeros(b, b);
+        faer::linalg::matmul::matmul(
+            ldl.as_mut(),
+            Accum::Replace,
+            ld.as_ref(),
+            l_interface.transpose(),
+            1.0,
+            Par::Seq,
+        );
+        let schur = Mat::from_fn(b, b, |i, j| {
+            let s = 0.5 * (ldl[(i, j)] + ldl[(j, i)]) / (w[i] * w[j]);
+            if i == j { s - shift } else { s }
+        });
+        self.numeric = Some(Numeric {
+            values: l_values,
+            scaling,
+            l_interface,
+            d_interface,
+            schur,
+        });
+        self.factorizations += 1;
+        self.factor_s
+            .set(self.factor_s.get() + t.elapsed().as_secs_f64());
+        Ok(())
+    }
+
+    /// The trailing b x b blocks of L (unit lower triangular) and D, read from the
+    /// supernodes that hold the last b columns.
+    fn trailing_block(&self, l_values: &[f64]) -> (Mat<f64>, Vec<f64>) {
+        let b = self.interface.len();
+        let first = self.n - b;
+        let mut l = Mat::zeros(b, b);
+        let mut d = vec![0.0; b];
+        let sym = self.supernodal();
+        let factor = SupernodalLdltRef::new(sym, l_values);
+        for s in 0..sym.n_supernodes() {
+            let node = factor.supernode(s);
+            let (start, values) = (node.start(), node.val());
+            let size = values.ncols();
+            if start + size <= first {
+                continue;
+            }
+            for jj in 0..size {
+                let j = start + jj;
+                if j < first {
+                    continue;
+                }
+                let col = j - first;
+                d[col] = values[(jj, jj)];
+                l[(col, col)] = 1.0;
+                for ii in jj + 1..size {
+                    l[(start + ii - first, col)] = values[(ii, jj)];
+                }
+                for (k, &i) in node.pattern().iter().enumerate() {
+                    l[(i - first, col)] = values[(size + k, jj)];
+                }
+            }
+        }
+        (l, d)
+    }
+
+    /// Factorize the dense interface system of the active set `active` (c: the scale of
+    /// the contact rows, force/length).
+    pub fn active_set(&mut self, active: &[bool], c: f64) -> Result<ActiveSet> {
+        let t = Instant::now();
+        let rows: Vec<usize> = (0..active.len()).filter(|&i| active[i]).collect();
+        let mut lu = self.saddle_point_lu(&rows, c, 0.0);
+        if !is_regular(&lu) {
+            // The active rows do not hold a body held only by contact (an intermediate
+            // active set of the semismooth search): its rigid mode gets a small stiffness,
+            // 1e-8 of the stiffness scale, for this active set (GMRES corrects the
+            // difference, the line search the size of the step).
+            lu = self.saddle_point_lu(&rows, c, 1e-8 * c);
+        }
+        self.factor_s
+            .set(self.factor_s.get() + t.elapsed().as_secs_f64());
+        Ok(ActiveSet {
+            active: active.to_vec(),
+            rows,
+            lu,
+        })
+    }
+
+    /// LU of the saddle-point matrix `[S + r I, c C_A^T s; s c C_A, 0]` of the rows `rows`
+    /// (s: the rows' scales, r: the regularization).
+    fn saddle_point_lu(&self, rows: &[usize], c: f64, regularization: f64) -> PartialPivLu<f64> {
+        let numeric = self.numeric.as_ref().expect("factor before active_set");
+        let b = self.interface.len();
+        let size = b + rows.len();
+        let mut a = Mat::<f64>::zeros(size, size);
+        for j in 0..b {
+            for i in 0..b {
+                a[(i, j)] = numeric.schur[(i, j)];
+            }
+            a[(j, j)] += regularization;
+        }
+        for (k, &r) in rows.iter().enumerate() {
+            let scale = c * self.row_scale[r];
+            for &(l, _, v) in &self.rows[r] {
+                a[(b + k, l)] += scale * v;
+                a[(l, b + k)] += scale * v;
+            }
+        }
+        a.partial_piv_lu()
+    }
+
+    /// Solve the Newton system of `set` in place: `v` = [f (n); g (m)] in, [x; y] out (see
+    /// the module; y is the multiplier step divided by c).
+    pub fn solve(&self, set: &ActiveSet, c: f64, v: &mut [f64]) {
+        let n = self.n;
+        let (f, g) = v.split_at_mut(n);
+        let mut condensed = self.condense(f);
+        // Inactive rows: y_i = g_i / c, its column moved to the right-hand side (on the
+        // interface only, where the condensed load equals the load).
+        for (i, row) in self.rows.iter().enumerate() {
+            if !set.active[i] {
+                for &(l, _, coef) in row {
+                    condensed.load[l] -= coef * g[i];
+                }
+                g[i] /= c;
+            }
+        }
+        let (x_interface, y_active) = self.interface_solve(set, &condensed.load, g);
+        for (&r, y) in set.rows.iter().zip(y_active) {
+            g[r] = y;
+        }
+        f.copy_from_slice(&self.expand(condensed, &x_interface));
+    }
+
+    /// Forward substitution of the load `f` (n): what the interface sees of it.
+    pub fn condense(&self, f: &[f64]) -> Condensed {
+        let numeric = self.numeric.as_ref().expect("factor before solve");
+        self.solves.set(self.solves.get() + 1);
+        let (n, b) = (self.n, self.interface.len());
+        let mut y = vec![0.0; n];
+        for (e, &p) in self.position.iter().enumerate() {
+            y[p] = numeric.scaling[e] * f[e];
+        }
+        self.forward(numeric, &mut y);
+        // The condensed load W_I^{-1} L_II y_I.
+        let first = n - b;
+        let mut load = vec![0.0; b];
+        for j in 0..b {
+            let yj = y[first + j];
+            if yj != 0.0 {
+                for i in j..b {
+                    load[i] += numeric.l_interface[(i, j)] * yj;
+                }
+            }
+        }
+        for (i, &e) in self.interface.iter().enumerate() {
+            load[i] /= numeric.scaling[e];
+        }
+        Condensed { y, load }
+    }
+
+    /// The interface unknowns x_I (b) and the active rows' y (in the order of
+    /// `set`'s rows) of the saddle-point system `[S c C_A^T; c C_A 0] [x_I; y] = [load;
+    /// g_A]` (`g`: every row's right-hand side, m).
+    pub fn interface_solve(
+        &self,
+        set: &ActiveSet,
+        load: &[f64],
+        g: &[f64],
+    ) -> (Vec<f64>, Vec<f64>) {
+        let b = self.interface.len();
+        let mut rhs = Mat::<f64>::zeros(b + set.rows.len(), 1);
+        for (i, &l) in load.iter().enumerate() {
+            rhs[(i, 0)] = l;
+        }
+        for (k, &r) in set.rows.iter().enumerate() {
+            rhs[(b + k, 0)] = self.row_scale[r] * g[r];
+        }
+        set.lu.solve_in_place_with_conj(Conj::No, rhs.as_mut());
+        let x = (0..b).map(|i| rhs[(i, 0)]).collect();
+        let y = set
+            .rows
+            .iter()
+            .enumerate()
+            .map(|(k, &r)| self.row_scale[r] * rhs[(b + k, 0)])
+            .collect();
+        (x, y)
+    }
+
+    /// The displacement (n) whose interface values are `x_interface`, from the forward
+    /// substitution `condensed`: the trailing values that lead to x_I, D L_II^T W_I^{-1}
+    /// x_I, then the back substitution.
+    pub fn expand(&self, condensed: Condensed, x_interface: &[f64]) -> Vec<f64> {
+        let numeric = self.numeric.as_ref().expect("factor before solve");
+        let (n, b) = (self.n, self.interface.len());
+        let first = n - b;
+        let mut y = condensed.y;
+        let scaled: Vec<f64> = (0..b)
+            .map(|i| x_interface[i] / numeric.scaling[self.interface[i]])
+            .collect();
+        for j in 0..b {
+            let s: f64 = (j..b)
+                .map(|i| numeric.l_interface[(i, j)] * scaled[i])
+                .sum();
+            y[first + j] = numeric.d_interface[j] * s;
+        }
+        self.diagonal_and_back(numeric, &mut y);
+        let mut x = vec![0.0; n];
+        for (e, &p) in self.position.iter().enumerate() {
+            x[e] = numeric.scaling[e] * y[p];
+        }
+        x
+    }
+
+    /// C_i x restricted to the interface (`x_interface`: b values).
+    pub fn row_product(&self, i: usize, x_interface: &[f64]) -> f64 {
+        self.rows[i]
+            .iter()
+            .map(|&(l, _, v)| v * x_interface[l])
+            .sum()
+    }
+
+    /// `load -= coef C_i^T` on the interface.
+    pub fn subtract_row(&self, i: usize, coef: f64, load: &mut [f64]) {
+        for &(l, _, v) in &self.rows[i] {
+            load[l] -= coef * v;
+        }
+    }
+
+    /// x <- L^{-1} x (unit lower triangular, supernode after supernode).
+    fn forward(&self, numeric: &Numeric, x: &mut [f64]) {
+        let sym = self.supernodal();
+        let factor = SupernodalLdltRef::new(sym, &numeric.values);
+        let mut tmp = Vec::new();
+        for s in 0..sym.n_supernodes() {
+            let node = factor.supernode(s);
+            let values = node.val();
+            let (start, size) = (node.start(), values.ncols());
+            let (top, bottom) = values.split_at_row(size);
+            let top_x = MatMut::from_column_major_slice_mut(&mut x[start..start + size], size, 1);
+            solve_unit_lower_triangular_in_place(top, top_x, Par::Seq);
+            let pattern = node.pattern();
+            tmp.clear();
+            tmp.resize(pattern.len(), 0.0);
+            faer::linalg::matmul::matmul(
+                MatMut::from_column_major_slice_mut(&mut tmp, pattern.len(), 1),
+                Accum::Replace,
+                bottom,
+                MatRef::from_column_major_slice(&x[start..start + size], size, 1),
+                1.0,
+                Par::Seq,
+            );
+            for (k, &i) in pattern.iter().enumerate() {
+                x[i] -= tmp[k];
+            }
+        }
+    }
+
+    /// x <- L^{-T} D^{-1} x.
+    fn diagonal_and_back(&self, numeric: &Numeric, x: &mut [f64]) {
+        let sym = self.supernodal();
+        let factor = SupernodalLdltRef::new(sym, &numeric.values);
+        for s in 0..sym.n_supernodes() {
+            let node = factor.supernode(s);
+            let values = node.val();
+            for k in 0..values.ncols() {
+                x[node.start() + k] /= values[(k, k)];
+            }
+        }
+        let mut tmp = Vec::new();
+        for s in (0..sym.n_supernodes()).rev() {
+            let node = factor.supernode(s);
+            let values = node.val();
+            let (start, size) = (node.start(), values.ncols());
+            let (top, bottom) = values.split_at_row(size);
+            let pattern = node.pattern();
+            tmp.clear();
+            tmp.extend(pattern.iter().map(|&i| x[i]));
+            let mut top_x =
+                MatMut::from_column_major_slice_mut(&mut x[start..start + size], size, 1);
+            faer::linalg::matmul::matmul(
+                top_x.as_mut(),
+                Accum::Add,
+                bottom.transpose(),
+                MatRef::from_column_major_slice(&tmp, pattern.len(), 1),
+                -1.0,
+                Par::Seq,
+            );
+            solve_unit_upper_triangular_in_place(top.transpose(), top_x, Par::Seq);
+        }
+    }
+}
