@@ -30,9 +30,6 @@ use crate::fe::Pattern;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::solvers::{PartialPivLu, SolveCore};
-use faer::linalg::triangular_solve::{
-    solve_unit_lower_triangular_in_place, solve_unit_upper_triangular_in_place,
-};
 use faer::perm::PermRef;
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::amd;
@@ -42,7 +39,7 @@ use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky,
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
-use faer::{Accum, Conj, Mat, MatMut, MatRef, Par, Side};
+use faer::{Accum, Conj, Mat, Par, Side};
 use std::cell::Cell;
 use std::time::Instant;
 
@@ -81,6 +78,11 @@ pub struct InterfaceFactorization {
 struct Numeric {
     /// Values of the supernodal L (unit diagonal) with D on its diagonal.
     values: Vec<f64>,
+    /// 1 / D, in elimination order.
+    inverse_diagonal: Vec<f64>,
+    /// The values of L rounded to single precision, for the solves (see
+    /// [`InterfaceFactorization::factor`]).
+    single: Option<Vec<f32>>,
     /// Symmetric scaling W (equation order): W (K + sigma P^T P) W was factorized.
     scaling: Vec<f64>,
     /// The trailing b x b block of L (unit lower triangular) and of D.
@@ -88,6 +90,37 @@ struct Numeric {
     d_interface: Vec<f64>,
     /// S: the Schur complement of the stiffness onto the interface (b x b, force/length).
     schur: Mat<f64>,
+}
+
+/// A stored value of the factor: f64, or f32 for the solves of a preconditioner.
+trait Value: Copy {
+    fn get(self) -> f64;
+}
+impl Value for f64 {
+    fn get(self) -> f64 {
+        self
+    }
+}
+impl Value for f32 {
+    fn get(self) -> f64 {
+        self as f64
+    }
+}
+
+/// sum_k l_k x_k, with four partial sums: one running sum is bound by the latency of the
+/// addition.
+fn dot<T: Value>(l: &[T], x: &[f64]) -> f64 {
+    let mut sums = [0.0; 4];
+    let (l_chunks, x_chunks) = (l.chunks_exact(4), x.chunks_exact(4));
+    let rest: f64 = (l_chunks.remainder().iter().zip(x_chunks.remainder()))
+        .map(|(a, b)| a.get() * b)
+        .sum();
+    for (a, b) in l_chunks.zip(x_chunks) {
+        for k in 0..4 {
+            sums[k] += a[k].get() * b[k];
+        }
+    }
+    sums[0] + sums[1] + sums[2] + sums[3] + rest
 }
 
 /// Whether an LU's pivots are all above 1e-12 of the largest (an empty matrix is regular).
@@ -258,7 +291,20 @@ impl InterfaceFactorization {
     /// Factorize the symmetric positive (semi)definite stiffness whose lower triangle is
     /// `values` (pattern order; overwritten: scaled and shifted). `shift` is sigma, the
     /// stiffness scale (force/length) added on the interface diagonal.
-    pub fn factor(&mut self, values: &mut [f64], shift: f64) -> Result<()> {
+    ///
+    /// With `single_precision_solves`, the sparse substitutions read L rounded to f32
+    /// (arithmetic in f64, the interface's dense blocks in f64): a solve reads the factor
+    /// once and is bound by memory, so it costs about half (measured: see the module). The
+    /// solve is then exact for a matrix within about 1e-7 cond(K) of K: for a
+    /// preconditioner of GMRES that already corrects a tangent 10% away from the factored
+    /// one (viscoplastic bodies) the rounding changes nothing; an elastic problem, where
+    /// the solve is the answer, keeps f64.
+    pub fn factor(
+        &mut self,
+        values: &mut [f64],
+        shift: f64,
+        single_precision_solves: bool,
+    ) -> Result<()> {
         let t = Instant::now();
         for &s in &self.interface_diagonal {
             values[s] += shift;
@@ -321,7 +367,17 @@ impl InterfaceFactorization {
             let s = 0.5 * (ldl[(i, j)] + ldl[(j, i)]) / (w[i] * w[j]);
             if i == j { s - shift } else { s }
         });
+        let mut inverse_diagonal = vec![0.0; self.n];
+        for (start, width, pattern, values) in self.supernodes(&l_values) {
+            let rows = width + pattern.len();
+            for j in 0..width {
+                inverse_diagonal[start + j] = 1.0 / values[j * rows + j];
+            }
+        }
+        let single = single_precision_solves.then(|| l_values.iter().map(|&v| v as f32).collect());
         self.numeric = Some(Numeric {
+            single,
+            inverse_diagonal,
             values: l_values,
             scaling,
             l_interface,
@@ -532,66 +588,91 @@ impl InterfaceFactorization {
         }
     }
 
-    /// x <- L^{-1} x (unit lower triangular, supernode after supernode).
-    fn forward(&self, numeric: &Numeric, x: &mut [f64]) {
+    /// The supernodes as (first column, width, off-diagonal row indices, values: the
+    /// columns of the width x width diagonal block and the off-diagonal rows, column-major).
+    fn supernodes<'v, T>(
+        &'v self,
+        values: &'v [T],
+    ) -> impl DoubleEndedIterator<Item = (usize, usize, &'v [usize], &'v [T])> + 'v {
         let sym = self.supernodal();
-        let factor = SupernodalLdltRef::new(sym, &numeric.values);
-        let mut tmp = Vec::new();
-        for s in 0..sym.n_supernodes() {
-            let node = factor.supernode(s);
-            let values = node.val();
-            let (start, size) = (node.start(), values.ncols());
-            let (top, bottom) = values.split_at_row(size);
-            let top_x = MatMut::from_column_major_slice_mut(&mut x[start..start + size], size, 1);
-            solve_unit_lower_triangular_in_place(top, top_x, Par::Seq);
-            let pattern = node.pattern();
-            tmp.clear();
-            tmp.resize(pattern.len(), 0.0);
-            faer::linalg::matmul::matmul(
-                MatMut::from_column_major_slice_mut(&mut tmp, pattern.len(), 1),
-                Accum::Replace,
-                bottom,
-                MatRef::from_column_major_slice(&x[start..start + size], size, 1),
-                1.0,
-                Par::Seq,
-            );
-            for (k, &i) in pattern.iter().enumerate() {
-                x[i] -= tmp[k];
+        let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
+        let (row_ptr, rows, val_ptr) = (
+            sym.col_ptr_for_row_idx(),
+            sym.row_idx(),
+            sym.col_ptr_for_val(),
+        );
+        (0..sym.n_supernodes()).map(move |s| {
+            (
+                begin[s],
+                end[s] - begin[s],
+                &rows[row_ptr[s]..row_ptr[s + 1]],
+                &values[val_ptr[s]..val_ptr[s + 1]],
+            )
+        })
+    }
+
+    /// x <- L^{-1} x, with the single-precision copy of L when there is one.
+    fn forward(&self, numeric: &Numeric, x: &mut [f64]) {
+        match &numeric.single {
+            Some(values) => self.forward_with(values, x),
+            None => self.forward_with(&numeric.values, x),
+        }
+    }
+
+    /// x <- L^{-T} D^{-1} x, with the single-precision copy of L when there is one.
+    fn diagonal_and_back(&self, numeric: &Numeric, x: &mut [f64]) {
+        for (xi, d) in x.iter_mut().zip(&numeric.inverse_diagonal) {
+            *xi *= d;
+        }
+        match &numeric.single {
+            Some(values) => self.back_with(values, x),
+            None => self.back_with(&numeric.values, x),
+        }
+    }
+
+    /// x <- L^{-1} x (unit lower triangular, supernode after supernode). Plain loops over
+    /// the columns, the off-diagonal rows gathered and scattered once per supernode: a
+    /// solve reads the factor once and is bound by memory.
+    fn forward_with<T: Value>(&self, values: &[T], x: &mut [f64]) {
+        let mut below = Vec::new();
+        for (start, width, pattern, values) in self.supernodes(values) {
+            let rows = width + pattern.len();
+            below.clear();
+            below.resize(pattern.len(), 0.0);
+            for j in 0..width {
+                let xj = x[start + j];
+                if xj == 0.0 {
+                    continue;
+                }
+                let column = &values[j * rows..(j + 1) * rows];
+                for (xi, l) in x[start + j + 1..start + width]
+                    .iter_mut()
+                    .zip(&column[j + 1..width])
+                {
+                    *xi -= l.get() * xj;
+                }
+                for (bk, l) in below.iter_mut().zip(&column[width..]) {
+                    *bk += l.get() * xj;
+                }
+            }
+            for (&i, bk) in pattern.iter().zip(&below) {
+                x[i] -= bk;
             }
         }
     }
 
-    /// x <- L^{-T} D^{-1} x.
-    fn diagonal_and_back(&self, numeric: &Numeric, x: &mut [f64]) {
-        let sym = self.supernodal();
-        let factor = SupernodalLdltRef::new(sym, &numeric.values);
-        for s in 0..sym.n_supernodes() {
-            let node = factor.supernode(s);
-            let values = node.val();
-            for k in 0..values.ncols() {
-                x[node.start() + k] /= values[(k, k)];
+    /// x <- L^{-T} x.
+    fn back_with<T: Value>(&self, values: &[T], x: &mut [f64]) {
+        let mut below = Vec::new();
+        for (start, width, pattern, values) in self.supernodes(values).rev() {
+            let rows = width + pattern.len();
+            below.clear();
+            below.extend(pattern.iter().map(|&i| x[i]));
+            for j in (0..width).rev() {
+                let column = &values[j * rows..(j + 1) * rows];
+                x[start + j] -= dot(&column[width..], &below)
+                    + dot(&column[j + 1..width], &x[start + j + 1..start + width]);
             }
-        }
-        let mut tmp = Vec::new();
-        for s in (0..sym.n_supernodes()).rev() {
-            let node = factor.supernode(s);
-            let values = node.val();
-            let (start, size) = (node.start(), values.ncols());
-            let (top, bottom) = values.split_at_row(size);
-            let pattern = node.pattern();
-            tmp.clear();
-            tmp.extend(pattern.iter().map(|&i| x[i]));
-            let mut top_x =
-                MatMut::from_column_major_slice_mut(&mut x[start..start + size], size, 1);
-            faer::linalg::matmul::matmul(
-                top_x.as_mut(),
-                Accum::Add,
-                bottom.transpose(),
-                MatRef::from_column_major_slice(&tmp, pattern.len(), 1),
-                -1.0,
-                Par::Seq,
-            );
-            solve_unit_upper_triangular_in_place(top.transpose(), top_x, Par::Seq);
         }
     }
 }

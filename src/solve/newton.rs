@@ -287,7 +287,15 @@ impl<'a> Newton<'a> {
                 .model
                 .add_tangent_change(&symmetric, &self.slots, &mut vals);
         });
-        let result = self.factorization.factor(&mut vals, self.c_scale);
+        let viscoplastic = self
+            .p
+            .model
+            .materials
+            .iter()
+            .any(|m| m.viscoplastic.is_some());
+        let result = self
+            .factorization
+            .factor(&mut vals, self.c_scale, viscoplastic);
         self.symmetric_values = vals;
         result?;
         self.active_set = None;
