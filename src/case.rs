@@ -337,8 +337,9 @@ impl PeakMemory {
     }
 }
 
-/// Return the heap's free memory to the system (glibc's malloc_trim; nothing elsewhere).
-fn release_free_heap() {
+/// Return the heap's free memory to the system (glibc's malloc_trim; nothing elsewhere):
+/// the next run pays its page faults as a fresh process would.
+pub fn release_free_heap() {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     {
         // glibc's own function; no crate wraps it more simply than this declaration.

@@ -243,7 +243,11 @@ fn solve_one(req: &SolveRequest) -> anyhow::Result<()> {
         }
     };
     let floor_s = match req.floor {
-        true => Some(solve::floor_time(&case.problem, steps)?),
+        true => {
+            // Cold, as the solve was (see PeakMemory::start).
+            contact_rates::case::release_free_heap();
+            Some(solve::floor_time(&case.problem, steps)?)
+        }
         false => None,
     };
     let run = RunSummary::new(&case, req.settings.kind, &sol, floor_s, peak);
