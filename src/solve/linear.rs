@@ -60,7 +60,7 @@ impl SparseSystem {
     }
 
     /// LU factorization with partial pivoting of the matrix itself (any invertible matrix;
-    /// its symbolic analysis is done on first use). 3-7x the cost of the LDL^T: the fallback
+    /// its symbolic analysis is done on first use). 3-7x the cost of a Cholesky: the fallback
     /// for a tangent too far from symmetric for GMRES.
     pub fn factor_lu(&mut self) -> Result<()> {
         if self.symbolic_lu.is_none() {

@@ -149,7 +149,7 @@ pub struct StepReport {
 /// Where the time of a solve went (s), and the factorization count.
 #[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
 pub struct Timings {
-    /// Assembling internal forces, tangents and the KKT values.
+    /// Assembling internal forces and tangent stiffnesses.
     pub assembly_s: f64,
     /// Numeric factorizations (for `qp`, also Clarabel's solves).
     pub factor_s: f64,
