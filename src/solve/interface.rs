@@ -271,16 +271,6 @@ impl InterfaceFactorization {
         })
     }
 
-    /// Number of unknowns on the interface (b).
-    pub fn interface_len(&self) -> usize {
-        self.interface.len()
-    }
-
-    /// Stored entries of the factor L.
-    pub fn factor_entries(&self) -> usize {
-        self.supernodal().len_val()
-    }
-
     fn supernodal(&self) -> &SymbolicSupernodalCholesky<usize> {
         match self.symbolic.raw() {
             SymbolicCholeskyRaw::Supernodal(s) => s,
