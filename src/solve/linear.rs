@@ -88,11 +88,6 @@ impl SparseSystem {
         Ok(())
     }
 
-    /// Whether the last factorization is the LU of the matrix itself.
-    pub fn is_lu(&self) -> bool {
-        self.lu.is_some()
-    }
-
     /// Cholesky factorization (symmetric positive definite matrices; lower triangle read).
     pub fn factor_llt(&mut self) -> Result<()> {
         if self.symbolic_llt.is_none() {
@@ -123,22 +118,13 @@ impl SparseSystem {
 
     /// Solve with the last factorization, in place.
     pub fn solve(&self, rhs: &mut [f64]) {
-        self.solve_many(rhs, 1);
-    }
-}
-
-impl SparseSystem {
-    /// Solve with the last factorization for `k` right-hand sides stored column after
-    /// column in `rhs`, in place (one blocked solve: several times cheaper per column than
-    /// `k` single solves).
-    pub fn solve_many(&self, rhs: &mut [f64], k: usize) {
         use faer::linalg::solvers::Solve;
-        let n = rhs.len() / k;
-        self.solves.set(self.solves.get() + k);
+        self.solves.set(self.solves.get() + 1);
+        let rhs = faer::MatMut::from_column_major_slice_mut(rhs, rhs.len(), 1);
         if let Some(lu) = &self.lu {
-            lu.solve_in_place(faer::MatMut::from_column_major_slice_mut(rhs, n, k));
+            lu.solve_in_place(rhs);
         } else if let Some(llt) = &self.llt {
-            llt.solve_in_place(faer::MatMut::from_column_major_slice_mut(rhs, n, k));
+            llt.solve_in_place(rhs);
         } else {
             panic!("solve before factor");
         }
@@ -158,11 +144,6 @@ impl SparseSystem {
                 }
             }
         }
-    }
-
-    /// Whether a factorization is available.
-    pub fn is_factored(&self) -> bool {
-        self.llt.is_some() || self.lu.is_some()
     }
 }
 
