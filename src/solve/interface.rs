@@ -148,11 +148,6 @@ pub struct ActiveSet {
 }
 
 impl ActiveSet {
-    /// The active rows, in order.
-    pub fn rows(&self) -> &[usize] {
-        &self.rows
-    }
-
     /// The active set this system was built for.
     pub fn active(&self) -> &[bool] {
         &self.active
@@ -465,21 +460,9 @@ impl InterfaceFactorization {
     pub fn solve(&self, set: &ActiveSet, c: f64, v: &mut [f64]) {
         let n = self.n;
         let (f, g) = v.split_at_mut(n);
-        let mut condensed = self.condense(f);
-        // Inactive rows: y_i = g_i / c, its column moved to the right-hand side (on the
-        // interface only, where the condensed load equals the load).
-        for (i, row) in self.rows.iter().enumerate() {
-            if !set.active[i] {
-                for &(l, _, coef) in row {
-                    condensed.load[l] -= coef * g[i];
-                }
-                g[i] /= c;
-            }
-        }
-        let (x_interface, y_active) = self.interface_solve(set, &condensed.load, g);
-        for (&r, y) in set.rows.iter().zip(y_active) {
-            g[r] = y;
-        }
+        let condensed = self.condense(f);
+        let (x_interface, y) = self.interface_solve(set, c, &condensed.load, g);
+        g.copy_from_slice(&y);
         f.copy_from_slice(&self.expand(condensed, &x_interface));
     }
 
@@ -510,12 +493,16 @@ impl InterfaceFactorization {
         Condensed { y, load }
     }
 
-    /// The interface unknowns x_I (b) and the active rows' y (in the order of
-    /// `set`'s rows) of the saddle-point system `[S c C_A^T; c C_A 0] [x_I; y] = [load;
-    /// g_A]` (`g`: every row's right-hand side, m).
+    /// The interface part of the Newton system of `set` (see the module): the interface
+    /// unknowns x_I (b) and every row's y (m), from the condensed load `load` (b, see
+    /// [`Condensed`]) and the rows' right-hand sides `g` (m). An inactive row's y is
+    /// g_i / c and its column moves to the right-hand side, on the interface only (where
+    /// the condensed load equals the load); the rest is the saddle-point system
+    /// `[S c C_A^T; c C_A 0] [x_I; y_A] = [load; g_A]`.
     pub fn interface_solve(
         &self,
         set: &ActiveSet,
+        c: f64,
         load: &[f64],
         g: &[f64],
     ) -> (Vec<f64>, Vec<f64>) {
@@ -524,18 +511,22 @@ impl InterfaceFactorization {
         for (i, &l) in load.iter().enumerate() {
             rhs[(i, 0)] = l;
         }
+        let mut y: Vec<f64> = g.iter().map(|gi| gi / c).collect();
+        for (i, row) in self.rows.iter().enumerate() {
+            if !set.active[i] {
+                for &(l, _, coef) in row {
+                    rhs[(l, 0)] -= coef * g[i];
+                }
+            }
+        }
         for (k, &r) in set.rows.iter().enumerate() {
             rhs[(b + k, 0)] = self.row_scale[r] * g[r];
         }
         set.lu.solve_in_place_with_conj(Conj::No, rhs.as_mut());
-        let x = (0..b).map(|i| rhs[(i, 0)]).collect();
-        let y = set
-            .rows
-            .iter()
-            .enumerate()
-            .map(|(k, &r)| self.row_scale[r] * rhs[(b + k, 0)])
-            .collect();
-        (x, y)
+        for (k, &r) in set.rows.iter().enumerate() {
+            y[r] = self.row_scale[r] * rhs[(b + k, 0)];
+        }
+        ((0..b).map(|i| rhs[(i, 0)]).collect(), y)
     }
 
     /// The displacement (n) whose interface values are `x_interface`, from the forward
@@ -569,13 +560,6 @@ impl InterfaceFactorization {
             .iter()
             .map(|&(l, _, v)| v * x_interface[l])
             .sum()
-    }
-
-    /// `load -= coef C_i^T` on the interface.
-    pub fn subtract_row(&self, i: usize, coef: f64, load: &mut [f64]) {
-        for &(l, _, v) in &self.rows[i] {
-            load[l] -= coef * v;
-        }
     }
 
     /// The supernodes as (first column, width, off-diagonal row indices, values: the

@@ -549,15 +549,7 @@ impl Newton<'_> {
             let set = self.active_set.as_ref().expect("prepared");
             let factorization = &self.factorization;
             let g = self.right_hand_side_rows(ev, lambda, &active);
-            let mut load = condensed.load.clone();
-            for i in (0..m).filter(|&i| !active[i]) {
-                factorization.subtract_row(i, g[i], &mut load);
-            }
-            let (x_interface, y_active) = factorization.interface_solve(set, &load, &g);
-            let mut y: Vec<f64> = g.iter().map(|gi| gi / c).collect();
-            for (&r, v) in set.rows().iter().zip(y_active) {
-                y[r] = v;
-            }
+            let (x_interface, y) = factorization.interface_solve(set, c, &condensed.load, &g);
             let next: Vec<bool> = (0..m)
                 .map(|i| {
                     let gap = ev.gaps[i] + factorization.row_product(i, &x_interface);
