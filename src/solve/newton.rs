@@ -341,22 +341,24 @@ impl<'a> Newton<'a> {
         timed(&self.clock.solve, || {
             let product = |x: &[f64], y: &mut [f64]| self.kkt_product(active, x, y);
             let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-            let Some(x0) = x0 else {
-                let rhs0 = rhs.to_vec();
-                let its = gmres(&product, rhs, forcing, budget, &|v| self.precondition(v));
-                if its.is_none() {
-                    rhs.copy_from_slice(&rhs0);
+            // Solve for the correction of x0 (zero when there is none): A e = b - A x0, to
+            // the same |b|-relative tolerance.
+            let zero;
+            let (x0, mut residual) = match x0 {
+                Some(x0) => {
+                    let mut residual = vec![0.0; rhs.len()];
+                    product(x0, &mut residual);
+                    residual
+                        .iter_mut()
+                        .zip(&*rhs)
+                        .for_each(|(r, b)| *r = b - *r);
+                    (x0, residual)
                 }
-                return its;
+                None => {
+                    zero = vec![0.0; rhs.len()];
+                    (&zero[..], rhs.to_vec())
+                }
             };
-            // Solve for the correction of x0: A e = b - A x0, to the same |b|-relative
-            // tolerance.
-            let mut residual = vec![0.0; rhs.len()];
-            product(x0, &mut residual);
-            residual
-                .iter_mut()
-                .zip(&*rhs)
-                .for_each(|(r, b)| *r = b - *r);
             let (b_norm, r_norm) = (norm(rhs), norm(&residual));
             if r_norm <= forcing * b_norm {
                 rhs.copy_from_slice(x0);
