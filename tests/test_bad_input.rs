@@ -3,10 +3,9 @@
 //! or failing) stops the binary with one clear message naming the file, the field and the
 //! fix, a non-zero exit, no panic, and no half-written output.
 
+mod common;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-const BIN: &str = env!("CARGO_BIN_EXE_contact-rates");
+use std::process::Output;
 
 fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -25,15 +24,6 @@ fn scene_file(dir: &Path, edit: impl Fn(String) -> String) -> PathBuf {
     f
 }
 
-fn run(args: &[&str], envs: &[(&str, &str)]) -> Output {
-    let mut c = Command::new(BIN);
-    c.args(args);
-    for (k, v) in envs {
-        c.env(k, v);
-    }
-    c.output().unwrap()
-}
-
 /// Assert a clean failure whose message contains every one of `needles`.
 fn fails_with(out: &Output, needles: &[&str]) {
     let err = String::from_utf8_lossy(&out.stderr);
@@ -50,7 +40,7 @@ fn fails_with(out: &Output, needles: &[&str]) {
 }
 
 fn solve_scene(scene: &Path, out: &Path, envs: &[(&str, &str)]) -> Output {
-    run(
+    common::run(
         &[
             "solve",
             "--scene",
@@ -175,11 +165,11 @@ fn unknown_scene_method_solver_and_steps() {
     let o = dir.path().join("o");
     let o = o.to_str().unwrap();
     fails_with(
-        &run(&["solve", "--scene", "nosuch", "--out", o], &[]),
+        &common::run(&["solve", "--scene", "nosuch", "--out", o], &[]),
         &["no built-in scene named 'nosuch'", "patch", "rates"],
     );
     fails_with(
-        &run(
+        &common::run(
             &[
                 "solve", "--scene", "rates", "--method", "penalty", "--out", o,
             ],
@@ -188,14 +178,14 @@ fn unknown_scene_method_solver_and_steps() {
         &["--method", "mortar", "nts"],
     );
     fails_with(
-        &run(
+        &common::run(
             &["solve", "--scene", "rates", "--solver", "cg", "--out", o],
             &[],
         ),
         &["--solver", "newton, paper or qp"],
     );
     fails_with(
-        &run(
+        &common::run(
             &["solve", "--scene", "rates", "--steps", "0", "--out", o],
             &[],
         ),
@@ -360,7 +350,7 @@ fn study_file_errors_through_the_binary() {
     ];
     for (edit, needles) in cases {
         let f = study_file(dir.path(), edit);
-        let o = run(
+        let o = common::run(
             &["study", f.to_str().unwrap(), "--out", out.to_str().unwrap()],
             &[],
         );
@@ -368,7 +358,7 @@ fn study_file_errors_through_the_binary() {
         assert!(!out.exists(), "a failed study wrote a report");
     }
     fails_with(
-        &run(&["study", "nosuch"], &[]),
+        &common::run(&["study", "nosuch"], &[]),
         &["nosuch", "built-in studies", "rates-quick"],
     );
 }
@@ -381,7 +371,7 @@ fn reports_folder_that_cannot_be_written_fails_before_computing() {
     std::fs::write(&file, "x").unwrap();
     let bad = file.join("report");
     let t = std::time::Instant::now();
-    let o = run(
+    let o = common::run(
         &["study", "rates-quick", "--out", bad.to_str().unwrap()],
         &[],
     );
@@ -389,7 +379,7 @@ fn reports_folder_that_cannot_be_written_fails_before_computing() {
     // Checked up front: the study itself takes tens of seconds.
     assert!(t.elapsed().as_secs_f64() < 5.0);
     // An existing path that is a file.
-    let o = run(
+    let o = common::run(
         &["study", "rates-quick", "--out", file.to_str().unwrap()],
         &[],
     );
@@ -416,7 +406,7 @@ fn reports_folder_that_cannot_be_written_fails_before_computing() {
             target.to_str().unwrap(),
         ],
     ] {
-        fails_with(&run(&args, &[]), &["reports folder", "writable"]);
+        fails_with(&common::run(&args, &[]), &["reports folder", "writable"]);
     }
 }
 
@@ -436,7 +426,7 @@ fn failed_study_leaves_the_previous_report_intact() {
             &format!("scene = {:?}", scene.display().to_string()),
         )
     });
-    let o = run(
+    let o = common::run(
         &["study", f.to_str().unwrap(), "--out", out.to_str().unwrap()],
         &[],
     );

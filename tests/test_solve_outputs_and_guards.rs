@@ -6,18 +6,16 @@
 //! Geometry: meshes/two_blocks.geo; the `patch` scene (paper Test 2: the upper block is held
 //! vertically only by contact, pressure 10 t on top, viscoplastic) and the `rates` scene.
 
+mod common;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-const BIN: &str = env!("CARGO_BIN_EXE_contact-rates");
-
-fn run(args: &[&str], envs: &[(&str, &str)]) -> Output {
-    let mut c = Command::new(BIN);
-    c.args(args);
-    for (k, v) in envs {
-        c.env(k, v);
-    }
-    c.output().unwrap()
+/// `contact-rates solve --scene SCENE ARGS... --out OUT` with extra environment `envs`.
+fn solve(scene: &str, args: &[&str], out: &Path, envs: &[(&str, &str)]) -> Output {
+    let mut all = vec!["solve", "--scene", scene];
+    all.extend_from_slice(args);
+    all.extend(["--out", out.to_str().unwrap()]);
+    common::run(&all, envs)
 }
 
 /// A clean failure: exit 1, no panic, at most 3 lines, one of them the error, containing
@@ -65,20 +63,10 @@ fn solve_writes_contact_csv_and_a_paraview_time_series() {
     for method in ["mortar", "nts"] {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("out");
-        let o = run(
-            &[
-                "solve",
-                "--scene",
-                "patch",
-                "--method",
-                method,
-                "--level",
-                "1",
-                "--steps",
-                "4",
-                "--out",
-                out.to_str().unwrap(),
-            ],
+        let o = solve(
+            "patch",
+            &["--method", method, "--level", "1", "--steps", "4"],
+            &out,
             &[],
         );
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -178,20 +166,7 @@ fn solve_writes_contact_csv_and_a_paraview_time_series() {
 fn every_kth_step_and_the_last() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    let o = run(
-        &[
-            "solve",
-            "--scene",
-            "patch",
-            "--steps",
-            "5",
-            "--every",
-            "2",
-            "--out",
-            out.to_str().unwrap(),
-        ],
-        &[],
-    );
+    let o = solve("patch", &["--steps", "5", "--every", "2"], &out, &[]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let pvd = std::fs::read_to_string(out.join("solution.pvd")).unwrap();
     let files: Vec<&str> = pvd
@@ -222,18 +197,7 @@ fn sizes_that_are_not_finite_or_not_positive_are_refused_before_meshing() {
     ] {
         let dir = tempfile::tempdir().unwrap();
         let set = format!("h_upper={value}");
-        let o = run(
-            &[
-                "solve",
-                "--scene",
-                "rates",
-                "--set",
-                &set,
-                "--out",
-                dir.path().join("o").to_str().unwrap(),
-            ],
-            &[],
-        );
+        let o = solve("rates", &["--set", &set], &dir.path().join("o"), &[]);
         fails_short(&o, &["rates.toml", "parameter h_upper", needle]);
     }
 }
@@ -244,18 +208,7 @@ fn sizes_that_are_not_finite_or_not_positive_are_refused_before_meshing() {
 fn a_level_beyond_the_machines_memory_is_refused_with_the_largest_that_fits() {
     let dir = tempfile::tempdir().unwrap();
     let t = std::time::Instant::now();
-    let o = run(
-        &[
-            "solve",
-            "--scene",
-            "rates",
-            "--level",
-            "12",
-            "--out",
-            dir.path().join("o").to_str().unwrap(),
-        ],
-        &[],
-    );
+    let o = solve("rates", &["--level", "12"], &dir.path().join("o"), &[]);
     fails_short(
         &o,
         &[
@@ -294,14 +247,10 @@ fn gmsh_errors_are_summarised() {
     std::fs::set_permissions(&gmsh, std::fs::Permissions::from_mode(0o755)).unwrap();
     let path = format!("{}:/usr/bin:/bin", bin.display());
     let cache = dir.path().join("cache");
-    let o = run(
-        &[
-            "solve",
-            "--scene",
-            "rates",
-            "--out",
-            dir.path().join("o").to_str().unwrap(),
-        ],
+    let o = solve(
+        "rates",
+        &[],
+        &dir.path().join("o"),
         &[
             ("PATH", &path),
             ("CONTACT_RATES_CACHE", cache.to_str().unwrap()),
@@ -323,21 +272,8 @@ fn a_broken_cache_entry_heals_itself() {
     let dir = tempfile::tempdir().unwrap();
     let cache = dir.path().join("cache");
     let env = [("CONTACT_RATES_CACHE", cache.to_str().unwrap())];
-    let solve = |out: &Path| {
-        run(
-            &[
-                "solve",
-                "--scene",
-                "rates",
-                "--steps",
-                "1",
-                "--out",
-                out.to_str().unwrap(),
-            ],
-            &env,
-        )
-    };
-    let first = solve(&dir.path().join("a"));
+    let solve_one_step = |out: &Path| solve("rates", &["--steps", "1"], out, &env);
+    let first = solve_one_step(&dir.path().join("a"));
     assert!(
         first.status.success(),
         "{}",
@@ -352,7 +288,7 @@ fn a_broken_cache_entry_heals_itself() {
     assert_eq!(cached.len(), 1, "{cached:?}");
     let text = std::fs::read_to_string(&cached[0]).unwrap();
     std::fs::write(&cached[0], &text[..text.len() / 2]).unwrap();
-    let second = solve(&dir.path().join("b"));
+    let second = solve_one_step(&dir.path().join("b"));
     let err = String::from_utf8_lossy(&second.stderr);
     assert!(second.status.success(), "{err}");
     let warnings: Vec<&str> = err.lines().filter(|l| l.starts_with("warning")).collect();

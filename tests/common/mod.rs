@@ -4,6 +4,17 @@
 use contact_rates::case::Case;
 use contact_rates::contact::Method;
 use contact_rates::scene::Scene;
+use std::process::{Command, Output};
+
+/// Run the `contact-rates` binary with `args` and extra environment `envs`.
+pub fn run(args: &[&str], envs: &[(&str, &str)]) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_contact-rates"));
+    c.args(args);
+    for (k, v) in envs {
+        c.env(k, v);
+    }
+    c.output().unwrap()
+}
 
 /// Build a built-in scene at `level` with `method` and gmsh parameter overrides.
 pub fn case(scene: &str, level: usize, method: Method, params: &[(&str, f64)]) -> Case {
