@@ -59,10 +59,10 @@ pub struct InterfaceFactorization {
     /// Position of each equation in the elimination order.
     position: Vec<usize>,
     symbolic: SymbolicCholesky<usize>,
-    /// Pattern of the stiffness (lower triangle read) and the slots of the interface
-    /// unknowns' diagonal entries.
+    /// Pattern of the stiffness (lower triangle read) and the slots of its diagonal
+    /// entries, in equation order.
     pattern: SymbolicSparseColMat<usize>,
-    interface_diagonal: Vec<usize>,
+    diagonal: Vec<usize>,
     numeric: Option<Numeric>,
     /// Seconds in numeric work: sparse LDL^T, interface block, dense LUs.
     pub factor_s: Cell<f64>,
@@ -248,7 +248,7 @@ impl InterfaceFactorization {
             },
         )
         .map_err(|e| Error::NotConverged(format!("symbolic LDLT failed: {e:?}")))?;
-        let interface_diagonal = interface.iter().map(|&e| pattern.slot(e, e)).collect();
+        let diagonal = (0..n).map(|e| pattern.slot(e, e)).collect();
         Ok(InterfaceFactorization {
             n,
             interface,
@@ -257,7 +257,7 @@ impl InterfaceFactorization {
             position,
             symbolic,
             pattern: full,
-            interface_diagonal,
+            diagonal,
             numeric: None,
             factor_s: Cell::new(0.0),
             symbolic_s: t.elapsed().as_secs_f64(),
@@ -291,18 +291,17 @@ impl InterfaceFactorization {
         single_precision_solves: bool,
     ) -> Result<()> {
         let t = Instant::now();
-        for &s in &self.interface_diagonal {
-            values[s] += shift;
+        for &e in &self.interface {
+            values[self.diagonal[e]] += shift;
         }
         let pattern = self.pattern.as_ref();
-        let scaling: Vec<f64> = (0..self.n)
-            .map(|j| {
-                let d = values[pattern.col_ptr()[j]
-                    + pattern
-                        .row_idx_of_col(j)
-                        .position(|i| i == j)
-                        .expect("diagonal in pattern")];
-                if d > 0.0 { 1.0 / d.sqrt() } else { 1.0 }
+        let scaling: Vec<f64> = (self.diagonal.iter())
+            .map(|&s| {
+                if values[s] > 0.0 {
+                    1.0 / values[s].sqrt()
+                } else {
+                    1.0
+                }
             })
             .collect();
         for j in 0..self.n {
