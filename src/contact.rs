@@ -161,6 +161,30 @@ fn chains(edges: &[[usize; 2]], what: &str, file: &std::path::Path) -> Result<Ve
 }
 
 impl Interface {
+    /// Whether equilibrium fixes the total contact force normal to Gamma_C: Gamma_C is
+    /// straight (every piece has the same normal) and one body's rigid translation along
+    /// that normal is held by no clamp or roller, so only the contact holds it there and
+    /// the contact resultant equals that body's load resultant along the normal, in the
+    /// discrete problem as in the exact one, in both cones. Its error then measures the
+    /// load's quadrature, not the contact discretization.
+    pub fn resultant_fixed_by_equilibrium(&self, model: &Model) -> bool {
+        let Some(first) = self.pieces.first() else {
+            return false;
+        };
+        let n = first.normal;
+        let straight = self
+            .pieces
+            .iter()
+            .all(|p| (p.normal[0] - n[0]).abs() + (p.normal[1] - n[1]).abs() <= 1e-12);
+        let free_along_normal = |b: usize| {
+            let nodes = model.node_offset[b]..model.node_offset[b] + model.meshes[b].nodes.len();
+            nodes
+                .into_iter()
+                .all(|g| (0..2).all(|c| model.equation[2 * g + c] != FIXED || n[c].abs() <= 1e-12))
+        };
+        straight && (free_along_normal(0) || free_along_normal(1))
+    }
+
     /// Build Gamma_C from the scene's slave and master curves.
     pub fn new(model: &Model, raw: &RawMesh) -> Result<Self> {
         let file = &model.mesh_file;

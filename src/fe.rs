@@ -3,8 +3,10 @@
 //! loads from tractions and body forces, and assembly of internal force and tangent.
 
 use crate::error::{Error, Result};
+use crate::expr::{Expr, distinct_kinks, kink_functions};
 use crate::material::{Material, Strain, Stress};
 use crate::mesh::{BodyMesh, RawMesh};
+use crate::quadrature;
 use crate::scene::Scene;
 use nalgebra::{Matrix3, SMatrix, SVector};
 use std::path::Path;
@@ -414,27 +416,42 @@ impl Model {
         (pattern, slots)
     }
 
-    /// External load vector F(t) over global dofs: tractions (4-point Gauss per edge) and
-    /// body forces (6-point degree-4 rule per triangle).
+    /// External load vector at time `t` over global dofs (force): tractions on their edges
+    /// (8 Gauss-Legendre points, exact to degree 15) and body forces on the triangles
+    /// ([`quadrature::dunavant8`], degree 8). Where a load expression changes branch (an `abs`) inside an element,
+    /// the element is split along the branch's zero line and the rule applied on each piece
+    /// ([`quadrature::triangle_rule`], [`quadrature::segment_rule`]): the load of a
+    /// manufactured field is then as exact on a kinked element as on a smooth one (for an
+    /// affine branch argument; see [`quadrature::split_triangle`] otherwise).
     pub fn load(&self, t: f64) -> Result<Vec<f64>> {
         let mut f = vec![0.0; 2 * self.n_nodes];
-        const GX: [f64; 4] = [
-            -0.861_136_311_594_052_6,
-            -0.339_981_043_584_856_3,
-            0.339_981_043_584_856_3,
-            0.861_136_311_594_052_6,
-        ];
-        const GW: [f64; 4] = [
-            0.347_854_845_137_453_9,
-            0.652_145_154_862_546_1,
-            0.652_145_154_862_546_1,
-            0.347_854_845_137_453_9,
-        ];
+        let (segment, triangle) = (quadrature::gauss_legendre(8), quadrature::dunavant8());
+        let exact = self.scene.exact.as_deref();
+        // The kinks of each traction's expressions (a derived traction: the body's stress).
+        let traction_kinks: Vec<Vec<&Expr>> = self
+            .scene
+            .tractions
+            .iter()
+            .map(|tr| match &tr.g {
+                Some(g) => distinct_kinks(&g.0),
+                None => Vec::new(),
+            })
+            .collect();
+        let stress_kinks: [Vec<&Expr>; 2] =
+            [0, 1].map(|b| match exact.and_then(|e| e.stress.as_ref()) {
+                Some(st) => distinct_kinks(&st[b]),
+                None => Vec::new(),
+            });
         for (e, &(i, [a, b])) in self.traction_edges.iter().enumerate() {
             let (pa, pb) = (self.position(a), self.position(b));
             let len = (pb[0] - pa[0]).hypot(pb[1] - pa[1]);
-            for q in 0..4 {
-                let s = 0.5 * (1.0 + GX[q]);
+            let kinks = match &self.scene.tractions[i].g {
+                Some(_) => &traction_kinks[i],
+                None => &stress_kinks[self.traction_normals[e].0],
+            };
+            let functions = kink_functions(kinks, t);
+            let refs: Vec<&quadrature::Kink> = functions.iter().map(|k| k.as_ref()).collect();
+            for &(s, w) in quadrature::segment_rule(pa, pb, &refs, &segment).iter() {
                 let x = pa[0] + s * (pb[0] - pa[0]);
                 let y = pa[1] + s * (pb[1] - pa[1]);
                 let field = || format!("traction '{}'.g", self.scene.tractions[i].curve);
@@ -442,65 +459,32 @@ impl Model {
                     Some(g) => g.eval(x, y, t, &self.scene.file, &field())?,
                     None => self.derived_traction(e, x, y, t, &field())?,
                 };
-                let w = 0.5 * GW[q] * len;
+                let w = w * len;
                 for c in 0..2 {
                     f[2 * a + c] += w * (1.0 - s) * g[c];
                     f[2 * b + c] += w * s * g[c];
                 }
             }
         }
-        // Dunavant degree-4 rule (6 points).
-        const TRI: [(f64, f64, f64); 6] = [
-            (
-                0.445_948_490_915_965,
-                0.445_948_490_915_965,
-                0.223_381_589_678_011,
-            ),
-            (
-                0.445_948_490_915_965,
-                0.108_103_018_168_070,
-                0.223_381_589_678_011,
-            ),
-            (
-                0.108_103_018_168_070,
-                0.445_948_490_915_965,
-                0.223_381_589_678_011,
-            ),
-            (
-                0.091_576_213_509_771,
-                0.091_576_213_509_771,
-                0.109_951_743_655_322,
-            ),
-            (
-                0.091_576_213_509_771,
-                0.816_847_572_980_459,
-                0.109_951_743_655_322,
-            ),
-            (
-                0.816_847_572_980_459,
-                0.091_576_213_509_771,
-                0.109_951_743_655_322,
-            ),
-        ];
-        for e in &self.elements {
-            let Some(bf) = &self.scene.bodies[e.body].body_force else {
+        for body in 0..2 {
+            let Some(bf) = &self.scene.bodies[body].body_force else {
                 continue;
             };
-            let p = e.nodes.map(|n| self.position(n));
-            for &(l1, l2, w) in &TRI {
-                let lam = [1.0 - l1 - l2, l1, l2];
-                let x = lam[0] * p[0][0] + lam[1] * p[1][0] + lam[2] * p[2][0];
-                let y = lam[0] * p[0][1] + lam[1] * p[1][1] + lam[2] * p[2][1];
-                let v = bf.eval(
-                    x,
-                    y,
-                    t,
-                    &self.scene.file,
-                    &format!("bodies '{}'.body_force", self.scene.bodies[e.body].surface),
-                )?;
-                for a in 0..3 {
-                    for c in 0..2 {
-                        f[2 * e.nodes[a] + c] += w * e.area * lam[a] * v[c];
+            let kinks = distinct_kinks(&bf.0);
+            let functions = kink_functions(&kinks, t);
+            let refs: Vec<&quadrature::Kink> = functions.iter().map(|k| k.as_ref()).collect();
+            let field = format!("bodies '{}'.body_force", self.scene.bodies[body].surface);
+            for e in self.elements.iter().filter(|e| e.body == body) {
+                let p = e.nodes.map(|n| self.position(n));
+                for &(l1, l2, w) in quadrature::triangle_rule(p, &refs, &triangle).iter() {
+                    let lam = [1.0 - l1 - l2, l1, l2];
+                    let x = lam[0] * p[0][0] + lam[1] * p[1][0] + lam[2] * p[2][0];
+                    let y = lam[0] * p[0][1] + lam[1] * p[1][1] + lam[2] * p[2][1];
+                    let v = bf.eval(x, y, t, &self.scene.file, &field)?;
+                    for a in 0..3 {
+                        for c in 0..2 {
+                            f[2 * e.nodes[a] + c] += w * e.area * lam[a] * v[c];
+                        }
                     }
                 }
             }

@@ -83,24 +83,20 @@ fn collapsed_rule_converges_on_a_smooth_integrand() {
 }
 
 #[test]
-fn composite_rule_is_exact_on_polynomials_and_converges_across_a_kink() {
-    use contact_rates::quadrature::triangle_composite;
-    let rule = triangle_composite(3, 4);
-    assert!((rule.iter().map(|p| p.2).sum::<f64>() - 1.0).abs() < 1e-14);
-    // x^2 y^2 over the reference triangle: 2! 2! / 6! = 1/180.
-    let q: f64 = rule.iter().map(|&(x, y, w)| 0.5 * w * x * x * y * y).sum();
-    assert!((q - 1.0 / 180.0).abs() < 1e-15, "{q}");
-    // |x - a| has a kink inside: int over the triangle = int_0^1 |x - a| (1 - x) dx
-    // = a^2/2 - a^3/6 + (1 - a)^3/6.
-    let a: f64 = 1.0 / 3.0;
-    let exact = (a * a / 2.0 - a * a * a / 6.0) + ((1.0 - a).powi(3) / 6.0);
-    let integral = |m: usize| -> f64 {
-        triangle_composite(4, m)
-            .iter()
-            .map(|&(x, _, w)| 0.5 * w * (x - a).abs())
-            .sum()
-    };
-    let (e1, e8) = ((integral(1) - exact).abs(), (integral(8) - exact).abs());
-    println!("kinked integrand: error {e1:.2e} on one triangle, {e8:.2e} on 8 x 8 sub-triangles");
-    assert!(e8 < e1 / 10.0, "{e1} {e8}");
+fn dunavant_degree_8_rule_is_exact_on_every_monomial_of_degree_8() {
+    // int over the reference triangle of x^i y^j = i! j! / (i + j + 2)!.
+    use contact_rates::quadrature::dunavant8;
+    let rule = dunavant8();
+    assert_eq!(rule.len(), 16);
+    let fact = |n: u32| (1..=n).map(f64::from).product::<f64>();
+    for i in 0..=8u32 {
+        for j in 0..=(8 - i) {
+            let exact = fact(i) * fact(j) / fact(i + j + 2);
+            let q: f64 = rule
+                .iter()
+                .map(|&(x, y, w)| 0.5 * w * x.powi(i as i32) * y.powi(j as i32))
+                .sum();
+            assert!((q - exact).abs() <= 1e-14 * exact.max(1e-3), "x^{i} y^{j}: {q} vs {exact}");
+        }
+    }
 }

@@ -119,18 +119,35 @@ impl Exact {
         }
     }
 
-    /// Which branches of the piecewise (abs) expressions of body `b` the point is on: where
-    /// two points differ, a kink of the exact fields lies between them.
-    pub fn branch(&self, b: usize, x: f64, y: f64, t: f64) -> u64 {
-        let mut bits = 0u64;
-        let mut mix = |e: &Expr| bits = bits.rotate_left(7) ^ e.branch(x, y, t);
+    /// The distinct kinks ([`Expr::kinks`]) of body `b`'s exact fields: where one changes
+    /// sign inside a triangle, the integrands of the errors are smooth only piecewise.
+    pub fn kinks(&self, b: usize) -> Vec<&Expr> {
+        let mut fields: Vec<&Expr> = Vec::new();
         if let Some(u) = &self.displacement {
-            u[b].iter().for_each(&mut mix);
+            fields.extend(u[b].iter());
+        }
+        if let Some(g) = &self.gradient {
+            fields.extend(g[b].iter().flatten());
         }
         if let Some(s) = &self.stress {
-            s[b].iter().for_each(&mut mix);
+            fields.extend(s[b].iter());
         }
-        bits
+        crate::expr::distinct_kinks(fields)
+    }
+
+    /// The distinct kinks of the exact pressure on Gamma_C (the given pressure, or the
+    /// slave's stress it follows from), and of the gap (both displacements).
+    pub fn contact_kinks(&self) -> Vec<&Expr> {
+        let mut fields: Vec<&Expr> = Vec::new();
+        match (&self.pressure, &self.stress) {
+            (Some(p), _) => fields.push(p),
+            (None, Some(s)) => fields.extend(s[0].iter()),
+            (None, None) => {}
+        }
+        if let Some(u) = &self.displacement {
+            fields.extend(u.iter().flatten());
+        }
+        crate::expr::distinct_kinks(fields)
     }
 
     /// Stress of body `b` at (x, y, t) as [s11, s22, s12].

@@ -44,9 +44,23 @@ struct RateCsv {
     rate_dofs: Option<f64>,
     /// Successive rates, space separated ("-" next to a level at round-off).
     successive: String,
-    /// What the errors support: fitted, pre-asymptotic, too few levels, not converging,
-    /// round-off.
+    /// What the errors support: fitted, drifting, pre-asymptotic, too few levels, not
+    /// converging, round-off, fixed by equilibrium.
     verdict: &'static str,
+    /// The fit over every usable level (what the window is compared with).
+    #[serde(serialize_with = "crate::io::finite_or_empty")]
+    rate_all_levels: f64,
+    /// Celik et al. 2008 on the last three usable levels: observed order,
+    #[serde(serialize_with = "crate::io::finite_or_empty")]
+    observed_order: f64,
+    /// whether the convergence oscillates (eps32 / eps21 < 0),
+    oscillatory: Option<bool>,
+    /// the GCI of the finest level (units of the error),
+    #[serde(serialize_with = "crate::io::finite_or_empty")]
+    gci_fine: f64,
+    /// and GCI_coarse / (r^p GCI_fine) at the reported rate (1 in the asymptotic range).
+    #[serde(serialize_with = "crate::io::finite_or_empty")]
+    asymptotic_ratio: f64,
 }
 
 impl RateCsv {
@@ -62,6 +76,11 @@ impl RateCsv {
             rate_dofs: r.rate_dofs(),
             successive: successive(r),
             verdict: r.assessment.verdict.name(),
+            rate_all_levels: r.assessment.fit_all.map_or(f64::NAN, |f| f.rate),
+            observed_order: r.assessment.celik.map_or(f64::NAN, |c| c.order),
+            oscillatory: r.assessment.celik.map(|c| c.oscillatory),
+            gci_fine: r.assessment.celik.map_or(f64::NAN, |c| c.gci_fine),
+            asymptotic_ratio: r.assessment.asymptotic_ratio.unwrap_or(f64::NAN),
         }
     }
 }
@@ -84,16 +103,37 @@ fn threshold_text(t: Threshold, digits: usize) -> String {
 }
 
 fn fmt_rate(r: &RateRow) -> String {
-    match (r.assessment.verdict, r.assessment.fit) {
+    let a = &r.assessment;
+    match (a.verdict, a.fit) {
         (Verdict::Fitted, Some(f)) => format!("{:.3} ± {:.3}", f.rate, f.stderr),
+        (Verdict::Drifting, Some(f)) => format!(
+            "{:.3} ± {:.3} (drifting: {} over every level)",
+            f.rate,
+            f.stderr,
+            fmt3(a.fit_all.map_or(f64::NAN, |f| f.rate))
+        ),
         (Verdict::PreAsymptotic, Some(f)) => {
             format!("{:.3} ± {:.3} (pre-asymptotic)", f.rate, f.stderr)
         }
         (Verdict::RoundOff, _) => format!("exact (round-off, <= {:.0e})", rates::ROUNDOFF),
         (Verdict::NotConverging, _) => "**does not converge**".into(),
         (Verdict::TooFewLevels, _) => format!("no fit (< {} levels)", rates::MIN_FIT_LEVELS),
+        (Verdict::FixedByEquilibrium, _) => {
+            "fixed by equilibrium: measures the load quadrature".into()
+        }
         _ => "n/a".into(),
     }
+}
+
+/// Celik's observed order of the last three levels, "(oscillatory)" where it oscillates.
+fn fmt_order(r: &RateRow) -> String {
+    r.assessment.celik.map_or("-".into(), |c| {
+        format!(
+            "{:.3}{}",
+            c.order,
+            if c.oscillatory { " (oscillatory)" } else { "" }
+        )
+    })
 }
 
 /// Write the report of a study into `dir` (normally reports/NAME).
@@ -355,22 +395,29 @@ fn readme(res: &StudyResult) -> String {
     let _ = writeln!(s, "![error against h](error_vs_h.png)\n");
     let _ = writeln!(
         s,
-        "## Rates\n\nLeast-squares slope of log(error) against log(h) over the levels used (± standard error), rate against dofs, and successive rates between neighbouring levels. A rate never overstates: errors at round-off (<= 1e-10, the solvers' tolerance) are marked and never fitted (their successive rates are `-`), levels within 5x of the truth's own error in that quantity are left out, a rate needs at least 3 levels, a rate whose last two successive rates differ by more than 0.25 is flagged pre-asymptotic, and a quantity whose last two successive rates average below 0.15 is called non-converging and given no slope. The `theorem` quantity is max_n (||u - u_ref||_H1 + ||sigma - sigma_ref||_L2) over both bodies, relative to the reference's; Theorem 3.1 predicts h^(3/4) for mortar (K_h^pi) and h^(1/2) for nts (K_h^I).\n"
+        "## Rates\n\nLeast-squares slope of log(error) against log(h) over the levels used (± standard error), rate against dofs, and successive rates between neighbouring levels. A rate never overstates: errors at round-off (<= 1e-10, the solvers' tolerance) are marked and never fitted (their successive rates are `-`), levels within 5x of the truth's own error in that quantity are left out, a rate needs at least 3 levels, and a quantity whose last two successive rates average below 0.15 is called non-converging and given no slope. The levels used are the longest trailing window (at least 3 levels) whose successive rates lie within 0.25 of each other; where even the last two differ by more, the fit over every level is shown, flagged pre-asymptotic. A window's rate that differs from the fit over every level, or from the mean of the last two successive rates, by more than max(0.15, 2 standard errors) is called drifting (the rate is still changing; the all-level fit is given beside it). A contact resultant fixed by equilibrium is named so and never fitted. Beside the fit, the conventions of ASME V&V 20 (Celik et al. 2008, J. Fluids Eng. 130, 078001) on the last three levels: the observed order p (non-uniform ratio, fixed-point iteration), oscillatory convergence named, the GCI of the finest level (safety factor 1.25 at the observed order, in the units of the error) and the asymptotic ratio GCI_coarse / (r^p GCI_fine) at the rate in h printed (1 where that rate describes the last three levels; at the observed order it would be 1 by construction). The `theorem` quantity is max_n (||u - u_ref||_H1 + ||sigma - sigma_ref||_L2) over both bodies, relative to the reference's; Theorem 3.1 predicts h^(3/4) for mortar (K_h^pi) and h^(1/2) for nts (K_h^I).\n"
     );
     let _ = writeln!(
         s,
-        "| method | quantity | rate in h | levels used | rate in dofs | successive | threshold | pass |\n|---|---|---|---|---|---|---|---|"
+        "| method | quantity | rate in h | levels used | rate in dofs | successive | observed order (last 3) | GCI fine | GCI ratio | threshold | pass |\n|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for r in &res.rates {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             r.method,
             r.quantity,
             fmt_rate(r),
             join(&r.assessment.used),
             fmt3(r.rate_dofs().unwrap_or(f64::NAN)),
             successive(r),
+            fmt_order(r),
+            r.assessment
+                .celik
+                .map_or("-".into(), |c| format!("{:.2e}", c.gci_fine)),
+            r.assessment
+                .asymptotic_ratio
+                .map_or("-".into(), |v| format!("{v:.3}")),
             r.threshold
                 .map(|t| threshold_text(t, 2))
                 .unwrap_or_default(),
@@ -598,16 +645,29 @@ fn contact_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
 fn verdict_text(r: &RateRow) -> String {
     match (r.assessment.verdict, r.assessment.fit) {
         (Verdict::Fitted, Some(f)) => format!("{:.2}", f.rate),
+        (Verdict::Drifting, Some(f)) => format!("{:.2} (drifting)", f.rate),
         (Verdict::PreAsymptotic, Some(f)) => format!("{:.2} (pre-asymptotic)", f.rate),
         (Verdict::RoundOff, _) => "exact".into(),
         (Verdict::NotConverging, _) => "does not converge".into(),
+        (Verdict::FixedByEquilibrium, _) => "fixed by equilibrium".into(),
         _ => "no fit".into(),
     }
 }
 
+/// Whether a verdict says what the errors do plainly enough to compare the cones on it:
+/// a fitted or drifting rate, exact, or not converging. Pre-asymptotic rates, tables too
+/// short to fit and quantities fixed by equilibrium are not compared.
+fn comparable(v: Verdict) -> bool {
+    matches!(
+        v,
+        Verdict::Fitted | Verdict::Drifting | Verdict::RoundOff | Verdict::NotConverging
+    )
+}
+
 /// The report's lead: what separates the cones, quantity by quantity, contact quantities
 /// first: the error at the finest level and the rate (or why there is none) of each cone,
-/// and a sentence per quantity.
+/// and a sentence per quantity; only quantities whose verdicts are [`comparable`] in every
+/// cone, the others named below the table with the reason.
 fn cones_compared(s: &mut String, res: &StudyResult) {
     let finest = *res.file.mesh.levels.last().expect("levels");
     let against = if res.reference.is_some() {
@@ -615,20 +675,43 @@ fn cones_compared(s: &mut String, res: &StudyResult) {
     } else {
         "the exact solution"
     };
-    let mut quantities: Vec<Quantity> = res
+    let rate_of =
+        |m: Method, q: Quantity| res.rates.iter().find(|r| r.method == m && r.quantity == q);
+    let compared = |q: Quantity| {
+        res.file
+            .methods
+            .iter()
+            .all(|&m| rate_of(m, q).is_some_and(|r| comparable(r.assessment.verdict)))
+    };
+    let ordered: Vec<Quantity> = res
         .file
         .quantities
         .iter()
         .copied()
         .filter(|q| q.is_contact())
+        .chain(
+            res.file
+                .quantities
+                .iter()
+                .copied()
+                .filter(|q| !q.is_contact()),
+        )
         .collect();
-    quantities.extend(
-        res.file
-            .quantities
-            .iter()
-            .copied()
-            .filter(|q| !q.is_contact()),
-    );
+    let quantities: Vec<Quantity> = ordered.iter().copied().filter(|&q| compared(q)).collect();
+    let left_out: Vec<String> = ordered
+        .iter()
+        .copied()
+        .filter(|&q| !compared(q))
+        .map(|q| {
+            let why: Vec<String> = res
+                .file
+                .methods
+                .iter()
+                .filter_map(|&m| rate_of(m, q).map(|r| format!("{m}: {}", fmt_rate(r))))
+                .collect();
+            format!("{q} ({})", why.join("; "))
+        })
+        .collect();
     let _ = writeln!(
         s,
         "## What separates the cones\n\nEvery quantity against {against}, the contact quantities (on Gamma_C and in the band of triangles touching it) first: the error at level {finest} and the rate in h of each cone.\n\n![contact quantities against h](contact_vs_h.png)\n\n| quantity | where | {} |\n|---|---|{}",
@@ -663,6 +746,13 @@ fn cones_compared(s: &mut String, res: &StudyResult) {
             .collect();
         let place = if q.is_contact() { "contact" } else { "bulk" };
         let _ = writeln!(s, "| {q} | {place} | {} |", cells.join(" | "));
+    }
+    if !left_out.is_empty() {
+        let _ = writeln!(
+            s,
+            "\nNot compared (no rate the numbers support in some cone, or a quantity that does not measure the cones): {}.",
+            left_out.join(", ")
+        );
     }
     if res.file.methods.len() == 2 {
         let _ = writeln!(s);

@@ -131,11 +131,23 @@ impl TruthPressure<'_> {
         }
     }
 
-    /// Breakpoints of the truth on a piece (none for a smooth exact pressure).
-    fn breakpoints(&self, piece_index: usize) -> Vec<f64> {
+    /// Breakpoints of the truth on a piece (arc length): a reference's nodes, or where a
+    /// kink of the exact pressure or gap crosses the piece (none for a smooth one), so the
+    /// integrals run on smooth pieces ([`crate::quadrature::segment_breaks`]).
+    fn breakpoints(&self, piece_index: usize, piece: &Piece) -> Vec<f64> {
         match self {
             TruthPressure::Profile(f, _) => f[piece_index].iter().map(|p| p.0).collect(),
-            TruthPressure::Exact(..) => Vec::new(),
+            TruthPressure::Exact(ex, t) => {
+                let kinks = ex.contact_kinks();
+                let functions = crate::expr::kink_functions(&kinks, *t);
+                let refs: Vec<&crate::quadrature::Kink> =
+                    functions.iter().map(|k| k.as_ref()).collect();
+                let (a, b) = (piece.point(0.0), piece.point(piece.length));
+                crate::quadrature::segment_breaks(a, b, &refs)
+                    .into_iter()
+                    .map(|r| r * piece.length)
+                    .collect()
+            }
         }
     }
 
@@ -218,7 +230,11 @@ pub fn contact_step(p: &Problem, s: &State, truth: &TruthPressure) -> ContactSte
             .map(|&(x, v)| (on_piece(piece, x).0, v))
             .collect();
         let nodes: Vec<f64> = ph.iter().map(|q| q.0).collect();
-        let mut br: Vec<f64> = nodes.iter().copied().chain(truth.breakpoints(i)).collect();
+        let mut br: Vec<f64> = nodes
+            .iter()
+            .copied()
+            .chain(truth.breakpoints(i, piece))
+            .collect();
         br.sort_by(f64::total_cmp);
         br.dedup_by(|a, b| (*a - *b).abs() <= 1e-14 * piece.length);
         for w in br.windows(2) {

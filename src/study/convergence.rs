@@ -20,7 +20,7 @@ use super::exact_error::{
 use super::file::{StudyFile, Threshold};
 use super::jobs::{self, Job, JobId, Mode, Solved};
 use super::quantity::{Differences, Quantity};
-use super::rates::{self, Assessment, Fit, LevelError};
+use super::rates::{self, Assessment, Fit, LevelError, Verdict};
 use crate::analytical::{Exact, Field};
 use crate::case::Case;
 use crate::contact::Method;
@@ -616,6 +616,9 @@ struct Measured {
     /// The mesh provenance and scene warnings of the first level.
     mesh: Option<crate::mesh::gmsh::GeneratedMesh>,
     warnings: Vec<String>,
+    /// Whether equilibrium fixes the contact resultant (first level's interface and
+    /// constraints; the same on every level of a family).
+    resultant_fixed: bool,
 }
 
 /// Step 3: every level of every cone against the truth (levels in parallel: each is
@@ -644,6 +647,10 @@ fn measure_levels(
     if let Some((_, _, case, _)) = runs.first() {
         out.mesh = Some(case.mesh.clone());
         out.warnings = case.warnings.clone();
+        out.resultant_fixed = case
+            .problem
+            .interface
+            .resultant_fixed_by_equilibrium(&case.problem.model);
     }
     let magnification = match truth {
         Truth::Solved(reference) => {
@@ -729,9 +736,11 @@ pub struct Variant {
 /// Step 3b: the variant families, measured against the same truth.
 fn measure_variants(
     sf: &StudyFile,
+    path: &Path,
     plan: &Plan,
     solved: &mut Solved,
     truth: &Truth,
+    resultant_fixed: bool,
 ) -> Result<Vec<Variant>> {
     let mut out = Vec::new();
     for (coarsest, runs) in &plan.variants {
@@ -750,7 +759,7 @@ fn measure_variants(
         for ((method, case, sol), e) in taken.iter().zip(&all_errors) {
             errors.extend(error_rows(sf, *method, case, sol, e)?);
         }
-        let rates = fit_rates(sf, &errors, truth);
+        let rates = fit_rates(sf, path, &errors, truth, resultant_fixed)?;
         out.push(Variant {
             coarsest: *coarsest,
             errors,
@@ -938,8 +947,17 @@ fn deformed(case: &Case, sol: &Solution, method: Method, magnification: f64) -> 
 
 /// Step 4: every quantity of every cone judged over its levels ([`rates::assess`]: no rate
 /// on round-off, on levels within 5x of the truth's own error in that quantity, on fewer
-/// than three levels, or for a quantity that stops converging), and the thresholds.
-fn fit_rates(sf: &StudyFile, errors: &[ErrorRow], truth: &Truth) -> Vec<RateRow> {
+/// than three levels, or for a quantity that stops converging; a rate over the trailing
+/// window of agreeing successive rates, drifting where it disagrees with the others), and
+/// the thresholds. Where equilibrium fixes the contact resultant (`resultant_fixed`), its
+/// error measures the load quadrature: it is named so and never fitted.
+fn fit_rates(
+    sf: &StudyFile,
+    path: &Path,
+    errors: &[ErrorRow],
+    truth: &Truth,
+    resultant_fixed: bool,
+) -> Result<Vec<RateRow>> {
     let mut out = Vec::new();
     for &method in &sf.methods {
         let threshold = sf.thresholds.of(method);
@@ -957,7 +975,14 @@ fn fit_rates(sf: &StudyFile, errors: &[ErrorRow], truth: &Truth) -> Vec<RateRow>
                     error: r.error,
                 })
                 .collect();
-            let a = rates::assess(&levels, truth.quantity_error(quantity));
+            let mut a = rates::assess(&levels, truth.quantity_error(quantity)).map_err(|e| {
+                Error::input(path, "mesh.levels", format!("{method} {quantity}: {e}"))
+            })?;
+            if quantity == Quantity::PressureResultant && resultant_fixed {
+                a.verdict = Verdict::FixedByEquilibrium;
+                (a.fit, a.fit_dofs, a.fit_all, a.celik, a.asymptotic_ratio) = (None, None, None, None, None);
+                a.used.clear();
+            }
             let threshold = (quantity == sf.thresholds.quantity).then_some(threshold);
             let pass = threshold.map(|t| match t {
                 Threshold::Exact(bound) => {
@@ -976,7 +1001,7 @@ fn fit_rates(sf: &StudyFile, errors: &[ErrorRow], truth: &Truth) -> Vec<RateRow>
             });
         }
     }
-    out
+    Ok(out)
 }
 
 /// Step 5: the rate in time on a fixed mesh, each run against the reference in time at the
@@ -1079,8 +1104,21 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
     };
     let profile_level = sf.mesh.levels[sf.mesh.levels.len() / 2];
     let measured = measure_levels(sf, &plan, &mut solved, &truth, profile_level)?;
-    let rates = fit_rates(sf, &measured.errors, &truth);
-    let variants = measure_variants(sf, &plan, &mut solved, &truth)?;
+    let rates = fit_rates(
+        sf,
+        &study.path,
+        &measured.errors,
+        &truth,
+        measured.resultant_fixed,
+    )?;
+    let variants = measure_variants(
+        sf,
+        &study.path,
+        &plan,
+        &mut solved,
+        &truth,
+        measured.resultant_fixed,
+    )?;
     let time_study = time_study(sf, &plan, &mut solved);
     let (reference, exact_quadrature, mesh, warnings) = match &truth {
         Truth::Solved(r) => (

@@ -1,24 +1,25 @@
 //! Errors of a study solution against a scene's exact solution, integrated on the study's
 //! own mesh by a collapsed Gauss rule per triangle (n x n points, exact to degree 2n - 2)
-//! and Gauss-Legendre on Gamma_C's segments: the exact fields are not polynomials, so the
-//! rule is chosen with its own error far below the errors measured (a test doubles it).
+//! and Gauss-Legendre on Gamma_C's segments (2n points, degree 4n - 1): the exact fields are
+//! not polynomials, so the rule is chosen with its own error far below the errors measured
+//! (a test doubles it). A triangle or segment that a kink of the exact fields crosses (an
+//! `abs` changing branch) is split along it and the rule applied on each piece, as the
+//! loads are ([`crate::quadrature::triangle_rule`]): one implementation for both.
 
 use super::error::{SquaredNorms, pressure_profile};
 use crate::analytical::Exact;
+use crate::expr::kink_functions;
 use crate::fe::Model;
 use crate::quadrature;
 use crate::solve::{Problem, State};
 
 /// Gauss points per direction of the default rule (16 points per triangle, degree 6).
-pub const DEFAULT_POINTS: usize = 4;
+pub const DEFAULT_POINTS: usize = quadrature::DEFAULT_POINTS;
 
 /// An exact solution with the quadrature that measures against it.
 pub struct ExactComparison<'a> {
     exact: &'a Exact,
     triangle: Vec<(f64, f64, f64)>,
-    /// The same rule on 8 x 8 sub-triangles, for the triangles a kink of the exact fields
-    /// (a branch change of an `abs`) crosses: there the integrand is smooth only piecewise.
-    kinked: Vec<(f64, f64, f64)>,
     segment: Vec<(f64, f64)>,
 }
 
@@ -48,7 +49,6 @@ impl<'a> ExactComparison<'a> {
         ExactComparison {
             exact,
             triangle: quadrature::triangle(points),
-            kinked: quadrature::triangle_composite(points, 8),
             segment: quadrature::gauss_legendre(2 * points),
         }
     }
@@ -61,6 +61,10 @@ impl<'a> ExactComparison<'a> {
             ..Default::default()
         };
         let band = super::contact_error::band(p);
+        let kinks = [0, 1].map(|b| ex.kinks(b));
+        let functions = [0, 1].map(|b| kink_functions(&kinks[b], t));
+        let refs: [Vec<&quadrature::Kink>; 2] =
+            [0, 1].map(|b| functions[b].iter().map(|k| k.as_ref()).collect());
         for (i, el) in m.elements.iter().enumerate() {
             let b = el.body;
             let pos = el.nodes.map(|n| m.position(n));
@@ -74,13 +78,8 @@ impl<'a> ExactComparison<'a> {
                 }
             }
             let sh = [s.sigma[i][0], s.sigma[i][1], s.sigma[i][2]];
-            let branches = pos.map(|p| ex.branch(b, p[0], p[1], t));
-            let rule = if branches.iter().all(|&v| v == branches[0]) {
-                &self.triangle
-            } else {
-                &self.kinked
-            };
-            for &(l1, l2, w) in rule {
+            let rule = quadrature::triangle_rule(pos, &refs[b], &self.triangle);
+            for &(l1, l2, w) in rule.iter() {
                 let lam = [1.0 - l1 - l2, l1, l2];
                 let x = [0, 1].map(|c| (0..3).map(|a| lam[a] * pos[a][c]).sum::<f64>());
                 let w = w * el.area;
@@ -118,11 +117,14 @@ impl<'a> ExactComparison<'a> {
     fn pressure_difference(&self, p: &Problem, s: &State) -> (f64, f64) {
         let t = s.time;
         let (mut diff, mut norm) = (0.0, 0.0);
+        let kinks = self.exact.contact_kinks();
+        let functions = kink_functions(&kinks, t);
+        let refs: Vec<&quadrature::Kink> = functions.iter().map(|k| k.as_ref()).collect();
         for (piece, profile) in p.interface.pieces.iter().zip(pressure_profile(p, s)) {
             for w in profile.windows(2) {
                 let ((xa, pa), (xb, pb)) = (w[0], w[1]);
                 let len = (xb[0] - xa[0]).hypot(xb[1] - xa[1]);
-                for &(q, wq) in &self.segment {
+                for &(q, wq) in quadrature::segment_rule(xa, xb, &refs, &self.segment).iter() {
                     let x = [xa[0] + q * (xb[0] - xa[0]), xa[1] + q * (xb[1] - xa[1])];
                     let exact = self
                         .exact

@@ -62,21 +62,35 @@ pub fn successive(x: &[f64], y: &[f64]) -> Vec<f64> {
 pub const ROUNDOFF: f64 = 1e-10;
 /// Fewest levels a fitted rate rests on; with fewer, only successive rates are given.
 pub const MIN_FIT_LEVELS: usize = 3;
-/// A fitted rate whose last two successive rates (its last three levels) differ by more
-/// than this is flagged pre-asymptotic.
-pub const PRE_ASYMPTOTIC_SPREAD: f64 = 0.25;
+/// The fitted window: the longest trailing run of levels (at least [`MIN_FIT_LEVELS`])
+/// whose successive rates lie within this spread (max - min) of each other. Where even the
+/// last two successive rates spread more, the rate is pre-asymptotic.
+pub const WINDOW_SPREAD: f64 = 0.25;
+/// Smallest disagreement that calls a rate drifting: the window's fit against the fit over
+/// every usable level, or against the mean of the last two successive rates, by more than
+/// max(DRIFT, 2 standard errors of the window's fit).
+pub const DRIFT: f64 = 0.15;
 /// A quantity whose last two successive rates average below this does not converge: it is
 /// called that, and given no slope.
 pub const STALLED: f64 = 0.15;
 /// Levels whose error is within this factor of the truth's own estimated error are left out.
 pub const TRUTH_MARGIN: f64 = 5.0;
+/// The safety factor of the grid convergence index with three levels (Celik et al. 2008).
+pub const GCI_SAFETY: f64 = 1.25;
 
 /// What a quantity's errors over the levels support.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Verdict {
-    /// A least-squares rate over at least [`MIN_FIT_LEVELS`] levels.
+    /// A least-squares rate over a trailing window of at least [`MIN_FIT_LEVELS`] levels
+    /// whose successive rates agree (within [`WINDOW_SPREAD`]), which agrees with the fit
+    /// over every usable level and with the last successive rates (within [`DRIFT`]).
     Fitted,
-    /// Fitted, but its last successive rates spread more than [`PRE_ASYMPTOTIC_SPREAD`].
+    /// The trailing window is fitted, but the fit over every usable level, or the last two
+    /// successive rates, differ from it by more than [`DRIFT`] (or 2 standard errors): the
+    /// rate is still changing; the window's rate is reported.
+    Drifting,
+    /// Even the last two successive rates differ by more than [`WINDOW_SPREAD`]: no window
+    /// of agreeing rates; the fit over every usable level is shown, flagged.
     PreAsymptotic,
     /// Fewer than [`MIN_FIT_LEVELS`] levels usable: successive rates only.
     TooFewLevels,
@@ -85,6 +99,10 @@ pub enum Verdict {
     NotConverging,
     /// Every level's error is at round-off ([`ROUNDOFF`]): the discretization is exact.
     RoundOff,
+    /// The quantity is fixed by equilibrium (the contact resultant of a body held normal to
+    /// Gamma_C only by the contact): it measures the load's quadrature, not the cones, and
+    /// is never fitted. Set by the study, never by [`assess`].
+    FixedByEquilibrium,
 }
 
 impl Verdict {
@@ -92,11 +110,21 @@ impl Verdict {
     pub fn name(self) -> &'static str {
         match self {
             Verdict::Fitted => "fitted",
+            Verdict::Drifting => "drifting",
             Verdict::PreAsymptotic => "pre-asymptotic",
             Verdict::TooFewLevels => "too few levels",
             Verdict::NotConverging => "not converging",
             Verdict::RoundOff => "round-off",
+            Verdict::FixedByEquilibrium => "fixed by equilibrium",
         }
+    }
+
+    /// Whether the verdict carries a rate to show (flagged unless [`Verdict::Fitted`]).
+    pub fn has_rate(self) -> bool {
+        matches!(
+            self,
+            Verdict::Fitted | Verdict::Drifting | Verdict::PreAsymptotic
+        )
     }
 }
 
@@ -113,29 +141,147 @@ pub struct LevelError {
     pub error: f64,
 }
 
+/// The verification conventions of ASME V&V 20 / Celik et al. 2008 (J. Fluids Eng. 130,
+/// 078001) on the last three usable levels, fine (1), medium (2), coarse (3), applied to
+/// the quantity's error phi (whose limit is 0): the observed order p of
+/// p = |ln|eps32 / eps21| + q(p)| / ln r21, q(p) = ln((r21^p - s) / (r32^p - s)), eps32 =
+/// phi3 - phi2, eps21 = phi2 - phi1, s = sign(eps32 / eps21), r = h_coarser / h_finer, by
+/// fixed-point iteration from q = 0. The GCIs are in the units of phi (the relative form
+/// divides by phi1, which tends to 0 for an error).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Celik {
+    /// Observed order p.
+    pub order: f64,
+    /// Oscillatory convergence: eps32 / eps21 < 0 (s = -1).
+    pub oscillatory: bool,
+    /// GCI of the finest level: 1.25 |eps21| / (r21^p - 1).
+    pub gci_fine: f64,
+    /// GCI of the medium level: 1.25 |eps32| / (r32^p - 1).
+    pub gci_coarse: f64,
+    /// Refinement ratios r21, r32.
+    pub ratios: (f64, f64),
+    /// Differences eps21, eps32.
+    pub differences: (f64, f64),
+}
+
+impl Celik {
+    /// Roache's asymptotic-range check GCI_coarse / (r21^p GCI_fine) with both GCIs taken
+    /// at the order `p`: 1 where an error ~ C h^p describes the three levels. With the
+    /// observed order of the same three levels it is 1 by construction (monotone case), so
+    /// the reports take `p` = the rate they print.
+    pub fn asymptotic_ratio(&self, p: f64) -> f64 {
+        let ((r21, r32), (e21, e32)) = (self.ratios, self.differences);
+        let fine = GCI_SAFETY * e21.abs() / (r21.powf(p) - 1.0);
+        let coarse = GCI_SAFETY * e32.abs() / (r32.powf(p) - 1.0);
+        coarse / (r21.powf(p) * fine)
+    }
+}
+
+/// Celik's procedure on three (h, phi) pairs ordered fine, medium, coarse (h increasing);
+/// None where it has no answer: two equal values (eps = 0), or an iteration that does not
+/// settle to a finite positive order within 200 steps.
+pub fn celik(h: [f64; 3], phi: [f64; 3]) -> Option<Celik> {
+    let (r21, r32) = (h[1] / h[0], h[2] / h[1]);
+    let (e21, e32) = (phi[1] - phi[0], phi[2] - phi[1]);
+    if e21 == 0.0 || e32 == 0.0 || r21 <= 1.0 || r32 <= 1.0 {
+        return None;
+    }
+    let s = (e32 / e21).signum();
+    let ln_ratio = (e32 / e21).abs().ln();
+    let q = |p: f64| ((r21.powf(p) - s) / (r32.powf(p) - s)).ln();
+    let mut p = ln_ratio.abs() / r21.ln();
+    let mut settled = false;
+    for _ in 0..200 {
+        let next = (ln_ratio + q(p)).abs() / r21.ln();
+        if !next.is_finite() {
+            return None;
+        }
+        let done = (next - p).abs() <= 1e-12 * next.abs().max(1.0);
+        p = next;
+        if done {
+            settled = true;
+            break;
+        }
+    }
+    if !settled || p <= 0.0 {
+        return None;
+    }
+    Some(Celik {
+        order: p,
+        oscillatory: s < 0.0,
+        gci_fine: GCI_SAFETY * e21.abs() / (r21.powf(p) - 1.0),
+        gci_coarse: GCI_SAFETY * e32.abs() / (r32.powf(p) - 1.0),
+        ratios: (r21, r32),
+        differences: (e21, e32),
+    })
+}
+
 /// What [`assess`] concluded.
 #[derive(Debug, Clone)]
 pub struct Assessment {
     /// The verdict.
     pub verdict: Verdict,
-    /// The fit in h over exactly `used` (Fitted and PreAsymptotic only).
+    /// The fit in h over exactly `used` (the verdicts with a rate only).
     pub fit: Option<Fit>,
     /// The fit in dofs over the same levels.
     pub fit_dofs: Option<Fit>,
-    /// The fitted levels.
+    /// The fitted levels: the trailing window (Fitted, Drifting), every usable level
+    /// (PreAsymptotic).
     pub used: Vec<usize>,
+    /// The fit over every usable level (at least [`MIN_FIT_LEVELS`]), the window's
+    /// comparison.
+    pub fit_all: Option<Fit>,
     /// Levels at round-off.
     pub roundoff: Vec<usize>,
     /// Levels within [`TRUTH_MARGIN`] of the truth's own error.
     pub near_truth: Vec<usize>,
     /// Successive rates between neighbouring levels; None where either is at round-off.
     pub successive: Vec<Option<f64>>,
+    /// Celik's procedure on the last three usable levels.
+    pub celik: Option<Celik>,
+    /// Its asymptotic-range ratio at the reported rate ([`Celik::asymptotic_ratio`]).
+    pub asymptotic_ratio: Option<f64>,
+}
+
+/// Two levels of a quantity's table with the same h: a successive rate would divide by
+/// log(1) = 0. A study file refuses it when read (levels must increase).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EqualH {
+    /// The two levels.
+    pub levels: (usize, usize),
+}
+
+impl std::fmt::Display for EqualH {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "levels {} and {} have the same h: no rate between them; give distinct, increasing levels",
+            self.levels.0, self.levels.1
+        )
+    }
+}
+
+/// Rate between two levels: log(e_a / e_b) / log(h_a / h_b).
+fn rate_between(a: &LevelError, b: &LevelError) -> f64 {
+    successive(&[a.h, b.h], &[a.error, b.error])[0]
 }
 
 /// Judge a quantity's errors over the levels (finest last) against a truth whose own
 /// estimated error is `truth_error` (0 for an exact solution): never a rate on round-off,
-/// on levels too close to the truth, on fewer than three levels, or of a stalled quantity.
-pub fn assess(levels: &[LevelError], truth_error: f64) -> Assessment {
+/// on levels too close to the truth, on fewer than three levels, or of a stalled quantity;
+/// a rate only over a trailing window of agreeing successive rates, called drifting where it
+/// disagrees with the fit over every level or with the last successive rates. Errs on two
+/// levels with the same h.
+pub fn assess(levels: &[LevelError], truth_error: f64) -> Result<Assessment, EqualH> {
+    for (i, a) in levels.iter().enumerate() {
+        for b in &levels[i + 1..] {
+            if (a.h - b.h).abs() <= 1e-12 * a.h.abs().max(b.h.abs()) {
+                return Err(EqualH {
+                    levels: (a.level, b.level),
+                });
+            }
+        }
+    }
     let at_roundoff = |e: &LevelError| e.error <= ROUNDOFF;
     let roundoff: Vec<usize> = levels
         .iter()
@@ -149,10 +295,7 @@ pub fn assess(levels: &[LevelError], truth_error: f64) -> Assessment {
         .collect();
     let successive_rates: Vec<Option<f64>> = levels
         .windows(2)
-        .map(|w| {
-            (!at_roundoff(&w[0]) && !at_roundoff(&w[1]))
-                .then(|| successive(&[w[0].h, w[1].h], &[w[0].error, w[1].error])[0])
-        })
+        .map(|w| (!at_roundoff(&w[0]) && !at_roundoff(&w[1])).then(|| rate_between(&w[0], &w[1])))
         .collect();
     let usable: Vec<&LevelError> = levels
         .iter()
@@ -163,34 +306,78 @@ pub fn assess(levels: &[LevelError], truth_error: f64) -> Assessment {
         fit: None,
         fit_dofs: None,
         used: Vec::new(),
+        fit_all: None,
         roundoff,
         near_truth,
         successive: successive_rates,
+        celik: None,
+        asymptotic_ratio: None,
     };
     if usable.is_empty() && !out.roundoff.is_empty() {
         out.verdict = Verdict::RoundOff;
-        return out;
+        return Ok(out);
     }
-    // The successive rates of the last three usable levels.
-    let tail: Vec<f64> = usable[usable.len().saturating_sub(3)..]
+    // Successive rates between neighbouring usable levels.
+    let rates: Vec<f64> = usable
         .windows(2)
-        .map(|w| successive(&[w[0].h, w[1].h], &[w[0].error, w[1].error])[0])
+        .map(|w| rate_between(w[0], w[1]))
         .collect();
-    if !tail.is_empty() && tail.iter().sum::<f64>() / (tail.len() as f64) < STALLED {
+    let last_two = &rates[rates.len().saturating_sub(2)..];
+    let mean_last = last_two.iter().sum::<f64>() / last_two.len().max(1) as f64;
+    if !last_two.is_empty() && mean_last < STALLED {
         out.verdict = Verdict::NotConverging;
-        return out;
+        return Ok(out);
     }
     if usable.len() < MIN_FIT_LEVELS {
-        return out;
+        return Ok(out);
     }
-    let column = |f: fn(&LevelError) -> f64| -> Vec<f64> { usable.iter().map(|e| f(e)).collect() };
-    out.fit = fit(&column(|e| e.h), &column(|e| e.error));
-    out.fit_dofs = fit(&column(|e| e.dofs), &column(|e| e.error));
-    out.used = usable.iter().map(|e| e.level).collect();
-    out.verdict = if tail.len() == 2 && (tail[0] - tail[1]).abs() > PRE_ASYMPTOTIC_SPREAD {
-        Verdict::PreAsymptotic
-    } else {
-        Verdict::Fitted
+    let n = usable.len();
+    out.celik = celik(
+        [usable[n - 1].h, usable[n - 2].h, usable[n - 3].h],
+        [
+            usable[n - 1].error,
+            usable[n - 2].error,
+            usable[n - 3].error,
+        ],
+    );
+    let fit_over = |window: &[&LevelError]| {
+        let h: Vec<f64> = window.iter().map(|e| e.h).collect();
+        let d: Vec<f64> = window.iter().map(|e| e.dofs).collect();
+        let e: Vec<f64> = window.iter().map(|e| e.error).collect();
+        (fit(&h, &e), fit(&d, &e))
     };
-    out
+    out.fit_all = fit_over(&usable).0;
+    // The longest trailing window whose successive rates lie within WINDOW_SPREAD.
+    let mut start = None;
+    for first in (0..=n - MIN_FIT_LEVELS).rev() {
+        let r = &rates[first..];
+        let spread = r.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+            - r.iter().copied().fold(f64::INFINITY, f64::min);
+        if spread > WINDOW_SPREAD {
+            break;
+        }
+        start = Some(first);
+    }
+    let window: &[&LevelError] = match start {
+        Some(first) => &usable[first..],
+        None => &usable,
+    };
+    (out.fit, out.fit_dofs) = fit_over(window);
+    out.used = window.iter().map(|e| e.level).collect();
+    out.verdict = match (start, out.fit, out.fit_all) {
+        (Some(_), Some(w), Some(all)) => {
+            let tolerance = DRIFT.max(2.0 * w.stderr);
+            if (all.rate - w.rate).abs() > tolerance || (mean_last - w.rate).abs() > tolerance {
+                Verdict::Drifting
+            } else {
+                Verdict::Fitted
+            }
+        }
+        _ => Verdict::PreAsymptotic,
+    };
+    out.asymptotic_ratio = match (out.celik, out.fit) {
+        (Some(c), Some(f)) if f.rate > 0.0 => Some(c.asymptotic_ratio(f.rate)),
+        _ => None,
+    };
+    Ok(out)
 }
