@@ -40,6 +40,9 @@ enum Command {
         #[arg(long)]
         merge: bool,
     },
+    /// Print the README's Results section, read from the committed reports' CSVs
+    /// (reports/rates, reports/rates-exact, reports/patch).
+    Results,
     /// Solve one scene on one mesh level and write solution.vtu and summary.csv.
     Solve {
         /// Built-in scene name or path to a scene .toml.
@@ -105,6 +108,10 @@ fn run() -> anyhow::Result<()> {
             shard,
             merge,
         } => study(&name, out, shard.as_deref(), merge),
+        Command::Results => {
+            print!("{}", report::results::section(&report::reports_dir())?);
+            Ok(())
+        }
         Command::Solve {
             scene,
             method,

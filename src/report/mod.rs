@@ -4,11 +4,13 @@
 //! - [`folder`]: report folders checked before computing and swapped in whole;
 //! - [`study`]: a convergence study; [`paper`], [`speed`], [`stability`]: the other kinds;
 //! - [`run`]: the output of `solve` (one case);
-//! - [`plot`]: the PNG charts all of them draw.
+//! - [`plot`]: the PNG charts all of them draw;
+//! - [`results`]: the README's Results section, read back from the reports' CSVs.
 
 pub mod folder;
 pub mod paper;
 pub mod plot;
+pub mod results;
 pub mod run;
 pub mod speed;
 pub mod stability;

@@ -485,7 +485,7 @@ fn readme(res: &StudyResult) -> String {
         (None, Some(points)) => {
             let _ = writeln!(
                 s,
-                "\n## Reference: the exact solution\n\nEvery error is measured against the exact solution of scene `{}` (its `[exact]` table), with no reference solve: integrated on each study mesh by a collapsed Gauss rule of {points} x {points} points per triangle (exact to degree {}; on 8 x 8 sub-triangles of the triangles a kink of a piecewise exact field crosses) and {} Gauss points per segment of Gamma_C. Doubling the rule changes no printed digit (tested).\n",
+                "\n## Reference: the exact solution\n\nEvery error is measured against the exact solution of scene `{}` (its `[exact]` table), with no reference solve: integrated on each study mesh by a collapsed Gauss rule of {points} x {points} points per triangle (exact to degree {}) and {} Gauss points per segment of Gamma_C, each triangle or segment that a kink of a piecewise exact field crosses split along the kink and the rule applied on each piece (the loads are integrated the same way, with Dunavant's degree-8 rule). Doubling the rule changes no printed digit (tested).\n",
                 res.scene.name,
                 2 * points - 2,
                 2 * points

@@ -1,0 +1,243 @@
+//! The README's "Results" section: the few numbers a reader needs from each committed
+//! convergence report, read back from its CSVs (rates.csv, errors.csv), so that the front
+//! page says what the harness found and a test can tell when it no longer matches them.
+//! `contact-rates results` prints it; the test compares it with README.md.
+
+use crate::error::{Error, Result};
+use serde::Deserialize;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The convergence studies whose reports the section summarises, with a line on what each
+/// measures against.
+pub const STUDIES: [(&str, &str); 3] = [
+    (
+        "rates",
+        "the viscoplastic `rates` scene against a matching-mesh reference",
+    ),
+    (
+        "rates-exact",
+        "the manufactured `contact-mms` scene against its exact solution",
+    ),
+    (
+        "patch",
+        "paper Test 2 against its exact stress diag(0, -10 t) and pressure 10 t",
+    ),
+];
+
+/// Theorem 3.1's rates of the `theorem` norm: K_h^pi (mortar), K_h^I (nts).
+const THEOREM: [(&str, f64); 2] = [("mortar", 0.75), ("nts", 0.5)];
+/// A ratio of the cones' errors at the finest level beyond this (either way) separates them.
+const SEPARATES: f64 = 1.5;
+/// An nts rate within this of 1/2 attains K_h^I's h^(1/2).
+const NEAR_HALF: f64 = 0.15;
+
+/// One row of a report's rates.csv (the columns read here).
+#[derive(Debug, Deserialize)]
+pub struct RateLine {
+    /// Cone.
+    pub method: String,
+    /// Quantity.
+    pub quantity: String,
+    /// Fitted rate (empty without one).
+    pub rate: Option<f64>,
+    /// Its standard error.
+    pub stderr: Option<f64>,
+    /// Fitted levels, space separated.
+    pub levels_used: String,
+    /// Successive rates, space separated.
+    pub successive: String,
+    /// Verdict name.
+    pub verdict: String,
+}
+
+/// One row of a report's errors.csv (the columns read here).
+#[derive(Debug, Deserialize)]
+pub struct ErrorLine {
+    /// Cone.
+    pub method: String,
+    /// Level.
+    pub level: usize,
+    /// Quantity.
+    pub quantity: String,
+    /// Relative error (max over time steps).
+    pub error: f64,
+}
+
+fn read<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<Vec<T>> {
+    let mut reader = csv::Reader::from_path(path).map_err(|e| {
+        Error::input(path, "file", format!("cannot read ({e}); regenerate the report"))
+    })?;
+    reader
+        .deserialize()
+        .collect::<std::result::Result<Vec<T>, _>>()
+        .map_err(|e| Error::input(path, "rows", format!("{e}; regenerate the report")))
+}
+
+/// The contact quantities (where the cones differ).
+fn is_contact(q: &str) -> bool {
+    matches!(
+        q,
+        "band_stress"
+            | "contact_edge"
+            | "l2_pressure"
+            | "pressure_weighted"
+            | "pressure_resultant"
+            | "pressure_oscillation"
+            | "max_penetration"
+            | "l2_penetration"
+    )
+}
+
+/// "0.981 ± 0.005 (fitted, levels 0-5)", or the verdict where there is no rate.
+fn rate_text(r: &RateLine) -> String {
+    match (r.rate, r.stderr) {
+        (Some(rate), Some(se)) => {
+            let levels: Vec<&str> = r.levels_used.split_whitespace().collect();
+            let span = match (levels.first(), levels.last()) {
+                (Some(a), Some(b)) => format!("levels {a}-{b}"),
+                _ => String::new(),
+            };
+            format!("{rate:.3} ± {se:.3} ({}, {span})", r.verdict)
+        }
+        _ => r.verdict.clone(),
+    }
+}
+
+/// The Results section (from "## Results" to before the next heading of its level) for the
+/// reports under `reports`.
+pub fn section(reports: &Path) -> Result<String> {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "## Results\n\nWhat the committed reports measured (`cargo run --release -- results` prints this section from their CSVs; a test fails when it no longer matches them). Rates are least-squares slopes in h over the levels named, with the verdict of the rule in [Rates](#studies) (fitted, drifting, pre-asymptotic, not converging, round-off, fixed by equilibrium).\n"
+    );
+    for (name, what) in STUDIES {
+        let dir = reports.join(name);
+        let rates: Vec<RateLine> = read(&dir.join("rates.csv"))?;
+        let errors: Vec<ErrorLine> = read(&dir.join("errors.csv"))?;
+        let finest = errors.iter().map(|e| e.level).max().unwrap_or(0);
+        let _ = writeln!(s, "### [`{name}`](reports/{name}/README.md): {what}\n");
+        let rate = |m: &str, q: &str| rates.iter().find(|r| r.method == m && r.quantity == q);
+        let error = |m: &str, q: &str| {
+            errors
+                .iter()
+                .find(|e| e.method == m && e.quantity == q && e.level == finest)
+                .map(|e| e.error)
+        };
+        // The theorem norm against Theorem 3.1 (where the study measures it).
+        let theorem: Vec<String> = THEOREM
+            .iter()
+            .filter_map(|&(m, p)| {
+                rate(m, "theorem").map(|r| format!("{m} {}, Theorem 3.1: {p}", rate_text(r)))
+            })
+            .collect();
+        if !theorem.is_empty() {
+            let _ = writeln!(s, "- Theorem 3.1 norm: {}.", theorem.join("; "));
+        }
+        // Where nts attains h^(1/2).
+        let half: Vec<String> = rates
+            .iter()
+            .filter(|r| r.method == "nts" && r.quantity != "theorem")
+            .filter(|r| r.verdict == "fitted" || r.verdict == "drifting")
+            .filter(|r| r.rate.is_some_and(|v| (v - 0.5).abs() <= NEAR_HALF))
+            .map(|r| format!("{} {}", r.quantity, rate_text(r)))
+            .collect();
+        let _ = writeln!(
+            s,
+            "- nts at h^(1/2) (a rate within {NEAR_HALF} of 0.5): {}.",
+            if half.is_empty() {
+                "no quantity".to_string()
+            } else {
+                half.join("; ")
+            }
+        );
+        // Contact quantities that separate the cones at the finest level.
+        let mut separate = Vec::new();
+        let mut agree = Vec::new();
+        for r in rates.iter().filter(|r| r.method == "mortar" && is_contact(&r.quantity)) {
+            let q = r.quantity.as_str();
+            let Some(nts) = rate("nts", q) else { continue };
+            let comparable = |v: &str| {
+                matches!(v, "fitted" | "drifting" | "round-off" | "not converging")
+            };
+            if !comparable(&r.verdict) || !comparable(&nts.verdict) {
+                continue;
+            }
+            let (Some(a), Some(b)) = (error("mortar", q), error("nts", q)) else {
+                continue;
+            };
+            // A cone at round-off is exact: say so rather than divide by round-off.
+            let exact = |v: &str| v == "round-off";
+            let ratio = match (exact(&r.verdict), exact(&nts.verdict)) {
+                (true, true) => 1.0,
+                (true, false) => f64::INFINITY,
+                (false, true) => 0.0,
+                (false, false) => b / a,
+            };
+            let ratio_text = if ratio.is_infinite() {
+                "mortar exact".to_string()
+            } else if ratio == 0.0 {
+                "nts exact".to_string()
+            } else if ratio >= 10.0 {
+                format!("nts/mortar = {ratio:.0}")
+            } else {
+                format!("nts/mortar = {ratio:.2}")
+            };
+            let text = format!(
+                "{q} {ratio_text} (mortar {a:.2e}, {}; nts {b:.2e}, {})",
+                rate_text(r),
+                rate_text(nts)
+            );
+            if !(1.0 / SEPARATES..=SEPARATES).contains(&ratio) {
+                separate.push(text);
+            } else {
+                agree.push(q.to_string());
+            }
+        }
+        let _ = writeln!(
+            s,
+            "- Contact quantities that separate the cones at level {finest} (error ratio beyond {SEPARATES}): {}.{}",
+            if separate.is_empty() {
+                "none".to_string()
+            } else {
+                separate.join("; ")
+            },
+            if agree.is_empty() {
+                String::new()
+            } else {
+                format!(" Within {SEPARATES}x: {}.", agree.join(", "))
+            }
+        );
+        // What does not converge, and what carries no rate the numbers support.
+        let stalled: Vec<String> = rates
+            .iter()
+            .filter(|r| r.verdict == "not converging")
+            .map(|r| {
+                let e = error(&r.method, &r.quantity).map_or(String::new(), |e| {
+                    format!(" (at {e:.2e} at level {finest}; successive {})", r.successive)
+                });
+                format!("{} {}{e}", r.method, r.quantity)
+            })
+            .collect();
+        let _ = writeln!(
+            s,
+            "- Does not converge: {}.",
+            if stalled.is_empty() {
+                "nothing".to_string()
+            } else {
+                stalled.join("; ")
+            }
+        );
+        let unfitted: Vec<String> = rates
+            .iter()
+            .filter(|r| matches!(r.verdict.as_str(), "pre-asymptotic" | "fixed by equilibrium" | "too few levels"))
+            .map(|r| format!("{} {} ({})", r.method, r.quantity, r.verdict))
+            .collect();
+        if !unfitted.is_empty() {
+            let _ = writeln!(s, "- No rate claimed: {}.", unfitted.join(", "));
+        }
+        let _ = writeln!(s);
+    }
+    Ok(s)
+}
