@@ -322,6 +322,11 @@ fn study_file_errors_through_the_binary() {
             vec!["study.toml", "mesh.levels", "at least 3 levels, got 0"],
         ),
         (
+            // Two levels with the same h: no rate between them (issue 20).
+            Box::new(|t| t.replace("levels = [0, 1, 2]", "levels = [0, 1, 1, 2]")),
+            vec!["study.toml", "mesh.levels", "same h"],
+        ),
+        (
             Box::new(|t| t.replace("levels = [0, 1, 2]", "levels = 0")),
             vec!["study.toml", "key mesh.levels", "sequence"],
         ),

@@ -235,7 +235,10 @@ impl StudyFile {
             );
         }
         if s.mesh.levels.windows(2).any(|w| w[1] <= w[0]) {
-            return bad("mesh.levels", "levels must increase".into());
+            return bad(
+                "mesh.levels",
+                "levels must increase: a repeated level has the same h as its twin, and no rate between them; list each level once, in increasing order".into(),
+            );
         }
         if !(s.mesh.coarsest > 0.0 && s.mesh.coarsest.is_finite()) {
             return bad(
