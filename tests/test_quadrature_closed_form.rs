@@ -96,7 +96,10 @@ fn dunavant_degree_8_rule_is_exact_on_every_monomial_of_degree_8() {
                 .iter()
                 .map(|&(x, y, w)| 0.5 * w * x.powi(i as i32) * y.powi(j as i32))
                 .sum();
-            assert!((q - exact).abs() <= 1e-14 * exact.max(1e-3), "x^{i} y^{j}: {q} vs {exact}");
+            assert!(
+                (q - exact).abs() <= 1e-14 * exact.max(1e-3),
+                "x^{i} y^{j}: {q} vs {exact}"
+            );
         }
     }
 }

@@ -106,7 +106,14 @@ fn committed_nts_band_stress_is_drifting_not_a_fitted_1_2() {
     // rates-exact before issue 20: nts band_stress "1.216 ± 0.076, fitted" over all levels.
     let a = assess_ok(&from_successive(&[1.56, 1.46, 1.27, 0.94, 0.82]), 0.0);
     let f = a.fit.unwrap();
-    println!("band_stress: {:?} {:.3} ± {:.3} over {:?}, all levels {:.3}", a.verdict, f.rate, f.stderr, a.used, a.fit_all.unwrap().rate);
+    println!(
+        "band_stress: {:?} {:.3} ± {:.3} over {:?}, all levels {:.3}",
+        a.verdict,
+        f.rate,
+        f.stderr,
+        a.used,
+        a.fit_all.unwrap().rate
+    );
     assert_eq!(a.verdict, Verdict::Drifting);
     // The window: 0.94, 0.82 agree (0.12 apart); 1.27 would spread them to 0.45.
     assert_eq!(a.used, vec![3, 4, 5]);

@@ -15,7 +15,9 @@ fn root() -> &'static Path {
 #[test]
 fn readme_results_section_matches_the_committed_reports() {
     let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
-    let start = readme.find("## Results\n").expect("README has a Results section");
+    let start = readme
+        .find("## Results\n")
+        .expect("README has a Results section");
     let end = readme[start + 3..]
         .find("\n## ")
         .map_or(readme.len(), |i| start + 3 + i + 1);

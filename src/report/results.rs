@@ -4,6 +4,7 @@
 //! `contact-rates results` prints it; the test compares it with README.md.
 
 use crate::error::{Error, Result};
+use crate::study::quantity::Quantity;
 use serde::Deserialize;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -66,7 +67,11 @@ pub struct ErrorLine {
 
 fn read<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<Vec<T>> {
     let mut reader = csv::Reader::from_path(path).map_err(|e| {
-        Error::input(path, "file", format!("cannot read ({e}); regenerate the report"))
+        Error::input(
+            path,
+            "file",
+            format!("cannot read ({e}); regenerate the report"),
+        )
     })?;
     reader
         .deserialize()
@@ -74,19 +79,9 @@ fn read<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<Vec<T>> {
         .map_err(|e| Error::input(path, "rows", format!("{e}; regenerate the report")))
 }
 
-/// The contact quantities (where the cones differ).
+/// Whether the quantity named `q` is a contact quantity (where the cones differ).
 fn is_contact(q: &str) -> bool {
-    matches!(
-        q,
-        "band_stress"
-            | "contact_edge"
-            | "l2_pressure"
-            | "pressure_weighted"
-            | "pressure_resultant"
-            | "pressure_oscillation"
-            | "max_penetration"
-            | "l2_penetration"
-    )
+    Quantity::CONTACT.iter().any(|c| c.name() == q)
 }
 
 /// "0.981 ± 0.005 (fitted, levels 0-5)", or the verdict where there is no rate.
@@ -155,12 +150,14 @@ pub fn section(reports: &Path) -> Result<String> {
         // Contact quantities that separate the cones at the finest level.
         let mut separate = Vec::new();
         let mut agree = Vec::new();
-        for r in rates.iter().filter(|r| r.method == "mortar" && is_contact(&r.quantity)) {
+        for r in rates
+            .iter()
+            .filter(|r| r.method == "mortar" && is_contact(&r.quantity))
+        {
             let q = r.quantity.as_str();
             let Some(nts) = rate("nts", q) else { continue };
-            let comparable = |v: &str| {
-                matches!(v, "fitted" | "drifting" | "round-off" | "not converging")
-            };
+            let comparable =
+                |v: &str| matches!(v, "fitted" | "drifting" | "round-off" | "not converging");
             if !comparable(&r.verdict) || !comparable(&nts.verdict) {
                 continue;
             }
@@ -215,7 +212,10 @@ pub fn section(reports: &Path) -> Result<String> {
             .filter(|r| r.verdict == "not converging")
             .map(|r| {
                 let e = error(&r.method, &r.quantity).map_or(String::new(), |e| {
-                    format!(" (at {e:.2e} at level {finest}; successive {})", r.successive)
+                    format!(
+                        " (at {e:.2e} at level {finest}; successive {})",
+                        r.successive
+                    )
                 });
                 format!("{} {}{e}", r.method, r.quantity)
             })
@@ -231,7 +231,12 @@ pub fn section(reports: &Path) -> Result<String> {
         );
         let unfitted: Vec<String> = rates
             .iter()
-            .filter(|r| matches!(r.verdict.as_str(), "pre-asymptotic" | "fixed by equilibrium" | "too few levels"))
+            .filter(|r| {
+                matches!(
+                    r.verdict.as_str(),
+                    "pre-asymptotic" | "fixed by equilibrium" | "too few levels"
+                )
+            })
             .map(|r| format!("{} {} ({})", r.method, r.quantity, r.verdict))
             .collect();
         if !unfitted.is_empty() {
@@ -239,5 +244,92 @@ pub fn section(reports: &Path) -> Result<String> {
         }
         let _ = writeln!(s);
     }
+    speed_and_stability(reports, &mut s)?;
     Ok(s)
+}
+
+/// One row of reports/speed/speed.csv (the columns read here).
+#[derive(Debug, Deserialize)]
+struct SpeedLine {
+    solver: String,
+    dofs: usize,
+    ratio_to_floor: f64,
+    family: String,
+}
+
+/// One row of reports/stability/stability.csv (the columns read here).
+#[derive(Debug, Deserialize)]
+struct StabilityLine {
+    case: String,
+    parameter: String,
+    method: String,
+    solver: String,
+    converged: bool,
+    max_step_iterations: usize,
+}
+
+/// The paper's tests (a link), the cost of the default solver against the floor, and the
+/// hard cases.
+fn speed_and_stability(reports: &Path, s: &mut String) -> Result<()> {
+    let speed: Vec<SpeedLine> = read(&reports.join("speed").join("speed.csv"))?;
+    let newton: Vec<&SpeedLine> = speed
+        .iter()
+        .filter(|r| r.solver == "newton" && r.dofs >= 10_000)
+        .collect();
+    let mut families: Vec<&str> = newton.iter().map(|r| r.family.as_str()).collect();
+    families.dedup();
+    let ranges: Vec<String> = families
+        .iter()
+        .map(|f| {
+            let ratios = newton
+                .iter()
+                .filter(|r| r.family == *f)
+                .map(|r| r.ratio_to_floor);
+            let (lo, hi) = ratios.fold((f64::INFINITY, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+            format!("{f} {lo:.2}-{hi:.2}")
+        })
+        .collect();
+    let top = speed.iter().map(|r| r.dofs).max().unwrap_or(0);
+    let _ = writeln!(
+        s,
+        "### [`paper`](reports/paper/README.md): the paper's three tests regenerated\n\n- Every figure of its section 5 and the numbers behind its words (no rates: one mesh per test).\n"
+    );
+    let _ = writeln!(
+        s,
+        "### [`speed`](reports/speed/README.md): cost against the floor (one Cholesky of the stiffness)
+
+- newton's (set-up + time loop) / floor from 1e4 to {top} dofs: {}.
+",
+        ranges.join(", ")
+    );
+    let stability: Vec<StabilityLine> = read(&reports.join("stability").join("stability.csv"))?;
+    let failed = |solver: &str| {
+        stability
+            .iter()
+            .filter(|r| r.solver == solver && !r.converged)
+            .count()
+    };
+    let total = |solver: &str| stability.iter().filter(|r| r.solver == solver).count();
+    let worst = stability
+        .iter()
+        .filter(|r| r.solver == "newton" && r.converged)
+        .max_by_key(|r| r.max_step_iterations);
+    let _ = writeln!(
+        s,
+        "### [`stability`](reports/stability/README.md): hard cases, every solver
+
+- Not converged: newton {} of {}, paper {} of {}, qp {} of {}.{}
+",
+        failed("newton"),
+        total("newton"),
+        failed("paper"),
+        total("paper"),
+        failed("qp"),
+        total("qp"),
+        worst.map_or(String::new(), |w| format!(
+            " newton's most iterations in one step: {} ({}, {}, {}).",
+            w.max_step_iterations, w.case, w.parameter, w.method
+        ))
+    );
+    Ok(())
 }

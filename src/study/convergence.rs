@@ -980,7 +980,8 @@ fn fit_rates(
             })?;
             if quantity == Quantity::PressureResultant && resultant_fixed {
                 a.verdict = Verdict::FixedByEquilibrium;
-                (a.fit, a.fit_dofs, a.fit_all, a.celik, a.asymptotic_ratio) = (None, None, None, None, None);
+                (a.fit, a.fit_dofs, a.fit_all, a.celik, a.asymptotic_ratio) =
+                    (None, None, None, None, None);
                 a.used.clear();
             }
             let threshold = (quantity == sf.thresholds.quantity).then_some(threshold);
