@@ -84,19 +84,23 @@ fn is_contact(q: &str) -> bool {
     Quantity::CONTACT.iter().any(|c| c.name() == q)
 }
 
-/// "0.981 ± 0.005 (fitted, levels 0-5)", or the verdict where there is no rate.
+/// "0.981 ± 0.005 (fitted, levels 0 1 2 3 4 5)", or the verdict where there is no rate.
 fn rate_text(r: &RateLine) -> String {
     match (r.rate, r.stderr) {
         (Some(rate), Some(se)) => {
-            let levels: Vec<&str> = r.levels_used.split_whitespace().collect();
-            let span = match (levels.first(), levels.last()) {
-                (Some(a), Some(b)) => format!("levels {a}-{b}"),
-                _ => String::new(),
-            };
-            format!("{rate:.3} ± {se:.3} ({}, {span})", r.verdict)
+            format!(
+                "{rate:.3} ± {se:.3} ({}, levels {})",
+                r.verdict, r.levels_used
+            )
         }
         _ => r.verdict.clone(),
     }
+}
+
+/// The last two successive rates of a row, as printed in rates.csv.
+fn last_successive(r: &RateLine) -> String {
+    let all: Vec<&str> = r.successive.split_whitespace().collect();
+    all[all.len().saturating_sub(2)..].join(" ")
 }
 
 /// The Results section (from "## Results" to before the next heading of its level) for the
@@ -136,7 +140,14 @@ pub fn section(reports: &Path) -> Result<String> {
             .filter(|r| r.method == "nts" && r.quantity != "theorem")
             .filter(|r| r.verdict == "fitted" || r.verdict == "drifting")
             .filter(|r| r.rate.is_some_and(|v| (v - 0.5).abs() <= NEAR_HALF))
-            .map(|r| format!("{} {}", r.quantity, rate_text(r)))
+            .map(|r| {
+                format!(
+                    "{} {}, last successive rates {}",
+                    r.quantity,
+                    rate_text(r),
+                    last_successive(r)
+                )
+            })
             .collect();
         let _ = writeln!(
             s,
@@ -150,6 +161,7 @@ pub fn section(reports: &Path) -> Result<String> {
         // Contact quantities that separate the cones at the finest level.
         let mut separate = Vec::new();
         let mut agree = Vec::new();
+        let mut not_compared = Vec::new();
         for r in rates
             .iter()
             .filter(|r| r.method == "mortar" && is_contact(&r.quantity))
@@ -159,6 +171,7 @@ pub fn section(reports: &Path) -> Result<String> {
             let comparable =
                 |v: &str| matches!(v, "fitted" | "drifting" | "round-off" | "not converging");
             if !comparable(&r.verdict) || !comparable(&nts.verdict) {
+                not_compared.push(q.to_string());
                 continue;
             }
             let (Some(a), Some(b)) = (error("mortar", q), error("nts", q)) else {
@@ -204,8 +217,15 @@ pub fn section(reports: &Path) -> Result<String> {
                 String::new()
             } else {
                 format!(" Within {SEPARATES}x: {}.", agree.join(", "))
-            }
+            },
         );
+        if !not_compared.is_empty() {
+            let _ = writeln!(
+                s,
+                "- Not compared (no rate the numbers support in some cone, or fixed by equilibrium): {}.",
+                not_compared.join(", ")
+            );
+        }
         // What does not converge, and what carries no rate the numbers support.
         let stalled: Vec<String> = rates
             .iter()
