@@ -3,7 +3,7 @@
 //! loads from tractions and body forces, and assembly of internal force and tangent.
 
 use crate::error::{Error, Result};
-use crate::expr::{Expr, distinct_kinks, kink_functions};
+use crate::expr::{distinct_kinks, kink_functions};
 use crate::material::{Material, Strain, Stress};
 use crate::mesh::{BodyMesh, RawMesh};
 use crate::quadrature;
@@ -427,21 +427,21 @@ impl Model {
         let mut f = vec![0.0; 2 * self.n_nodes];
         let (segment, triangle) = (quadrature::gauss_legendre(8), quadrature::dunavant8());
         let exact = self.scene.exact.as_deref();
-        // The kinks of each traction's expressions (a derived traction: the body's stress).
-        let traction_kinks: Vec<Vec<&Expr>> = self
+        // The kinks at t of each traction's expressions (a derived traction: of the body's
+        // stress), built once per call rather than per edge.
+        let traction_kinks: Vec<_> = self
             .scene
             .tractions
             .iter()
             .map(|tr| match &tr.g {
-                Some(g) => distinct_kinks(&g.0),
+                Some(g) => kink_functions(&distinct_kinks(&g.0), t),
                 None => Vec::new(),
             })
             .collect();
-        let stress_kinks: [Vec<&Expr>; 2] =
-            [0, 1].map(|b| match exact.and_then(|e| e.stress.as_ref()) {
-                Some(st) => distinct_kinks(&st[b]),
-                None => Vec::new(),
-            });
+        let stress_kinks = [0, 1].map(|b| match exact.and_then(|e| e.stress.as_ref()) {
+            Some(st) => kink_functions(&distinct_kinks(&st[b]), t),
+            None => Vec::new(),
+        });
         for (e, &(i, [a, b])) in self.traction_edges.iter().enumerate() {
             let (pa, pb) = (self.position(a), self.position(b));
             let len = (pb[0] - pa[0]).hypot(pb[1] - pa[1]);
@@ -449,9 +449,7 @@ impl Model {
                 Some(_) => &traction_kinks[i],
                 None => &stress_kinks[self.traction_normals[e].0],
             };
-            let functions = kink_functions(kinks, t);
-            let refs: Vec<&quadrature::Kink> = functions.iter().map(|k| k.as_ref()).collect();
-            for &(s, w) in quadrature::segment_rule(pa, pb, &refs, &segment).iter() {
+            for &(s, w) in quadrature::segment_rule(pa, pb, kinks, &segment).iter() {
                 let x = pa[0] + s * (pb[0] - pa[0]);
                 let y = pa[1] + s * (pb[1] - pa[1]);
                 let field = || format!("traction '{}'.g", self.scene.tractions[i].curve);
@@ -470,13 +468,11 @@ impl Model {
             let Some(bf) = &self.scene.bodies[body].body_force else {
                 continue;
             };
-            let kinks = distinct_kinks(&bf.0);
-            let functions = kink_functions(&kinks, t);
-            let refs: Vec<&quadrature::Kink> = functions.iter().map(|k| k.as_ref()).collect();
+            let kinks = kink_functions(&distinct_kinks(&bf.0), t);
             let field = format!("bodies '{}'.body_force", self.scene.bodies[body].surface);
             for e in self.elements.iter().filter(|e| e.body == body) {
                 let p = e.nodes.map(|n| self.position(n));
-                for &(l1, l2, w) in quadrature::triangle_rule(p, &refs, &triangle).iter() {
+                for &(l1, l2, w) in quadrature::triangle_rule(p, &kinks, &triangle).iter() {
                     let lam = [1.0 - l1 - l2, l1, l2];
                     let x = lam[0] * p[0][0] + lam[1] * p[1][0] + lam[2] * p[2][0];
                     let y = lam[0] * p[0][1] + lam[1] * p[1][1] + lam[2] * p[2][1];

@@ -106,7 +106,8 @@ pub fn dunavant8() -> Vec<(f64, f64, f64)> {
 }
 
 /// A kink of a piecewise field: a function whose sign tells the branch, so the field is
-/// smooth where it keeps its sign (the argument z of an `abs(z)`).
+/// smooth where it keeps its sign (the argument z of an `abs(z)`). The rules below take any
+/// `Fn([f64; 2]) -> f64`; this is the object form.
 pub type Kink<'a> = dyn Fn([f64; 2]) -> f64 + 'a;
 
 /// Relative size below which a kink function counts as zero at a vertex (the vertex lies on
@@ -126,7 +127,7 @@ fn sign(z: f64, scale: f64) -> i8 {
 /// The point of the segment a -> b where `z` vanishes, given z(a) > 0 > z(b) or the reverse.
 /// Exact (one evaluation to confirm) where z is affine along the segment; otherwise the
 /// Illinois variant of regula falsi to round-off.
-fn zero_on_segment(a: [f64; 2], b: [f64; 2], za: f64, zb: f64, z: &Kink) -> f64 {
+fn zero_on_segment(a: [f64; 2], b: [f64; 2], za: f64, zb: f64, z: impl Fn([f64; 2]) -> f64) -> f64 {
     let at = |s: f64| z([a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])]);
     let scale = za.abs().max(zb.abs());
     let (mut s0, mut s1, mut z0, mut z1) = (0.0, 1.0, za, zb);
@@ -166,7 +167,7 @@ fn twice_area(p: &[[f64; 2]; 3]) -> f64 {
 /// zero line is curved and the straight cut between the edge zeros leaves a sliver of
 /// width O(h^2 |curvature|) on the wrong side; a kink that enters and leaves through the
 /// same edge (signs equal at the vertices) is not seen. Both vanish as the mesh is refined.
-pub fn split_triangle(t: [[f64; 2]; 3], kinks: &[&Kink]) -> Vec<[[f64; 2]; 3]> {
+pub fn split_triangle<K: Fn([f64; 2]) -> f64>(t: [[f64; 2]; 3], kinks: &[K]) -> Vec<[[f64; 2]; 3]> {
     let full = twice_area(&t).abs();
     let mut pieces = vec![t];
     for z in kinks {
@@ -190,7 +191,7 @@ pub fn split_triangle(t: [[f64; 2]; 3], kinks: &[&Kink]) -> Vec<[[f64; 2]; 3]> {
                     minus.push(p[i]);
                 }
                 if s[i] * s[j] == -1 {
-                    let r = zero_on_segment(p[i], p[j], v[i], v[j], *z);
+                    let r = zero_on_segment(p[i], p[j], v[i], v[j], z);
                     let c = [
                         p[i][0] + r * (p[j][0] - p[i][0]),
                         p[i][1] + r * (p[j][1] - p[i][1]),
@@ -220,9 +221,9 @@ pub fn split_triangle(t: [[f64; 2]; 3], kinks: &[&Kink]) -> Vec<[[f64; 2]; 3]> {
 /// [`split_triangle`] otherwise. On each piece the integrand is as smooth as the field's
 /// branches, so the rule keeps `base`'s degree of exactness: with [`triangle`]`(n)`,
 /// polynomials of degree 2n - 2 on each side of an affine kink, whatever jumps across it.
-pub fn triangle_rule<'b>(
+pub fn triangle_rule<'b, K: Fn([f64; 2]) -> f64>(
     t: [[f64; 2]; 3],
-    kinks: &[&Kink],
+    kinks: &[K],
     base: &'b [(f64, f64, f64)],
 ) -> Cow<'b, [(f64, f64, f64)]> {
     let pieces = split_triangle(t, kinks);
@@ -253,13 +254,13 @@ pub fn triangle_rule<'b>(
 /// The parameters in (0, 1) where a kink crosses the segment a -> b (sorted): the segment's
 /// smooth pieces lie between them. Exact for affine kinks; a kink whose sign is the same at
 /// both ends is not seen (as in [`split_triangle`]).
-pub fn segment_breaks(a: [f64; 2], b: [f64; 2], kinks: &[&Kink]) -> Vec<f64> {
+pub fn segment_breaks<K: Fn([f64; 2]) -> f64>(a: [f64; 2], b: [f64; 2], kinks: &[K]) -> Vec<f64> {
     let mut out = Vec::new();
     for z in kinks {
         let (za, zb) = (z(a), z(b));
         let scale = za.abs().max(zb.abs());
         if sign(za, scale) * sign(zb, scale) == -1 {
-            out.push(zero_on_segment(a, b, za, zb, *z));
+            out.push(zero_on_segment(a, b, za, zb, z));
         }
     }
     out.sort_by(f64::total_cmp);
@@ -269,10 +270,10 @@ pub fn segment_breaks(a: [f64; 2], b: [f64; 2], kinks: &[&Kink]) -> Vec<f64> {
 /// A rule for the segment a -> b as (s, w), s in [0, 1] and weights summing to 1: `base` (a
 /// rule of [0, 1], as [`gauss_legendre`]) on each piece between the kinks' crossings
 /// ([`segment_breaks`]), so it keeps `base`'s degree on each smooth piece.
-pub fn segment_rule<'b>(
+pub fn segment_rule<'b, K: Fn([f64; 2]) -> f64>(
     a: [f64; 2],
     b: [f64; 2],
-    kinks: &[&Kink],
+    kinks: &[K],
     base: &'b [(f64, f64)],
 ) -> Cow<'b, [(f64, f64)]> {
     let breaks = segment_breaks(a, b, kinks);

@@ -6,6 +6,7 @@
 //! Data: README.md and reports/*/rates.csv, errors.csv as committed.
 
 use contact_rates::report::results::{RateLine, STUDIES, section};
+use contact_rates::study::rates::Verdict;
 use std::path::Path;
 
 fn root() -> &'static Path {
@@ -39,7 +40,7 @@ fn every_fitted_rate_agrees_with_its_last_successive_rates() {
         let mut reader = csv::Reader::from_path(&path).unwrap();
         for row in reader.deserialize::<RateLine>() {
             let r = row.unwrap();
-            if r.verdict != "fitted" {
+            if r.verdict != Verdict::Fitted {
                 continue;
             }
             let (rate, se) = (r.rate.unwrap(), r.stderr.unwrap());

@@ -5,6 +5,7 @@
 
 use crate::error::{Error, Result};
 use crate::study::quantity::Quantity;
+use crate::study::rates::Verdict;
 use serde::Deserialize;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -48,8 +49,18 @@ pub struct RateLine {
     pub levels_used: String,
     /// Successive rates, space separated.
     pub successive: String,
-    /// Verdict name.
-    pub verdict: String,
+    /// Verdict.
+    #[serde(deserialize_with = "verdict_by_name")]
+    pub verdict: Verdict,
+}
+
+/// A verdict read back from its name in rates.csv.
+fn verdict_by_name<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> std::result::Result<Verdict, D::Error> {
+    let name = String::deserialize(d)?;
+    Verdict::from_name(&name)
+        .ok_or_else(|| serde::de::Error::custom(format!("unknown verdict '{name}'")))
 }
 
 /// One row of a report's errors.csv (the columns read here).
@@ -90,10 +101,20 @@ fn rate_text(r: &RateLine) -> String {
         (Some(rate), Some(se)) => {
             format!(
                 "{rate:.3} ± {se:.3} ({}, levels {})",
-                r.verdict, r.levels_used
+                r.verdict.name(),
+                r.levels_used
             )
         }
-        _ => r.verdict.clone(),
+        _ => r.verdict.name().to_string(),
+    }
+}
+
+/// The items joined by "; ", or `none` where there are none.
+fn listed(items: &[String], none: &str) -> String {
+    if items.is_empty() {
+        none.to_string()
+    } else {
+        items.join("; ")
     }
 }
 
@@ -138,7 +159,7 @@ pub fn section(reports: &Path) -> Result<String> {
         let half: Vec<String> = rates
             .iter()
             .filter(|r| r.method == "nts" && r.quantity != "theorem")
-            .filter(|r| r.verdict == "fitted" || r.verdict == "drifting")
+            .filter(|r| matches!(r.verdict, Verdict::Fitted | Verdict::Drifting))
             .filter(|r| r.rate.is_some_and(|v| (v - 0.5).abs() <= NEAR_HALF))
             .map(|r| {
                 format!(
@@ -152,11 +173,7 @@ pub fn section(reports: &Path) -> Result<String> {
         let _ = writeln!(
             s,
             "- nts at h^(1/2) (a rate within {NEAR_HALF} of 0.5): {}.",
-            if half.is_empty() {
-                "no quantity".to_string()
-            } else {
-                half.join("; ")
-            }
+            listed(&half, "no quantity")
         );
         // Contact quantities that separate the cones at the finest level.
         let mut separate = Vec::new();
@@ -168,9 +185,7 @@ pub fn section(reports: &Path) -> Result<String> {
         {
             let q = r.quantity.as_str();
             let Some(nts) = rate("nts", q) else { continue };
-            let comparable =
-                |v: &str| matches!(v, "fitted" | "drifting" | "round-off" | "not converging");
-            if !comparable(&r.verdict) || !comparable(&nts.verdict) {
+            if !r.verdict.compares_cones() || !nts.verdict.compares_cones() {
                 not_compared.push(q.to_string());
                 continue;
             }
@@ -178,8 +193,8 @@ pub fn section(reports: &Path) -> Result<String> {
                 continue;
             };
             // A cone at round-off is exact: say so rather than divide by round-off.
-            let exact = |v: &str| v == "round-off";
-            let ratio = match (exact(&r.verdict), exact(&nts.verdict)) {
+            let exact = |v: Verdict| v == Verdict::RoundOff;
+            let ratio = match (exact(r.verdict), exact(nts.verdict)) {
                 (true, true) => 1.0,
                 (true, false) => f64::INFINITY,
                 (false, true) => 0.0,
@@ -208,11 +223,7 @@ pub fn section(reports: &Path) -> Result<String> {
         let _ = writeln!(
             s,
             "- Contact quantities that separate the cones at level {finest} (error ratio beyond {SEPARATES}): {}.{}",
-            if separate.is_empty() {
-                "none".to_string()
-            } else {
-                separate.join("; ")
-            },
+            listed(&separate, "none"),
             if agree.is_empty() {
                 String::new()
             } else {
@@ -229,7 +240,7 @@ pub fn section(reports: &Path) -> Result<String> {
         // What does not converge, and what carries no rate the numbers support.
         let stalled: Vec<String> = rates
             .iter()
-            .filter(|r| r.verdict == "not converging")
+            .filter(|r| r.verdict == Verdict::NotConverging)
             .map(|r| {
                 let e = error(&r.method, &r.quantity).map_or(String::new(), |e| {
                     format!(
@@ -240,24 +251,16 @@ pub fn section(reports: &Path) -> Result<String> {
                 format!("{} {}{e}", r.method, r.quantity)
             })
             .collect();
-        let _ = writeln!(
-            s,
-            "- Does not converge: {}.",
-            if stalled.is_empty() {
-                "nothing".to_string()
-            } else {
-                stalled.join("; ")
-            }
-        );
+        let _ = writeln!(s, "- Does not converge: {}.", listed(&stalled, "nothing"));
         let unfitted: Vec<String> = rates
             .iter()
             .filter(|r| {
                 matches!(
-                    r.verdict.as_str(),
-                    "pre-asymptotic" | "fixed by equilibrium" | "too few levels"
+                    r.verdict,
+                    Verdict::PreAsymptotic | Verdict::FixedByEquilibrium | Verdict::TooFewLevels
                 )
             })
-            .map(|r| format!("{} {} ({})", r.method, r.quantity, r.verdict))
+            .map(|r| format!("{} {} ({})", r.method, r.quantity, r.verdict.name()))
             .collect();
         if !unfitted.is_empty() {
             let _ = writeln!(s, "- No rate claimed: {}.", unfitted.join(", "));

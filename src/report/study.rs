@@ -654,20 +654,10 @@ fn verdict_text(r: &RateRow) -> String {
     }
 }
 
-/// Whether a verdict says what the errors do plainly enough to compare the cones on it:
-/// a fitted or drifting rate, exact, or not converging. Pre-asymptotic rates, tables too
-/// short to fit and quantities fixed by equilibrium are not compared.
-fn comparable(v: Verdict) -> bool {
-    matches!(
-        v,
-        Verdict::Fitted | Verdict::Drifting | Verdict::RoundOff | Verdict::NotConverging
-    )
-}
-
 /// The report's lead: what separates the cones, quantity by quantity, contact quantities
 /// first: the error at the finest level and the rate (or why there is none) of each cone,
-/// and a sentence per quantity; only quantities whose verdicts are [`comparable`] in every
-/// cone, the others named below the table with the reason.
+/// and a sentence per quantity; only quantities whose verdicts compare the cones in every
+/// cone ([`Verdict::compares_cones`]), the others named below the table with the reason.
 fn cones_compared(s: &mut String, res: &StudyResult) {
     let finest = *res.file.mesh.levels.last().expect("levels");
     let against = if res.reference.is_some() {
@@ -681,7 +671,7 @@ fn cones_compared(s: &mut String, res: &StudyResult) {
         res.file
             .methods
             .iter()
-            .all(|&m| rate_of(m, q).is_some_and(|r| comparable(r.assessment.verdict)))
+            .all(|&m| rate_of(m, q).is_some_and(|r| r.assessment.verdict.compares_cones()))
     };
     let ordered: Vec<Quantity> = res
         .file

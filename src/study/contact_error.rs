@@ -138,12 +138,9 @@ impl TruthPressure<'_> {
         match self {
             TruthPressure::Profile(f, _) => f[piece_index].iter().map(|p| p.0).collect(),
             TruthPressure::Exact(ex, t) => {
-                let kinks = ex.contact_kinks();
-                let functions = crate::expr::kink_functions(&kinks, *t);
-                let refs: Vec<&crate::quadrature::Kink> =
-                    functions.iter().map(|k| k.as_ref()).collect();
+                let kinks = crate::expr::kink_functions(&ex.contact_kinks(), *t);
                 let (a, b) = (piece.point(0.0), piece.point(piece.length));
-                crate::quadrature::segment_breaks(a, b, &refs)
+                crate::quadrature::segment_breaks(a, b, &kinks)
                     .into_iter()
                     .map(|r| r * piece.length)
                     .collect()

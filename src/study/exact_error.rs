@@ -61,10 +61,7 @@ impl<'a> ExactComparison<'a> {
             ..Default::default()
         };
         let band = super::contact_error::band(p);
-        let kinks = [0, 1].map(|b| ex.kinks(b));
-        let functions = [0, 1].map(|b| kink_functions(&kinks[b], t));
-        let refs: [Vec<&quadrature::Kink>; 2] =
-            [0, 1].map(|b| functions[b].iter().map(|k| k.as_ref()).collect());
+        let kinks = [0, 1].map(|b| kink_functions(&ex.kinks(b), t));
         for (i, el) in m.elements.iter().enumerate() {
             let b = el.body;
             let pos = el.nodes.map(|n| m.position(n));
@@ -78,7 +75,7 @@ impl<'a> ExactComparison<'a> {
                 }
             }
             let sh = [s.sigma[i][0], s.sigma[i][1], s.sigma[i][2]];
-            let rule = quadrature::triangle_rule(pos, &refs[b], &self.triangle);
+            let rule = quadrature::triangle_rule(pos, &kinks[b], &self.triangle);
             for &(l1, l2, w) in rule.iter() {
                 let lam = [1.0 - l1 - l2, l1, l2];
                 let x = [0, 1].map(|c| (0..3).map(|a| lam[a] * pos[a][c]).sum::<f64>());
@@ -117,14 +114,12 @@ impl<'a> ExactComparison<'a> {
     fn pressure_difference(&self, p: &Problem, s: &State) -> (f64, f64) {
         let t = s.time;
         let (mut diff, mut norm) = (0.0, 0.0);
-        let kinks = self.exact.contact_kinks();
-        let functions = kink_functions(&kinks, t);
-        let refs: Vec<&quadrature::Kink> = functions.iter().map(|k| k.as_ref()).collect();
+        let kinks = kink_functions(&self.exact.contact_kinks(), t);
         for (piece, profile) in p.interface.pieces.iter().zip(pressure_profile(p, s)) {
             for w in profile.windows(2) {
                 let ((xa, pa), (xb, pb)) = (w[0], w[1]);
                 let len = (xb[0] - xa[0]).hypot(xb[1] - xa[1]);
-                for &(q, wq) in quadrature::segment_rule(xa, xb, &refs, &self.segment).iter() {
+                for &(q, wq) in quadrature::segment_rule(xa, xb, &kinks, &self.segment).iter() {
                     let x = [xa[0] + q * (xb[0] - xa[0]), xa[1] + q * (xb[1] - xa[1])];
                     let exact = self
                         .exact

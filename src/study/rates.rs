@@ -119,11 +119,28 @@ impl Verdict {
         }
     }
 
-    /// Whether the verdict carries a rate to show (flagged unless [`Verdict::Fitted`]).
-    pub fn has_rate(self) -> bool {
+    /// The verdict named `name` in rates.csv ([`Verdict::name`]).
+    pub fn from_name(name: &str) -> Option<Verdict> {
+        [
+            Verdict::Fitted,
+            Verdict::Drifting,
+            Verdict::PreAsymptotic,
+            Verdict::TooFewLevels,
+            Verdict::NotConverging,
+            Verdict::RoundOff,
+            Verdict::FixedByEquilibrium,
+        ]
+        .into_iter()
+        .find(|v| v.name() == name)
+    }
+
+    /// Whether the verdict says what the errors do plainly enough to compare the cones on
+    /// it: a fitted or drifting rate, exact, or not converging. Pre-asymptotic rates, tables
+    /// too short to fit and quantities fixed by equilibrium are not compared.
+    pub fn compares_cones(self) -> bool {
         matches!(
             self,
-            Verdict::Fitted | Verdict::Drifting | Verdict::PreAsymptotic
+            Verdict::Fitted | Verdict::Drifting | Verdict::RoundOff | Verdict::NotConverging
         )
     }
 }
