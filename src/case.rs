@@ -390,6 +390,7 @@ pub fn verify_exact(
         .collect();
     let supports = support_samples(model, raw);
     let scales = exact_scales(ex, &contact, &supports, &times);
+    check_symmetry(model, ex, &times, scales.0)?;
     for &t in &times {
         let failure = contact
             .iter()
@@ -414,6 +415,36 @@ pub fn verify_exact(
                     x[0], x[1]
                 ),
             ));
+        }
+    }
+    Ok(())
+}
+
+/// Refuse a stress given as a full tensor whose off-diagonal entries differ (s12 != s21 at
+/// an element centroid, beyond round-off of the stress scale `s_scale`): a Cauchy stress is
+/// symmetric, and the solver stores one shear component.
+fn check_symmetry(model: &Model, ex: &Exact, times: &[f64], s_scale: f64) -> Result<()> {
+    for (b, asymmetry) in ex.asymmetry.iter().enumerate() {
+        let Some(d) = asymmetry else { continue };
+        for e in model.elements.iter().filter(|e| e.body == b) {
+            let p = e.nodes.map(|n| model.position(n));
+            let (x, y) = (
+                (p[0][0] + p[1][0] + p[2][0]) / 3.0,
+                (p[0][1] + p[1][1] + p[2][1]) / 3.0,
+            );
+            for &t in times {
+                let v = d.eval(x, y, t);
+                if !(v.abs() <= EXACT_TOL * s_scale) {
+                    return Err(Error::input(
+                        &model.scene.file,
+                        "exact.stress",
+                        format!(
+                            "the stress of body '{}' is not symmetric: s12 - s21 = {v:.3e} at (x, y) = ({x:.6}, {y:.6}), t = {t}; a Cauchy stress is symmetric: give s21 the same expression as s12",
+                            model.scene.bodies[b].surface
+                        ),
+                    ));
+                }
+            }
         }
     }
     Ok(())

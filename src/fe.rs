@@ -488,6 +488,49 @@ impl Model {
         Ok(f)
     }
 
+    /// The constitutive source of a manufactured solution at time `t`, per element: the
+    /// mean over the triangle of s = d sigma/dt - E eps(du/dt) - G(sigma) (stress per time;
+    /// its L2 projection onto the P0 stresses), by the loads' rule split along the exact
+    /// fields' kinks ([`quadrature::dunavant8`], [`quadrature::triangle_rule`]). None when
+    /// the scene's law needs no source: such a scene pays nothing.
+    pub fn constitutive_source(&self, t: f64) -> Result<Option<Vec<Stress>>> {
+        let Some(exact) = self.scene.exact.as_deref() else {
+            return Ok(None);
+        };
+        if exact.source_rate.is_none() {
+            return Ok(None);
+        }
+        let rule = quadrature::dunavant8();
+        let kinks = [0, 1].map(|b| kink_functions(&exact.kinks(b), t));
+        let mut out = Vec::with_capacity(self.elements.len());
+        for e in &self.elements {
+            let (b, p) = (e.body, e.nodes.map(|n| self.position(n)));
+            let mut mean = Stress::zeros();
+            for &(l1, l2, w) in quadrature::triangle_rule(p, &kinks[b], &rule).iter() {
+                let lam = [1.0 - l1 - l2, l1, l2];
+                let x = lam[0] * p[0][0] + lam[1] * p[1][0] + lam[2] * p[2][0];
+                let y = lam[0] * p[0][1] + lam[1] * p[1][1] + lam[2] * p[2][1];
+                let s = exact
+                    .source_at(b, &self.materials[b], x, y, t)
+                    .expect("a scene with a source rate has a stress");
+                if s.iter().any(|v| !v.is_finite()) {
+                    return Err(Error::input(
+                        &self.scene.file,
+                        "exact",
+                        format!(
+                            "the constitutive source derived from exact.stress and exact.displacement of body '{}' is not finite at x = {x}, y = {y}, t = {t}; fix the fields",
+                            self.scene.bodies[b].surface
+                        ),
+                    ));
+                }
+                // The rule's weights sum to 1 over the triangle: a mean, not an integral.
+                mean += w * Stress::from(s);
+            }
+            out.push(mean);
+        }
+        Ok(Some(out))
+    }
+
     /// Restrict a global-dof vector to the free equations.
     pub fn restrict(&self, v: &[f64]) -> Vec<f64> {
         let mut r = vec![0.0; self.n_free];
@@ -508,13 +551,16 @@ impl Model {
     }
 
     /// Constitutive update of every element: `sigma = sigma_prev + E (eps(u) - eps(u_prev))
-    /// + k G(sigma)`. Returns the stresses and, if `tangent`, the consistent tangents.
+    /// + k G(sigma) + k s` with `s` the element's constitutive source at t_n, if any
+    /// ([`Model::constitutive_source`]; it only shifts the trial stress). Returns the
+    /// stresses and, if `tangent`, the consistent tangents.
     pub fn update_stresses(
         &self,
         u: &[f64],
         u_prev: &[f64],
         sigma_prev: &[Stress],
         k: f64,
+        source: Option<&[Stress]>,
         tangent: bool,
     ) -> (Vec<Stress>, Vec<Matrix3<f64>>) {
         // Serial on purpose: a rayon version (chunks of 1024 triangles) was measured slower
@@ -524,7 +570,10 @@ impl Model {
         for (i, e) in self.elements.iter().enumerate() {
             let m = &self.materials[e.body];
             let de = e.strain(u) - e.strain(u_prev);
-            let trial = sigma_prev[i] + m.elastic.apply(&de);
+            let mut trial = sigma_prev[i] + m.elastic.apply(&de);
+            if let Some(source) = source {
+                trial += k * source[i];
+            }
             let (s, d) = m.update(&trial, k);
             sig.push(s);
             if tangent {

@@ -69,14 +69,40 @@ pub struct ContactSpec {
     pub master_curve: String,
 }
 
-/// Exact stress: one [s11, s22, s12] for both bodies, or one per body.
+/// Exact stress: components [s11, s22, s12] or the full tensor [[s11, s12], [s21, s22]]
+/// (whose symmetry is checked), for both bodies or one per body.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(untagged)]
 pub enum StressSpec {
-    /// The same stress in both bodies.
+    /// The same stress in both bodies, as [s11, s22, s12].
     Both([String; 3]),
-    /// One stress per body, in [[bodies]] order.
+    /// One stress per body, in [[bodies]] order, as [s11, s22, s12].
     PerBody([[String; 3]; 2]),
+    /// The same stress tensor in both bodies, [[s11, s12], [s21, s22]].
+    BothTensor([[String; 2]; 2]),
+    /// One stress tensor per body, in [[bodies]] order.
+    PerBodyTensor([[[String; 2]; 2]; 2]),
+}
+
+impl StressSpec {
+    /// The stress of body `i` (file order) as (field name, [s11, s22, s12], s21 when the
+    /// tensor form gives it with a text other than s12's).
+    fn of(&self, i: usize) -> (String, [&String; 3], Option<&String>) {
+        fn tensor(t: &[[String; 2]; 2], field: String) -> (String, [&String; 3], Option<&String>) {
+            let same = t[0][1].split_whitespace().collect::<String>()
+                == t[1][0].split_whitespace().collect::<String>();
+            (field, [&t[0][0], &t[1][1], &t[0][1]], (!same).then_some(&t[1][0]))
+        }
+        match self {
+            StressSpec::Both(s) => ("exact.stress".into(), [&s[0], &s[1], &s[2]], None),
+            StressSpec::PerBody(s) => {
+                let s = &s[i];
+                (format!("exact.stress[{i}]"), [&s[0], &s[1], &s[2]], None)
+            }
+            StressSpec::BothTensor(t) => tensor(t, "exact.stress".into()),
+            StressSpec::PerBodyTensor(t) => tensor(&t[i], format!("exact.stress[{i}]")),
+        }
+    }
 }
 
 /// Optional exact solution: what a study with `[reference] exact = true` measures against.
@@ -85,12 +111,15 @@ pub enum StressSpec {
 pub struct ExactSpec {
     /// Displacement [u_x, u_y] of each body, in [[bodies]] order (length).
     pub displacement: Option<[[String; 2]; 2]>,
-    /// Stress [s11, s22, s12] (derived from the displacement of elastic bodies when omitted).
+    /// Stress [s11, s22, s12] or [[s11, s12], [s21, s22]] (derived from the displacement
+    /// of elastic bodies when omitted; required with the displacement of a manufactured
+    /// viscoplastic body, whose constitutive source needs both).
     pub stress: Option<StressSpec>,
     /// Contact pressure on Gamma_C (force/length; -sigma_nn of the slave when omitted).
     pub pressure: Option<String>,
-    /// The displacement is manufactured: the body forces and the tractions on the Neumann
-    /// curves are derived from it (elastic bodies only).
+    /// The fields are manufactured: the body forces f = -div sigma and the tractions
+    /// sigma n on the Neumann curves are derived from them, and where the stress is given
+    /// the constitutive source s = d sigma/dt - E eps(du/dt) - G(sigma).
     #[serde(default)]
     pub manufactured: bool,
 }
@@ -408,7 +437,7 @@ impl Scene {
                     return Err(Error::input(
                         file,
                         format!("traction[{i}].g"),
-                        "a manufactured scene derives g = sigma(u) n from exact.displacement; remove g",
+                        "a manufactured scene derives g = sigma n from the exact fields; remove g",
                     ));
                 }
             };
@@ -477,20 +506,20 @@ fn exact_solution(
         Some([[a, b], [c, d]]) => Some([[a?, b?], [c?, d?]]),
         None => None,
     };
-    let stress_text = |b: usize| -> Option<(String, &[String; 3])> {
-        match spec.stress.as_ref()? {
-            StressSpec::Both(s) => Some(("exact.stress".into(), s)),
-            StressSpec::PerBody(s) => Some((format!("exact.stress[{}]", order(b)), &s[order(b)])),
-        }
-    };
     let mut stress = Vec::new();
+    let mut asymmetry = [None, None];
     for b in 0..2 {
-        if let Some((field, s)) = stress_text(b) {
+        if let Some(spec) = &spec.stress {
+            let (field, s, s21) = spec.of(order(b));
             stress.push([
-                Expr::parse(&s[0], file, &format!("{field}[0]"))?,
-                Expr::parse(&s[1], file, &format!("{field}[1]"))?,
-                Expr::parse(&s[2], file, &format!("{field}[2]"))?,
+                Expr::parse(s[0], file, &format!("{field}[0]"))?,
+                Expr::parse(s[1], file, &format!("{field}[1]"))?,
+                Expr::parse(s[2], file, &format!("{field}[2]"))?,
             ]);
+            if let Some(s21) = s21 {
+                let s21 = Expr::parse(s21, file, &format!("{field}[1][0]"))?;
+                asymmetry[b] = Some(Expr::combine(&[(1.0, &stress[b][2]), (-1.0, &s21)]));
+            }
         }
     }
     let stress: Option<[[Expr; 3]; 2]> = stress.try_into().ok();
@@ -508,12 +537,12 @@ fn exact_solution(
             ));
         }
         for b in bodies.iter() {
-            if b.material.viscoplastic.is_some() {
+            if b.material.viscoplastic.is_some() && stress.is_none() {
                 return Err(Error::input(
                     file,
-                    "exact.manufactured",
+                    "exact.stress",
                     format!(
-                        "body '{}' is viscoplastic; manufactured solutions are for elastic bodies: remove its lambda and yield_stress",
+                        "body '{}' is viscoplastic: the constitutive source s = d sigma/dt - E eps(du/dt) - G(sigma) of a manufactured solution needs its stress; give exact.stress = [[\"s11\", \"s22\", \"s12\"], [\"s11\", \"s22\", \"s12\"]], one per body (or remove lambda and yield_stress for an elastic body)",
                         b.surface
                     ),
                 ));
@@ -523,27 +552,21 @@ fn exact_solution(
                     file,
                     "exact.manufactured",
                     format!(
-                        "body '{}' gives a body_force; a manufactured scene derives it from exact.displacement: remove it",
+                        "body '{}' gives a body_force; a manufactured scene derives it from the exact fields: remove it",
                         b.surface
                     ),
                 ));
             }
         }
-        if stress.is_some() {
-            return Err(Error::input(
-                file,
-                "exact.stress",
-                "a manufactured scene derives the stress from exact.displacement; remove exact.stress",
-            ));
-        }
     }
-    let exact = Exact::new(
+    let mut exact = Exact::new(
         displacement,
         stress,
         pressure,
         spec.manufactured,
         [&bodies[0].material, &bodies[1].material],
     );
+    exact.asymmetry = asymmetry;
     if let Some(f) = &exact.body_force {
         for (b, body) in bodies.iter_mut().enumerate() {
             body.body_force = Some(VectorExpr(f[b].clone()));

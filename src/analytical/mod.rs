@@ -1,7 +1,10 @@
 //! Closed-form and manufactured solutions as first-class code: a scene's exact solution
 //! (displacement and stress of each body, the contact pressure on Gamma_C), with what
 //! follows from it by exact symbolic differentiation: the gradient, the stress of an
-//! elastic body, and for a manufactured solution the body force f = -div sigma(u).
+//! elastic body, and for a manufactured solution the body force f = -div sigma and, where
+//! the stress is given with the displacement (a viscoplastic body), the constitutive source
+//! s = d sigma/dt - E eps(du/dt) - G(sigma) (SPEC section 5, Roache's method of
+//! manufactured solutions with a source in every equation the fields do not satisfy).
 //!
 //! [`stacked`] derives the closed form of the `stacked-exact` scene.
 
@@ -28,8 +31,17 @@ pub struct Exact {
     /// Contact pressure on Gamma_C (force/length), if given; otherwise -sigma_nn of the
     /// slave's stress where the stress is known.
     pub pressure: Option<Expr>,
-    /// Body force f = -div sigma(u) of each body, for a manufactured solution.
+    /// Body force f = -div sigma of each body, for a manufactured solution.
     pub body_force: Option<[[Expr; 2]; 2]>,
+    /// The part of the constitutive source that is linear in the fields,
+    /// d sigma/dt - E eps(du/dt) of each body (stress per time), for a manufactured solution
+    /// whose stress is given with its displacement; the source is this minus G(sigma)
+    /// ([`Exact::source_at`]). None: the law needs no source (an elastic manufactured
+    /// solution, whose stress is E eps(u)).
+    pub source_rate: Option<[StressField; 2]>,
+    /// s12 - s21 of a body whose stress was given as a full tensor with different
+    /// off-diagonal texts: checked to vanish on the mesh before anything is solved.
+    pub asymmetry: [Option<Expr>; 2],
 }
 
 /// What an exact solution gives, for messages.
@@ -70,6 +82,14 @@ pub fn elastic_stress(material: &Material, g: &[[Expr; 2]; 2]) -> StressField {
     ]
 }
 
+/// d sigma/dt - E eps(du/dt) of one body: the linear part of the constitutive source of a
+/// manufactured solution with displacement gradient `g` and stress `s`.
+pub fn source_rate(material: &Material, g: &[[Expr; 2]; 2], s: &StressField) -> StressField {
+    let dg = g.each_ref().map(|row| row.each_ref().map(|e| e.partial(2)));
+    let elastic_rate = elastic_stress(material, &dg);
+    [0, 1, 2].map(|c| Expr::combine(&[(1.0, &s[c].partial(2)), (-1.0, &elastic_rate[c])]))
+}
+
 /// The body force that balances a stress field: f = -div sigma.
 pub fn body_force(s: &StressField) -> [Expr; 2] {
     [
@@ -81,7 +101,8 @@ pub fn body_force(s: &StressField) -> [Expr; 2] {
 impl Exact {
     /// Complete what is given: the gradient of a given displacement, the stress of an
     /// elastic body from it (when not given), and for a manufactured solution the body
-    /// forces. `materials` are the bodies' in scene order.
+    /// forces and, where the stress is given with the displacement, the constitutive
+    /// source. `materials` are the bodies' in scene order.
     pub fn new(
         displacement: Option<[Displacement; 2]>,
         stress: Option<[StressField; 2]>,
@@ -93,6 +114,7 @@ impl Exact {
             .as_ref()
             .map(|u| [gradient(&u[0]), gradient(&u[1])]);
         let elastic = materials.iter().all(|m| m.viscoplastic.is_none());
+        let stress_given = stress.is_some();
         let stress = stress.or_else(|| {
             let g = gradient.as_ref().filter(|_| elastic)?;
             Some([0, 1].map(|b| elastic_stress(materials[b], &g[b])))
@@ -101,13 +123,32 @@ impl Exact {
             .as_ref()
             .filter(|_| manufactured)
             .map(|s| [body_force(&s[0]), body_force(&s[1])]);
+        let source_rate = match (&gradient, &stress) {
+            (Some(g), Some(s)) if manufactured && stress_given => {
+                Some([0, 1].map(|b| source_rate(materials[b], &g[b], &s[b])))
+            }
+            _ => None,
+        };
         Exact {
             displacement,
             gradient,
             stress,
             pressure,
             body_force,
+            source_rate,
+            asymmetry: [None, None],
         }
+    }
+
+    /// The constitutive source s = d sigma/dt - E eps(du/dt) - G(sigma) of body `b` (with
+    /// its `material`) at (x, y, t), stress per time; None when the law needs none. Added
+    /// as `k s(t_n)` to the backward-Euler update, it makes fields affine in t satisfy the
+    /// time-discrete law exactly.
+    pub fn source_at(&self, b: usize, material: &Material, x: f64, y: f64, t: f64) -> Option<[f64; 3]> {
+        let rate = &self.source_rate.as_ref()?[b];
+        let sigma = nalgebra::Vector3::from(self.stress_at(b, x, y, t)?);
+        let g = material.g(&sigma);
+        Some([0, 1, 2].map(|c| rate[c].eval(x, y, t) - g[c]))
     }
 
     /// Whether the exact solution gives `field` (the pressure also follows from the stress).
@@ -131,6 +172,9 @@ impl Exact {
         }
         if let Some(s) = &self.stress {
             fields.extend(s[b].iter());
+        }
+        if let Some(r) = &self.source_rate {
+            fields.extend(r[b].iter());
         }
         crate::expr::distinct_kinks(fields)
     }

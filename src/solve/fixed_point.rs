@@ -270,12 +270,19 @@ impl StepSolver for FixedPoint<'_> {
         let p = self.p;
         let model = &p.model;
         let f_ext = model.load(t)?;
-        // Shift of (4.2): E eps(u^{n-1}) - sigma^{n-1} per element.
+        // k s of a manufactured solution's constitutive source: added to sigma with k eta.
+        let source: Vec<Stress> = match model.constitutive_source(t)? {
+            Some(s) => s.iter().map(|s| k * s).collect(),
+            None => vec![Stress::zeros(); model.elements.len()],
+        };
+        // Shift of (4.2): E eps(u^{n-1}) - sigma^{n-1} - k s per element.
         let shift: Vec<Stress> = model
             .elements
             .iter()
             .enumerate()
-            .map(|(i, e)| model.materials[e.body].elastic.apply(&e.strain(&prev.u)) - prev.sigma[i])
+            .map(|(i, e)| {
+                model.materials[e.body].elastic.apply(&e.strain(&prev.u)) - prev.sigma[i] - source[i]
+            })
             .collect();
         let mut eta: Vec<Stress> = match &self.eta {
             Some(e) => e.clone(),
@@ -305,7 +312,8 @@ impl StepSolver for FixedPoint<'_> {
             let (un, lambda, inner) = self.contact_subproblem(&b, &u)?;
             inner_total += inner;
             u = un;
-            // (4.3): sigma_eta = sigma^{n-1} + E eps(u) - E eps(u^{n-1}) + k eta; eta' = G(sigma_eta).
+            // (4.3): sigma_eta = sigma^{n-1} + E eps(u) - E eps(u^{n-1}) + k eta (+ k s);
+            // eta' = G(sigma_eta).
             let sigma: Vec<Stress> = model
                 .elements
                 .iter()
@@ -316,6 +324,7 @@ impl StepSolver for FixedPoint<'_> {
                             .elastic
                             .apply(&(e.strain(&u) - e.strain(&prev.u)))
                         + k * eta[i]
+                        + source[i]
                 })
                 .collect();
             let eta_new: Vec<Stress> = model

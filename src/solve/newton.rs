@@ -397,6 +397,8 @@ struct Evaluation {
 struct StepData<'s> {
     prev: &'s State,
     k: f64,
+    /// The constitutive source per element at t_n (a manufactured solution's), if any.
+    source: Option<Vec<Stress>>,
     f_ext: Vec<f64>,
     f_free: Vec<f64>,
 }
@@ -414,7 +416,14 @@ impl Newton<'_> {
     fn evaluate(&self, data: &StepData, u: &[f64], lambda: &[f64]) -> Evaluation {
         let (model, clock) = (&self.p.model, &self.clock);
         let (sigma, tangents) = timed(&clock.constitutive, || {
-            model.update_stresses(u, &data.prev.u, &data.prev.sigma, data.k, true)
+            model.update_stresses(
+                u,
+                &data.prev.u,
+                &data.prev.sigma,
+                data.k,
+                data.source.as_deref(),
+                true,
+            )
         });
         let f_int = timed(&clock.assembly, || model.internal_force(&sigma));
         let mut r = f_int.clone();
@@ -655,9 +664,11 @@ impl StepSolver for Newton<'_> {
         let model = &self.p.model;
         let (n, m, c) = (self.n, self.p.rows.len(), self.c_scale);
         let f_ext = model.load(t)?;
+        let source = timed(&self.clock.constitutive, || model.constitutive_source(t))?;
         let data = StepData {
             prev,
             k,
+            source,
             f_free: model.restrict(&f_ext),
             f_ext,
         };
