@@ -500,7 +500,7 @@ impl Model {
         if exact.source_rate.is_none() {
             return Ok(None);
         }
-        let rule = quadrature::dunavant8();
+        let rule = quadrature::triangle(2);
         let kinks = [0, 1].map(|b| kink_functions(&exact.kinks(b), t));
         let mut out = Vec::with_capacity(self.elements.len());
         for e in &self.elements {

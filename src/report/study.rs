@@ -6,7 +6,7 @@ use super::plot::{self, Panel, Series};
 use crate::contact::Method;
 use crate::error::Result;
 use crate::io::{csv_bytes, fmt3};
-use crate::study::convergence::{RateRow, Source, StudyResult, join};
+use crate::study::convergence::{RateRow, Source, StudyResult, TimeStudy, join};
 use crate::study::file::Threshold;
 use crate::study::quantity::Quantity;
 use crate::study::rates::{self, Verdict};
@@ -103,7 +103,11 @@ fn threshold_text(t: Threshold, digits: usize) -> String {
 }
 
 fn fmt_rate(r: &RateRow) -> String {
-    let a = &r.assessment;
+    fmt_assessment(&r.assessment)
+}
+
+/// A judged rate with its standard error, or the verdict that replaces it.
+fn fmt_assessment(a: &rates::Assessment) -> String {
     match (a.verdict, a.fit) {
         (Verdict::Fitted, Some(f)) => format!("{:.3} ± {:.3}", f.rate, f.stderr),
         (Verdict::Drifting, Some(f)) => format!(
@@ -163,6 +167,9 @@ pub fn write_study(res: &StudyResult, dir: &Path) -> Result<()> {
                 .collect();
             write(d, "variants.csv", &csv_bytes(&rows)?)?;
         }
+        if let Some(ts) = &res.time_study {
+            write(d, "time.csv", &csv_bytes(&ts.runs)?)?;
+        }
         plots(res, d)?;
         write(d, "README.md", readme(res).as_bytes())
     })
@@ -172,6 +179,9 @@ fn plots(res: &StudyResult, d: &Path) -> Result<()> {
     error_vs_h(res, d)?;
     contact_vs_h(res, d)?;
     error_vs_time(res, d)?;
+    if let Some(ts) = &res.time_study {
+        error_vs_k(res, ts, d)?;
+    }
     profiles(res, d)?;
     von_mises(res, d)
 }
@@ -256,6 +266,45 @@ fn error_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
         &format!("relative error ({})", quantity_label(key)),
         &series,
         &[(0.5, "1/2"), (0.75, "3/4"), (1.0, "1")],
+    )
+}
+
+/// The time study's error against k, with the fitted slope in the legend.
+fn error_vs_k(res: &StudyResult, ts: &TimeStudy, d: &Path) -> Result<()> {
+    let mut series = vec![Series {
+        label: format!("{} (theorem norm)", ts.method),
+        points: ts.runs.iter().map(|r| (r.k, r.error)).collect(),
+        markers: true,
+        line: false,
+        color: 0,
+        thin: false,
+    }];
+    let a = &ts.assessment;
+    let used: Vec<f64> = a.used.iter().map(|&i| ts.runs[i].k).collect();
+    if let Some(fit) = a.fit.filter(|_| used.len() >= 2) {
+        let ks = [
+            used.iter().copied().fold(f64::INFINITY, f64::min),
+            used.iter().copied().fold(0.0, f64::max),
+        ];
+        series.push(Series {
+            label: format!("fit: slope {:.2} ± {:.2} ({})", fit.rate, fit.stderr, a.verdict.name()),
+            points: ks
+                .iter()
+                .map(|&k| (k, (fit.intercept + fit.rate * k.ln()).exp()))
+                .collect(),
+            markers: false,
+            line: true,
+            color: 0,
+            thin: false,
+        });
+    }
+    plot::loglog(
+        &d.join("error_vs_k.png"),
+        &format!("{}: error against the time step ({}, level {})", res.name, ts.scene, ts.level),
+        "k (time step)",
+        "relative error (theorem norm)",
+        &series,
+        &[(1.0, "1")],
     )
 }
 
@@ -495,21 +544,7 @@ fn readme(res: &StudyResult) -> String {
     }
     alignment(&mut s, res);
     if let Some(ts) = &res.time_study {
-        let _ = writeln!(
-            s,
-            "## Rate in time\n\nFixed mesh (level {}), k halved, against a reference with {} steps on the same mesh:\n\n| steps | k | theorem error |\n|---|---|---|",
-            ts.level, ts.reference_steps
-        );
-        for r in &ts.runs {
-            let _ = writeln!(s, "| {} | {:.4} | {:.3e} |", r.steps, r.k, r.error);
-        }
-        if let Some(f) = ts.fit {
-            let _ = writeln!(
-                s,
-                "\nRate in k: **{:.3} ± {:.3}** (backward Euler: 1).\n",
-                f.rate, f.stderr
-            );
-        }
+        time_section(&mut s, ts);
     }
     let _ = writeln!(
         s,
@@ -534,6 +569,49 @@ fn readme(res: &StudyResult) -> String {
         "\nData: `errors.csv`, `rates.csv`, `levels.csv`, `pressure.csv`, `gap.csv`."
     );
     s
+}
+
+/// The rate in time: the runs, the truth they are measured against, and the judged rate.
+fn time_section(s: &mut String, ts: &TimeStudy) {
+    let truth = match ts.reference_steps {
+        Some(r) => format!("a reference with {r} steps on the same mesh, at the common time points"),
+        None => format!(
+            "the exact solution of scene `{}` at every step (no reference in time)",
+            ts.scene
+        ),
+    };
+    let _ = writeln!(
+        s,
+        "## Rate in time
+
+Scene `{}`, {}, fixed mesh (level {}, h = {:.4}, {} dofs), k halved from run to run, each run against {truth}. Theorem 3.1 bounds the error by C (h^r + k): backward Euler's k term has rate 1. The rate in k is judged as a rate in h is (the same windows and verdicts); data in `time.csv`.\n\n![error against k](error_vs_k.png)\n\n| steps | k | theorem error | successive rate | plastic fraction at T | solve (s) |\n|---|---|---|---|---|---|",
+        ts.scene, ts.method, ts.level, ts.h, ts.dofs
+    );
+    for (i, r) in ts.runs.iter().enumerate() {
+        let rate = (i > 0).then(|| {
+            let p = &ts.runs[i - 1];
+            (p.error / r.error).ln() / (p.k / r.k).ln()
+        });
+        let _ = writeln!(
+            s,
+            "| {} | {:.5} | {:.3e} | {} | {:.3} | {:.2} |",
+            r.steps,
+            r.k,
+            r.error,
+            rate.map_or("-".into(), |v| format!("{v:.3}")),
+            r.plastic_fraction,
+            r.wall_s
+        );
+    }
+    let a = &ts.assessment;
+    let steps: Vec<String> = a.used.iter().map(|&i| ts.runs[i].steps.to_string()).collect();
+    let _ = writeln!(
+        s,
+        "\nRate in k: **{}**, verdict `{}`, fitted on the step counts {} (backward Euler: 1).\n",
+        fmt_assessment(a),
+        a.verdict.name(),
+        if steps.is_empty() { "-".into() } else { steps.join(", ") }
+    );
 }
 
 /// What `study NAME` prints: the rates with their thresholds, the theorem error per level,
@@ -568,6 +646,24 @@ pub fn console(res: &StudyResult, dir: &Path) -> String {
             s,
             "{} level {} h {:.4} dofs {} error {:.4e} ({:.2} s)",
             e.method, e.level, e.h, e.dofs, e.error, e.wall_s
+        );
+    }
+    if let Some(ts) = &res.time_study {
+        for r in &ts.runs {
+            let _ = writeln!(
+                s,
+                "time study {} level {} steps {} k {:.5} error {:.4e} ({:.2} s)",
+                ts.scene, ts.level, r.steps, r.k, r.error, r.wall_s
+            );
+        }
+        let a = &ts.assessment;
+        let _ = writeln!(
+            s,
+            "time study rate in k {:>6} +- {} (steps {}) {}",
+            fmt3(a.fit.map_or(f64::NAN, |f| f.rate)),
+            fmt3(a.fit.map_or(f64::NAN, |f| f.stderr)),
+            a.used.iter().map(|&i| ts.runs[i].steps.to_string()).collect::<Vec<_>>().join(" "),
+            a.verdict.name()
         );
     }
     match res.reference {

@@ -20,7 +20,7 @@ use super::exact_error::{
 use super::file::{StudyFile, Threshold};
 use super::jobs::{self, Job, JobId, Mode, Solved};
 use super::quantity::{Differences, Quantity};
-use super::rates::{self, Assessment, Fit, LevelError, Verdict};
+use super::rates::{self, Assessment, LevelError, Verdict};
 use crate::analytical::{Exact, Field};
 use crate::case::Case;
 use crate::contact::Method;
@@ -188,27 +188,39 @@ pub struct Reference {
 }
 
 /// One run of the time study.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Serialize)]
 pub struct TimeRun {
     /// Time steps.
     pub steps: usize,
     /// Step length k (time).
     pub k: f64,
-    /// Relative theorem-norm error against the time reference.
+    /// Relative theorem-norm error (max over the steps) against the truth in time.
     pub error: f64,
+    /// Plastic fraction at T.
+    pub plastic_fraction: f64,
+    /// Wall time of the solve (s).
+    pub wall_s: f64,
 }
 
 /// The rate in time on a fixed mesh.
 #[derive(Debug, Clone)]
 pub struct TimeStudy {
+    /// Scene of the runs.
+    pub scene: String,
+    /// Cone of the runs.
+    pub method: Method,
     /// Mesh level.
     pub level: usize,
-    /// Steps of the reference in time.
-    pub reference_steps: usize,
+    /// Max element diameter of that mesh (length).
+    pub h: f64,
+    /// Free dofs of that mesh.
+    pub dofs: usize,
+    /// Steps of the reference in time; None: measured against the exact solution.
+    pub reference_steps: Option<usize>,
     /// The runs, k halved from one to the next.
     pub runs: Vec<TimeRun>,
-    /// The fitted rate in k.
-    pub fit: Option<Fit>,
+    /// The rate in k judged like a rate in h ([`rates::assess`], k in place of h).
+    pub assessment: Assessment,
 }
 
 /// Everything a study measured.
@@ -292,6 +304,18 @@ struct Study {
     text: String,
     file: StudyFile,
     scene: Scene,
+    /// The time study's scene, where it is not the study's own.
+    time_scene: Option<Scene>,
+}
+
+/// A scene named by a study file: a path relative to the study file, else a built-in name.
+fn study_scene(path: &Path, name: &str) -> Result<Scene> {
+    let scene_path = path.parent().unwrap_or(Path::new(".")).join(name);
+    if scene_path.exists() {
+        Scene::load(&scene_path.display().to_string())
+    } else {
+        Scene::load(name)
+    }
 }
 
 impl Study {
@@ -299,15 +323,16 @@ impl Study {
         let path = super::file::resolve(name).ok_or_else(|| super::unknown_study(name))?;
         let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
         let file = StudyFile::from_toml(&text, &path)?;
-        // A scene path is relative to the study file; otherwise it is a built-in name.
-        let scene_path = path.parent().unwrap_or(Path::new(".")).join(&file.scene);
-        let scene = if scene_path.exists() {
-            Scene::load(&scene_path.display().to_string())?
-        } else {
-            Scene::load(&file.scene)?
+        let scene = study_scene(&path, &file.scene)?;
+        let time_scene = match file.time.as_ref().and_then(|t| t.scene.as_ref()) {
+            Some(name) => Some(study_scene(&path, name)?),
+            None => None,
         };
         if file.reference.exact {
             check_covered(&file, &scene, &path)?;
+            if let Some(ts) = &time_scene {
+                check_time_covered(ts, &path)?;
+            }
         }
         Ok(Study {
             name: path.file_stem().unwrap().to_string_lossy().to_string(),
@@ -315,6 +340,7 @@ impl Study {
             text,
             file,
             scene,
+            time_scene,
         })
     }
 
@@ -372,6 +398,25 @@ fn check_covered(file: &StudyFile, scene: &Scene, path: &Path) -> Result<()> {
     Ok(())
 }
 
+/// The time study measures the theorem norm: its scene's exact solution must give the
+/// displacement and the stress.
+fn check_time_covered(scene: &Scene, path: &Path) -> Result<()> {
+    let covered = scene.exact.as_deref().is_some_and(|e| {
+        needs(Quantity::Theorem).iter().all(|f| e.gives(*f))
+    });
+    if covered {
+        return Ok(());
+    }
+    Err(Error::input(
+        path,
+        "time.scene",
+        format!(
+            "scene '{}' gives no exact displacement and stress, which the time study measures against (reference.exact = true); add them to its [exact] table or choose another scene",
+            scene.name
+        ),
+    ))
+}
+
 /// The study's solves, with a named handle for each.
 struct Plan {
     jobs: Vec<Job>,
@@ -382,8 +427,9 @@ struct Plan {
     levels: Vec<(Method, usize, JobId)>,
     /// The variant families: their coarsest size and their levels like `levels`.
     variants: Vec<(f64, Vec<(Method, usize, JobId)>)>,
-    /// The time study: its reference, then one run per step count.
-    time: Option<(JobId, Vec<(usize, JobId)>)>,
+    /// The time study: its reference in time (none against the exact solution), then one
+    /// run per step count.
+    time: Option<(Option<JobId>, Vec<(usize, JobId)>)>,
 }
 
 impl Plan {
@@ -395,11 +441,13 @@ impl Plan {
         let family = sf.family_parameters();
         let reference_parameters = sf.reference_parameters();
         let mut jobs = Vec::new();
+        let time_scene = usize::from(study.time_scene.is_some());
         let mut add = |label: String,
                        method: Method,
                        level: usize,
                        params: &[(String, f64)],
-                       steps: usize| {
+                       steps: usize,
+                       scene: usize| {
             jobs.push(Job {
                 id: jobs.len(),
                 label,
@@ -407,6 +455,7 @@ impl Plan {
                 level,
                 params: params.to_vec(),
                 steps,
+                scene,
             });
             jobs.len() - 1
         };
@@ -419,6 +468,7 @@ impl Plan {
                     l,
                     &reference_parameters,
                     sf.steps,
+                    0,
                 )
             })
         });
@@ -431,6 +481,7 @@ impl Plan {
                     level,
                     &family,
                     sf.steps,
+                    0,
                 );
                 levels.push((method, level, id));
             }
@@ -442,34 +493,29 @@ impl Plan {
             for &method in &sf.methods {
                 for &level in &sf.mesh.levels {
                     let label = format!("{method} level {level} (family {coarsest})");
-                    runs.push((method, level, add(label, method, level, &params, sf.steps)));
+                    runs.push((method, level, add(label, method, level, &params, sf.steps, 0)));
                 }
             }
             variants.push((coarsest, runs));
         }
         let time = sf.time.as_ref().map(|ts| {
             let method = sf.methods[0];
-            let reference = add(
-                format!("time reference ({} steps)", ts.reference_steps),
-                method,
-                ts.level,
-                &family,
-                ts.reference_steps,
-            );
+            let reference = ts.reference_steps.map(|r| {
+                add(
+                    format!("time reference ({r} steps)"),
+                    method,
+                    ts.level,
+                    &family,
+                    r,
+                    time_scene,
+                )
+            });
             let runs = ts
                 .steps
                 .iter()
                 .map(|&n| {
-                    (
-                        n,
-                        add(
-                            format!("time study ({n} steps)"),
-                            method,
-                            ts.level,
-                            &family,
-                            n,
-                        ),
-                    )
+                    let label = format!("time study ({n} steps)");
+                    (n, add(label, method, ts.level, &family, n, time_scene))
                 })
                 .collect();
             (reference, runs)
@@ -1005,39 +1051,124 @@ fn fit_rates(
     Ok(out)
 }
 
-/// Step 5: the rate in time on a fixed mesh, each run against the reference in time at the
-/// common time points.
-fn time_study(sf: &StudyFile, plan: &Plan, solved: &mut Solved) -> Option<TimeStudy> {
-    let ts = sf.time.as_ref()?;
-    let (reference_id, run_ids) = plan.time.as_ref()?;
-    let (case, reference) = solved.take(*reference_id);
-    let model = &case.problem.model;
-    let runs: Vec<TimeRun> = run_ids
+/// Step 5: the rate in time on a fixed mesh: each run against the reference in time at the
+/// common time points, or against the exact solution of the time study's scene at every
+/// step (`points`: the Gauss points per direction of the error rule). The rate in k is
+/// judged as a rate in h is ([`rates::assess`]: the same windows and verdicts).
+fn time_study(
+    study: &Study,
+    plan: &Plan,
+    solved: &mut Solved,
+    points: usize,
+) -> Result<Option<TimeStudy>> {
+    let sf = &study.file;
+    let (Some(ts), Some((reference_id, run_ids))) = (sf.time.as_ref(), plan.time.as_ref()) else {
+        return Ok(None);
+    };
+    let reference = reference_id.map(|id| solved.take(id));
+    let runs: Vec<(usize, Case, Solution)> = run_ids
         .iter()
         .map(|&(steps, id)| {
-            let (_, sol) = solved.take(id);
-            let stride = ts.reference_steps / steps;
-            let (mut error, mut norm) = (0.0f64, 0.0f64);
-            for (i, state) in sol.states.iter().enumerate().skip(1) {
-                let r = &reference.states[i * stride];
-                error = error.max(error::norms_of_difference(model, state, r).theorem());
-                norm = norm.max(error::norms(model, r).theorem());
-            }
-            TimeRun {
-                steps,
-                k: model.scene.final_time / steps as f64,
-                error: error / norm,
-            }
+            let (case, sol) = solved.take(id);
+            (steps, case, sol)
         })
         .collect();
-    let ks: Vec<f64> = runs.iter().map(|r| r.k).collect();
-    let es: Vec<f64> = runs.iter().map(|r| r.error).collect();
-    Some(TimeStudy {
+    let scene = study.time_scene.as_ref().unwrap_or(&study.scene);
+    let errors: Vec<f64> = match &reference {
+        Some((_, reference)) => runs
+            .par_iter()
+            .map(|(steps, case, sol)| time_reference_error(case, sol, reference, *steps))
+            .collect(),
+        None => {
+            let exact = scene.exact.as_deref().expect("checked when the study was read");
+            time_exact_errors(&runs, exact, points)
+        }
+    };
+    let case = &runs[0].1;
+    let model = &case.problem.model;
+    let runs: Vec<TimeRun> = runs
+        .iter()
+        .zip(&errors)
+        .map(|((steps, case, sol), &error)| TimeRun {
+            steps: *steps,
+            k: model.scene.final_time / *steps as f64,
+            error,
+            plastic_fraction: metrics::plastic_fraction(&case.problem, sol.last()),
+            wall_s: sol.wall_s,
+        })
+        .collect();
+    if let Some(r) = runs.iter().find(|r| !r.error.is_finite()) {
+        return Err(Error::NotConverged(format!(
+            "time study ({} steps): the theorem error is not finite",
+            r.steps
+        )));
+    }
+    let levels: Vec<LevelError> = runs
+        .iter()
+        .enumerate()
+        .map(|(i, r)| LevelError {
+            level: i,
+            h: r.k,
+            dofs: r.steps as f64,
+            error: r.error,
+        })
+        .collect();
+    let assessment = rates::assess(&levels, 0.0).map_err(|e| {
+        Error::input(&study.path, "time.steps", format!("time study: {e}"))
+    })?;
+    Ok(Some(TimeStudy {
+        scene: scene.name.clone(),
+        method: case.problem.method,
         level: ts.level,
+        h: case.h,
+        dofs: model.n_free,
         reference_steps: ts.reference_steps,
-        fit: rates::fit(&ks, &es),
         runs,
-    })
+        assessment,
+    }))
+}
+
+/// The relative theorem-norm error of each run against the exact solution: max over the
+/// steps of ||e||, relative to the max of the exact solution's norm (as
+/// [`Differences::relative`] has it). Every state of every run is measured in parallel: the
+/// longest run alone would otherwise set the wall time.
+fn time_exact_errors(runs: &[(usize, Case, Solution)], exact: &Exact, points: usize) -> Vec<f64> {
+    let cmp = ExactComparison::new(exact, points);
+    let states: Vec<(usize, &crate::solve::State)> = runs
+        .iter()
+        .enumerate()
+        .flat_map(|(r, (_, _, sol))| sol.states.iter().skip(1).map(move |s| (r, s)))
+        .collect();
+    let norms: Vec<(usize, f64, f64)> = states
+        .par_iter()
+        .map(|&(r, s)| {
+            let d = cmp.difference(&runs[r].1.problem, s);
+            (r, d.difference.theorem(), d.exact.theorem())
+        })
+        .collect();
+    (0..runs.len())
+        .map(|r| {
+            let (mut error, mut norm) = (0.0f64, 0.0f64);
+            for &(_, e, n) in norms.iter().filter(|x| x.0 == r) {
+                (error, norm) = (error.max(e), norm.max(n));
+            }
+            error / norm.max(f64::MIN_POSITIVE)
+        })
+        .collect()
+}
+
+/// The relative theorem-norm error (max over the steps) of a run with `steps` steps against
+/// a reference in time on the same mesh, at the common time points.
+fn time_reference_error(case: &Case, sol: &Solution, reference: &Solution, steps: usize) -> f64 {
+    let model = &case.problem.model;
+    let stride = (reference.states.len() - 1) / steps;
+    let (mut error, mut norm) = (0.0f64, 0.0f64);
+    for (i, state) in sol.states.iter().enumerate().skip(1) {
+        let r = &reference.states[i * stride];
+        error = error.max(error::norms_of_difference(model, state, r).theorem());
+        norm = norm.max(error::norms(model, r).theorem());
+    }
+    error / norm
 }
 
 /// Step 6: where the numbers come from.
@@ -1073,9 +1204,12 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
     let sf = &study.file;
     let plan = Plan::new(&study)?;
     let progress = Progress::new(plan.jobs.len() as u64, &study.name);
+    let scenes: Vec<&Scene> = std::iter::once(&study.scene)
+        .chain(study.time_scene.as_ref())
+        .collect();
     let outputs = jobs::execute(
         &plan.jobs,
-        &study.scene,
+        &scenes,
         sf.solver,
         &study.text,
         mode,
@@ -1120,7 +1254,7 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
         &truth,
         measured.resultant_fixed,
     )?;
-    let time_study = time_study(sf, &plan, &mut solved);
+    let time_study = time_study(&study, &plan, &mut solved, sf.reference.quadrature)?;
     let (reference, exact_quadrature, mesh, warnings) = match &truth {
         Truth::Solved(r) => (
             Some(r.facts),

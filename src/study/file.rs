@@ -124,10 +124,16 @@ impl ThresholdSpec {
 pub struct TimeSpec {
     /// Mesh level.
     pub level: usize,
-    /// Numbers of steps (each doubling halves k).
+    /// Numbers of steps, increasing (each doubling halves k).
     pub steps: Vec<usize>,
-    /// Steps of the reference in time.
-    pub reference_steps: usize,
+    /// Steps of the reference in time (a solve on the same mesh); omitted when the study
+    /// measures against the exact solution (`reference.exact`), which then is the truth in
+    /// time too.
+    pub reference_steps: Option<usize>,
+    /// Scene of the time study (built-in name or path relative to the study file); default
+    /// the study's. A scene whose fields are affine in t has no time error to measure: a
+    /// variant with a t^2 part has.
+    pub scene: Option<String>,
 }
 
 /// A study file.
@@ -307,20 +313,51 @@ impl StudyFile {
             );
         }
         if let Some(ts) = &s.time {
-            if ts.steps.len() < 3
-                || ts.steps.iter().any(|&n| n == 0)
-                || ts.reference_steps <= *ts.steps.iter().max().unwrap()
-            {
-                return bad("time", "give at least 3 positive step counts and reference_steps larger than all of them".into());
-            }
-            if let Some(n) = ts.steps.iter().find(|&&n| ts.reference_steps % n != 0) {
+            if ts.steps.len() < super::rates::MIN_FIT_LEVELS || ts.steps.iter().any(|&n| n == 0) {
                 return bad(
-                    "time.reference_steps",
+                    "time.steps",
                     format!(
-                        "reference_steps must be a multiple of every step count ({} is not a multiple of {n})",
-                        ts.reference_steps
+                        "give at least {} positive step counts (a rate in k is fitted on 3 or more)",
+                        super::rates::MIN_FIT_LEVELS
                     ),
                 );
+            }
+            if ts.steps.windows(2).any(|w| w[1] <= w[0]) {
+                return bad(
+                    "time.steps",
+                    "step counts must increase: a repeated count has the same k as its twin, and no rate between them".into(),
+                );
+            }
+            match (ts.reference_steps, s.reference.exact) {
+                (Some(_), true) => {
+                    return bad(
+                        "time.reference_steps",
+                        "the study measures against the exact solution, which is also the truth in time: remove reference_steps".into(),
+                    );
+                }
+                (None, false) => {
+                    return bad(
+                        "time.reference_steps",
+                        "missing: give the steps of the reference in time (a multiple of every step count), or measure against an exact solution (reference.exact = true)".into(),
+                    );
+                }
+                (Some(r), false) => {
+                    if r <= *ts.steps.iter().max().unwrap() {
+                        return bad(
+                            "time.reference_steps",
+                            "reference_steps must be larger than every step count".into(),
+                        );
+                    }
+                    if let Some(n) = ts.steps.iter().find(|&&n| r % n != 0) {
+                        return bad(
+                            "time.reference_steps",
+                            format!(
+                                "reference_steps must be a multiple of every step count ({r} is not a multiple of {n})"
+                            ),
+                        );
+                    }
+                }
+                (None, true) => {}
             }
         }
         Ok(s)

@@ -31,6 +31,8 @@ pub struct Job {
     pub params: Vec<(String, f64)>,
     /// Time steps.
     pub steps: usize,
+    /// Which of the study's scenes (0: the study's own; 1: its time study's, if another).
+    pub scene: usize,
 }
 
 /// How a study's jobs are executed.
@@ -114,12 +116,13 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Solution> {
         })
 }
 
-/// Build every job's case and obtain its solution according to `mode`. Returns, in plan
+/// Build every job's case (on its scene of `scenes`) and obtain its solution according to
+/// `mode`. Returns, in plan
 /// order, `Some((case, solution))` for the jobs that were run or loaded (all of them except
 /// in `Shard` mode).
 pub fn execute(
     jobs: &[Job],
-    scene: &Scene,
+    scenes: &[&Scene],
     kind: SolverKind,
     study_text: &str,
     mode: Mode,
@@ -134,6 +137,7 @@ pub fn execute(
         if !mine {
             return Ok(None);
         }
+        let scene = scenes[job.scene];
         let case = Case::build(scene, job.level, job.method, &job.params)?;
         let path = dir.join(format!("{}.rec", key(job, scene, kind, study_text)?));
         let sol = if mode == Mode::Merge {
