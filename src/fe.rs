@@ -490,9 +490,9 @@ impl Model {
 
     /// The constitutive source of a manufactured solution at time `t`, per element: the
     /// mean over the triangle of s = d sigma/dt - E eps(du/dt) - G(sigma) (stress per time;
-    /// its L2 projection onto the P0 stresses), by the loads' rule split along the exact
-    /// fields' kinks ([`quadrature::dunavant8`], [`quadrature::triangle_rule`]). None when
-    /// the scene's law needs no source: such a scene pays nothing.
+    /// its L2 projection onto the P0 stresses), by the 2 x 2 collapsed Gauss rule split along
+    /// the exact fields' kinks ([`quadrature::triangle_rule`]). None when the scene's law
+    /// needs no source: such a scene pays nothing.
     pub fn constitutive_source(&self, t: f64) -> Result<Option<Vec<Stress>>> {
         let Some(exact) = self.scene.exact.as_deref() else {
             return Ok(None);
@@ -500,6 +500,10 @@ impl Model {
         if exact.source_rate.is_none() {
             return Ok(None);
         }
+        // Degree 2, not the loads' degree 8: measured on levels 0-4 of contact-mms-vp, every
+        // theorem error moved by <= 1.4e-4 relative (1.2e-6 at level 4) and no slope by more
+        // than 1e-4 against Dunavant-8, at a quarter of the cost; G(sigma)'s own kink (the
+        // yield surface) is not split by either rule.
         let rule = quadrature::triangle(2);
         let kinks = [0, 1].map(|b| kink_functions(&exact.kinks(b), t));
         let mut out = Vec::with_capacity(self.elements.len());

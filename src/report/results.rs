@@ -5,14 +5,14 @@
 
 use crate::error::{Error, Result};
 use crate::study::quantity::Quantity;
-use crate::study::rates::Verdict;
+use crate::study::rates::{self, Verdict};
 use serde::Deserialize;
 use std::fmt::Write as _;
 use std::path::Path;
 
 /// The convergence studies whose reports the section summarises, with a line on what each
 /// measures against.
-pub const STUDIES: [(&str, &str); 3] = [
+pub const STUDIES: [(&str, &str); 4] = [
     (
         "rates",
         "the viscoplastic `rates` scene against a matching-mesh reference",
@@ -20,6 +20,10 @@ pub const STUDIES: [(&str, &str); 3] = [
     (
         "rates-exact",
         "the manufactured `contact-mms` scene against its exact solution",
+    ),
+    (
+        "rates-exact-vp",
+        "the manufactured viscoplastic `contact-mms-vp` scene (both bodies flowing) against its exact solution, in h and in k",
     ),
     (
         "patch",
@@ -155,6 +159,7 @@ pub fn section(reports: &Path) -> Result<String> {
         if !theorem.is_empty() {
             let _ = writeln!(s, "- Theorem 3.1 norm: {}.", theorem.join("; "));
         }
+        plasticity_and_time(&dir, &mut s)?;
         // Where nts attains h^(1/2).
         let half: Vec<String> = rates
             .iter()
@@ -269,6 +274,62 @@ pub fn section(reports: &Path) -> Result<String> {
     }
     speed_and_stability(reports, &mut s)?;
     Ok(s)
+}
+
+/// One row of a report's levels.csv (the columns read here).
+#[derive(Debug, Deserialize)]
+struct LevelLine {
+    method: String,
+    level: usize,
+    plastic_fraction: f64,
+}
+
+/// One row of a report's time.csv.
+#[derive(Debug, Deserialize)]
+struct TimeLine {
+    steps: usize,
+    k: f64,
+    error: f64,
+}
+
+/// The plastic fraction at T of the finest level (where the bodies flow), and the rate in
+/// k of the time study (where there is one), judged again from time.csv by the rule that
+/// judged it ([`rates::assess`]).
+fn plasticity_and_time(dir: &Path, s: &mut String) -> Result<()> {
+    let levels: Vec<LevelLine> = read(&dir.join("levels.csv"))?;
+    let finest = levels.iter().map(|l| l.level).max().unwrap_or(0);
+    let plastic: Vec<String> = levels
+        .iter()
+        .filter(|l| l.level == finest && l.plastic_fraction > 0.0)
+        .map(|l| format!("{} {:.3}", l.method, l.plastic_fraction))
+        .collect();
+    if !plastic.is_empty() {
+        let _ = writeln!(s, "- Plastic fraction at T, level {finest}: {}.", plastic.join(", "));
+    }
+    let path = dir.join("time.csv");
+    if !path.exists() {
+        return Ok(());
+    }
+    let runs: Vec<TimeLine> = read(&path)?;
+    let levels: Vec<rates::LevelError> = runs
+        .iter()
+        .enumerate()
+        .map(|(i, r)| rates::LevelError {
+            level: i,
+            h: r.k,
+            dofs: r.steps as f64,
+            error: r.error,
+        })
+        .collect();
+    let a = rates::assess(&levels, 0.0)
+        .map_err(|e| Error::input(&path, "k", format!("{e}; regenerate the report")))?;
+    let steps: Vec<String> = a.used.iter().map(|&i| runs[i].steps.to_string()).collect();
+    let rate = match a.fit {
+        Some(f) => format!("{:.3} ± {:.3} ({}, steps {})", f.rate, f.stderr, a.verdict.name(), steps.join(" ")),
+        None => a.verdict.name().to_string(),
+    };
+    let _ = writeln!(s, "- Rate in k (time study, backward Euler's k term: 1): {rate}.");
+    Ok(())
 }
 
 /// One row of reports/speed/speed.csv (the columns read here).

@@ -539,6 +539,12 @@ fn readme(res: &StudyResult) -> String {
                 2 * points - 2,
                 2 * points
             );
+            if res.scene.exact.as_deref().is_some_and(|e| e.source_rate.is_some()) {
+                let _ = writeln!(
+                    s,
+                    "The scene is a manufactured viscoplastic solution: its constitutive law carries the source s = d sigma/dt - E eps(du/dt) - G(sigma), each triangle's mean (2 x 2 collapsed Gauss rule, split along the kinks) added as k s(t_n) to the backward-Euler update. Where its fields are affine in t (contact-mms-vp), the time-discrete law holds exactly and every error in h is spatial; a t^2 part (contact-mms-vp-time) is what the time study measures.\n"
+                );
+            }
         }
         (None, None) => {}
     }
