@@ -196,6 +196,8 @@ pub struct TimeRun {
     pub k: f64,
     /// Relative theorem-norm error (max over the steps) against the truth in time.
     pub error: f64,
+    /// What the error is relative to: the truth's theorem norm, max over the steps.
+    pub norm: f64,
     /// Plastic fraction at T.
     pub plastic_fraction: f64,
     /// Wall time of the solve (s).
@@ -1074,7 +1076,7 @@ fn time_study(
         })
         .collect();
     let scene = study.time_scene.as_ref().unwrap_or(&study.scene);
-    let errors: Vec<f64> = match &reference {
+    let errors: Vec<(f64, f64)> = match &reference {
         Some((_, reference)) => runs
             .par_iter()
             .map(|(steps, case, sol)| time_reference_error(case, sol, reference, *steps))
@@ -1089,10 +1091,11 @@ fn time_study(
     let runs: Vec<TimeRun> = runs
         .iter()
         .zip(&errors)
-        .map(|((steps, case, sol), &error)| TimeRun {
+        .map(|((steps, case, sol), &(error, norm))| TimeRun {
             steps: *steps,
             k: model.scene.final_time / *steps as f64,
             error,
+            norm,
             plastic_fraction: metrics::plastic_fraction(&case.problem, sol.last()),
             wall_s: sol.wall_s,
         })
@@ -1128,11 +1131,15 @@ fn time_study(
     }))
 }
 
-/// The relative theorem-norm error of each run against the exact solution: max over the
-/// steps of ||e||, relative to the max of the exact solution's norm (as
-/// [`Differences::relative`] has it). Every state of every run is measured in parallel: the
+/// The relative theorem-norm error of each run against the exact solution, max over the
+/// steps of ||e|| relative to the max of the exact solution's norm (as
+/// [`Differences::relative`] has it), with that norm. Every state of every run is measured in parallel: the
 /// longest run alone would otherwise set the wall time.
-fn time_exact_errors(runs: &[(usize, Case, Solution)], exact: &Exact, points: usize) -> Vec<f64> {
+fn time_exact_errors(
+    runs: &[(usize, Case, Solution)],
+    exact: &Exact,
+    points: usize,
+) -> Vec<(f64, f64)> {
     let cmp = ExactComparison::new(exact, points);
     let states: Vec<(usize, &crate::solve::State)> = runs
         .iter()
@@ -1152,14 +1159,20 @@ fn time_exact_errors(runs: &[(usize, Case, Solution)], exact: &Exact, points: us
             for &(_, e, n) in norms.iter().filter(|x| x.0 == r) {
                 (error, norm) = (error.max(e), norm.max(n));
             }
-            error / norm.max(f64::MIN_POSITIVE)
+            (error / norm.max(f64::MIN_POSITIVE), norm)
         })
         .collect()
 }
 
 /// The relative theorem-norm error (max over the steps) of a run with `steps` steps against
-/// a reference in time on the same mesh, at the common time points.
-fn time_reference_error(case: &Case, sol: &Solution, reference: &Solution, steps: usize) -> f64 {
+/// a reference in time on the same mesh, at the common time points, with the reference's
+/// norm it is relative to.
+fn time_reference_error(
+    case: &Case,
+    sol: &Solution,
+    reference: &Solution,
+    steps: usize,
+) -> (f64, f64) {
     let model = &case.problem.model;
     let stride = (reference.states.len() - 1) / steps;
     let (mut error, mut norm) = (0.0f64, 0.0f64);
@@ -1168,7 +1181,7 @@ fn time_reference_error(case: &Case, sol: &Solution, reference: &Solution, steps
         error = error.max(error::norms_of_difference(model, state, r).theorem());
         norm = norm.max(error::norms(model, r).theorem());
     }
-    error / norm
+    (error / norm, norm)
 }
 
 /// Step 6: where the numbers come from.
