@@ -103,6 +103,59 @@ impl Case {
             check_memory(scene, &all, level)?;
         }
         let (generated, raw) = mesh_healed(scene, &all, level)?;
+        Self::from_mesh(scene, level, method, generated, raw, t0)
+    }
+
+    /// [`Case::build`] with the two bodies refined independently: body 1 (the slave) at
+    /// `levels[0]`, body 2 at `levels[1]`, both from the same gmsh family (level 0 meshed
+    /// with the scene's parameters overridden by `params`, then split). Where the levels are
+    /// equal the mesh is [`Case::build`]'s at that level. `level` of the case is the larger.
+    pub fn build_sizes(
+        scene: &Scene,
+        levels: [usize; 2],
+        method: Method,
+        params: &[(String, f64)],
+    ) -> Result<Self> {
+        if levels[0] == levels[1] {
+            return Self::build(scene, levels[0], method, params);
+        }
+        let t0 = Instant::now();
+        let mut all: Vec<(String, f64)> = scene
+            .parameters
+            .iter()
+            .map(|(k, v)| (k.clone(), *v))
+            .collect();
+        for (k, v) in params {
+            match all.iter_mut().find(|(kk, _)| kk == k) {
+                Some(e) => e.1 = *v,
+                None => all.push((k.clone(), *v)),
+            }
+        }
+        check_parameters(scene, &all)?;
+        let top = levels[0].max(levels[1]);
+        if top > 0 {
+            check_memory(scene, &all, top)?;
+        }
+        let (g0, r0) = mesh_healed(scene, &all, levels[0])?;
+        let (g1, r1) = mesh_healed(scene, &all, levels[1])?;
+        let raw = msh::RawMesh::combine_bodies(
+            &r0,
+            &r1,
+            [&scene.bodies[0].surface, &scene.bodies[1].surface],
+        );
+        let generated = if levels[0] >= levels[1] { g0 } else { g1 };
+        Self::from_mesh(scene, top, method, generated, raw, t0)
+    }
+
+    /// The case of `scene` on the read mesh `raw` (generated as `generated`, from `t0`).
+    fn from_mesh(
+        scene: &Scene,
+        level: usize,
+        method: Method,
+        generated: gmsh::GeneratedMesh,
+        raw: msh::RawMesh,
+        t0: Instant,
+    ) -> Result<Self> {
         let mesh_s = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
         let model = Model::new(scene, &raw, &generated.path)?;

@@ -275,9 +275,37 @@ impl Scene {
         Self::from_toml(&text, &file)
     }
 
+    /// The same scene with body `surface` carrying the contact constraint (the slave):
+    /// the file read again with its `[contact]` slave and master exchanged where needed,
+    /// and validated as a file would be.
+    pub fn with_slave(&self, surface: &str) -> Result<Self> {
+        let text = std::fs::read_to_string(&self.file).map_err(|e| Error::io(&self.file, e))?;
+        let mut sf: SceneFile = crate::error::parse_toml(&text, &self.file, "scene file")?;
+        if sf.contact.slave_body != surface {
+            if !sf.bodies.iter().any(|b| b.surface == surface) {
+                return Err(Error::input(
+                    &self.file,
+                    "contact.slave_body",
+                    format!(
+                        "'{surface}' is not the surface of either body ({}); name one of them as the slave",
+                        sf.bodies.iter().map(|b| b.surface.as_str()).collect::<Vec<_>>().join(", ")
+                    ),
+                ));
+            }
+            sf.contact.slave_body = surface.to_string();
+            std::mem::swap(&mut sf.contact.slave_curve, &mut sf.contact.master_curve);
+        }
+        Self::validate(sf, &self.file)
+    }
+
     /// Parse and validate scene TOML text; `file` locates the .geo and names errors.
     pub fn from_toml(text: &str, file: &Path) -> Result<Self> {
         let sf: SceneFile = crate::error::parse_toml(text, file, "scene file")?;
+        Self::validate(sf, file)
+    }
+
+    /// Validate a parsed scene file; `file` locates the .geo and names errors.
+    fn validate(sf: SceneFile, file: &Path) -> Result<Self> {
         let name = file
             .file_stem()
             .map(|s| s.to_string_lossy().to_string())

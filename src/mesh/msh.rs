@@ -46,6 +46,38 @@ impl RawMesh {
         })
     }
 
+    /// A mesh made of body `surfaces[0]` as meshed in `a` and body `surfaces[1]` as meshed in
+    /// `b` (two levels of one family, the bodies refined independently): their triangles
+    /// and the boundary lines on their nodes, `b`'s nodes numbered after `a`'s. The bodies
+    /// of a non-matching family share no node, so each line belongs to one body and the
+    /// result is the mesh gmsh would give with those two sizes, without a new gmsh run.
+    pub fn combine_bodies(a: &RawMesh, b: &RawMesh, surfaces: [&str; 2]) -> RawMesh {
+        let mut out = RawMesh {
+            physical_names: a.physical_names.clone(),
+            ..Default::default()
+        };
+        for (raw, surface) in [(a, surfaces[0]), (b, surfaces[1])] {
+            let offset = out.nodes.len();
+            out.nodes.extend_from_slice(&raw.nodes);
+            let tag = raw.physical_tag(2, surface);
+            let mut on_body = vec![false; raw.nodes.len()];
+            for (t, p) in &raw.triangles {
+                if Some(*p) == tag {
+                    out.triangles.push((t.map(|n| n + offset), *p));
+                    for &n in t {
+                        on_body[n] = true;
+                    }
+                }
+            }
+            for (l, p) in &raw.lines {
+                if l.iter().all(|&n| on_body[n]) {
+                    out.lines.push((l.map(|n| n + offset), *p));
+                }
+            }
+        }
+        out
+    }
+
     /// Sorted names of the physical groups of dimension `dim`.
     pub fn names_of_dim(&self, dim: usize) -> Vec<String> {
         let mut v: Vec<String> = self

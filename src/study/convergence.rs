@@ -300,14 +300,14 @@ pub fn join(levels: &[usize]) -> String {
 }
 
 /// A study file with its scene, read and checked.
-struct Study {
-    name: String,
-    path: PathBuf,
-    text: String,
-    file: StudyFile,
-    scene: Scene,
+pub(crate) struct Study {
+    pub(crate) name: String,
+    pub(crate) path: PathBuf,
+    pub(crate) text: String,
+    pub(crate) file: StudyFile,
+    pub(crate) scene: Scene,
     /// The time study's scene, where it is not the study's own.
-    time_scene: Option<Scene>,
+    pub(crate) time_scene: Option<Scene>,
 }
 
 /// A scene named by a study file: a path relative to the study file, else a built-in name.
@@ -321,7 +321,7 @@ fn study_scene(path: &Path, name: &str) -> Result<Scene> {
 }
 
 impl Study {
-    fn load(name: &str) -> Result<Self> {
+    pub(crate) fn load(name: &str) -> Result<Self> {
         let path = super::file::resolve(name).ok_or_else(|| super::unknown_study(name))?;
         let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
         let file = StudyFile::from_toml(&text, &path)?;
@@ -347,7 +347,7 @@ impl Study {
     }
 
     /// The reference level: the finest study level plus `levels_above`.
-    fn reference_level(&self) -> usize {
+    pub(crate) fn reference_level(&self) -> usize {
         self.file.mesh.levels.last().unwrap() + self.file.reference.levels_above
     }
 }
@@ -455,6 +455,7 @@ impl Plan {
                 label,
                 method,
                 level,
+                body_levels: [level, level],
                 params: params.to_vec(),
                 steps,
                 scene,
@@ -549,14 +550,14 @@ impl Plan {
 }
 
 /// The reference solution with what every level is measured against.
-struct ReferenceSolution {
-    case: Case,
-    solution: Solution,
+pub(crate) struct ReferenceSolution {
+    pub(crate) case: Case,
+    pub(crate) solution: Solution,
     /// Squared norms per step t_1..t_N.
     norms: Vec<SquaredNorms>,
     /// Largest |u| over the history (length).
     max_displacement: f64,
-    facts: Reference,
+    pub(crate) facts: Reference,
     /// Each quantity's estimated own error (the same nested-space model per quantity).
     quantity_errors: BTreeMap<Quantity, f64>,
 }
@@ -577,7 +578,7 @@ pub fn estimated_reference_error(d1: f64, d2: f64) -> (f64, f64) {
 /// conforming spaces, so their errors are close to orthogonal: d(L, R)^2 = e_L^2 - e_R^2 with
 /// e_L = C h_L^p (measured on the rates scene: d(R-2,R)/d(R-1,R) = 2.24 = sqrt(5), i.e.
 /// p = 1). Hence (d(R-2,R)/d(R-1,R))^2 = 4^p + 1 and e_R = d(R-1,R) / sqrt(4^p - 1).
-fn reference(ids: [JobId; 3], solved: &mut Solved, level: usize) -> ReferenceSolution {
+pub(crate) fn reference(ids: [JobId; 3], solved: &mut Solved, level: usize) -> ReferenceSolution {
     let [coarser2, coarser1, finest] = ids.map(|id| solved.take(id));
     let (case, solution) = finest;
     let norms = solution
@@ -623,7 +624,7 @@ fn reference(ids: [JobId; 3], solved: &mut Solved, level: usize) -> ReferenceSol
 }
 
 /// What the levels are measured against.
-enum Truth<'s> {
+pub(crate) enum Truth<'s> {
     /// A fine reference solve on matching meshes.
     Solved(ReferenceSolution),
     /// The scene's exact solution, with the Gauss points per direction of the rule.
@@ -632,7 +633,7 @@ enum Truth<'s> {
 
 impl Truth<'_> {
     /// Every quantity's relative error of one solved level.
-    fn relative_errors(&self, case: &Case, sol: &Solution) -> BTreeMap<Quantity, f64> {
+    pub(crate) fn relative_errors(&self, case: &Case, sol: &Solution) -> BTreeMap<Quantity, f64> {
         match self {
             Truth::Solved(reference) => relative_errors(case, sol, reference),
             Truth::Exact(exact, points) => exact_errors(case, sol, exact, *points),
@@ -640,12 +641,12 @@ impl Truth<'_> {
     }
 
     /// The estimated error of the truth in the theorem norm (0 for the exact solution).
-    fn error(&self) -> f64 {
+    pub(crate) fn error(&self) -> f64 {
         self.quantity_error(Quantity::Theorem)
     }
 
     /// The estimated error of the truth in quantity `q` (0 for the exact solution).
-    fn quantity_error(&self, q: Quantity) -> f64 {
+    pub(crate) fn quantity_error(&self, q: Quantity) -> f64 {
         match self {
             Truth::Solved(r) => r.quantity_errors[&q],
             Truth::Exact(..) => 0.0,
@@ -1185,7 +1186,7 @@ fn time_reference_error(
 }
 
 /// Step 6: where the numbers come from.
-fn provenance(study: &Study, mesh: &crate::mesh::gmsh::GeneratedMesh) -> BTreeMap<String, String> {
+pub(crate) fn provenance(study: &Study, mesh: &crate::mesh::gmsh::GeneratedMesh) -> BTreeMap<String, String> {
     let geo = study.scene.geo.file_name().unwrap().to_string_lossy();
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     BTreeMap::from([

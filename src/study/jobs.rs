@@ -25,8 +25,10 @@ pub struct Job {
     pub label: String,
     /// Cone.
     pub method: Method,
-    /// Mesh level.
+    /// Mesh level (the finer body's, where the bodies differ).
     pub level: usize,
+    /// Levels of body 1 (the slave) and body 2; both `level` except in a two-size study.
+    pub body_levels: [usize; 2],
     /// gmsh parameters.
     pub params: Vec<(String, f64)>,
     /// Time steps.
@@ -77,11 +79,11 @@ fn key(job: &Job, scene: &Scene, kind: SolverKind, study_text: &str) -> Result<S
     let scene_text = std::fs::read(&scene.file).map_err(|e| Error::io(&scene.file, e))?;
     let geo = std::fs::read(&scene.geo).map_err(|e| Error::io(&scene.geo, e))?;
     let mut k = format!(
-        "record-v2|{}|{}|{}|{}|{:?}|{}|",
+        "record-v3|{}|{}|{}|{:?}|{:?}|{}|",
         super::commit(),
         kind.name(),
         job.method.name(),
-        job.level,
+        job.body_levels,
         job.params,
         job.steps
     );
@@ -138,7 +140,7 @@ pub fn execute(
             return Ok(None);
         }
         let scene = scenes[job.scene];
-        let case = Case::build(scene, job.level, job.method, &job.params)?;
+        let case = Case::build_sizes(scene, job.body_levels, job.method, &job.params)?;
         let path = dir.join(format!("{}.rec", key(job, scene, kind, study_text)?));
         let sol = if mode == Mode::Merge {
             let bytes = std::fs::read(&path).map_err(|_| {
