@@ -15,6 +15,7 @@ pub mod run;
 pub mod speed;
 pub mod stability;
 pub mod study;
+pub mod two_size;
 
 pub use folder::{check_writable, reports_dir, write_folder};
 
@@ -26,6 +27,7 @@ use std::path::Path;
 pub fn write(outcome: &Outcome, dir: &Path) -> Result<()> {
     match outcome {
         Outcome::Convergence(r) => study::write_study(r, dir),
+        Outcome::TwoSize(r) => two_size::write_two_size(r, dir),
         Outcome::Paper(r) => paper::write_paper(r, dir),
         Outcome::Speed(r) => speed::write_speed(r, dir),
         Outcome::Stability(r) => stability::write_stability(r, dir),
@@ -36,6 +38,7 @@ pub fn write(outcome: &Outcome, dir: &Path) -> Result<()> {
 pub fn console(outcome: &Outcome, dir: &Path) -> String {
     match outcome {
         Outcome::Convergence(r) => study::console(r, dir),
+        Outcome::TwoSize(r) => two_size::console(r, dir),
         Outcome::Paper(r) => paper::console(r, dir),
         Outcome::Speed(r) => speed::console(r, dir),
         Outcome::Stability(r) => stability::console(r, dir),

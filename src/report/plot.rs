@@ -444,3 +444,84 @@ pub fn mesh_panels(path: &Path, title: &str, panels: &[MeshPanel]) -> Result<()>
     root.present().map_err(err(path))?;
     Ok(())
 }
+
+/// One panel of a map over a grid of (x, y) cells: a value per cell, lines on top.
+pub struct GridPanel {
+    /// Panel title.
+    pub title: String,
+    /// Cells: (x, y, value); each cell is drawn as the unit square centred at (x, y).
+    pub cells: Vec<(f64, f64, f64)>,
+    /// Polylines to draw over the cells (e.g. the iso-dofs lines), with a label each.
+    pub lines: Vec<(String, Vec<(f64, f64)>)>,
+}
+
+/// Maps side by side (two per row), each with its own colour scale on log10 of the values,
+/// the value written in every cell.
+pub fn grid_panels(path: &Path, title: &str, xlabel: &str, ylabel: &str, panels: &[GridPanel]) -> Result<()> {
+    register();
+    let rows = panels.len().div_ceil(2) as u32;
+    let root = BitMapBackend::new(path, (1100, 520 * rows + 40)).into_drawing_area();
+    root.fill(&WHITE).map_err(err(path))?;
+    let root = root.titled(title, ("sans-serif", 20)).map_err(err(path))?;
+    let areas = root.split_evenly((rows as usize, 2));
+    for (p, area) in panels.iter().zip(areas.iter()) {
+        let (x0, x1) = range(p.cells.iter().map(|c| c.0), false);
+        let (y0, y1) = range(p.cells.iter().map(|c| c.1), false);
+        let logs: Vec<f64> = p.cells.iter().map(|c| c.2.max(1e-300).log10()).collect();
+        let (v0, v1) = range(logs.iter().copied(), false);
+        let mut chart = ChartBuilder::on(area)
+            .caption(&p.title, ("sans-serif", 16))
+            .margin(10)
+            .x_label_area_size(35)
+            .y_label_area_size(45)
+            .build_cartesian_2d(x0 - 0.5..x1 + 0.5, y0 - 0.5..y1 + 0.5)
+            .map_err(err(path))?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc(xlabel)
+            .y_desc(ylabel)
+            .x_labels((x1 - x0) as usize + 1)
+            .y_labels((y1 - y0) as usize + 1)
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .y_label_formatter(&|v| format!("{v:.0}"))
+            .label_style(("sans-serif", 12))
+            .draw()
+            .map_err(err(path))?;
+        for (c, l) in p.cells.iter().zip(&logs) {
+            let t = (l - v0) / (v1 - v0).max(f64::MIN_POSITIVE);
+            chart
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(c.0 - 0.5, c.1 - 0.5), (c.0 + 0.5, c.1 + 0.5)],
+                    colormap(t).filled(),
+                )))
+                .map_err(err(path))?;
+            let ink = if t > 0.6 { BLACK } else { WHITE };
+            chart
+                .draw_series(std::iter::once(Text::new(
+                    format!("{:.2e}", c.2),
+                    (c.0 - 0.38, c.1 + 0.08),
+                    ("sans-serif", 12).into_font().color(&ink),
+                )))
+                .map_err(err(path))?;
+        }
+        for (i, (label, pts)) in p.lines.iter().enumerate() {
+            let style = ShapeStyle::from(&RED).stroke_width(2);
+            chart
+                .draw_series(LineSeries::new(pts.iter().copied(), style))
+                .map_err(err(path))?;
+            if let Some(&last) = pts.iter().filter(|q| q.1 <= y1 + 0.5 && q.0 <= x1 + 0.5).last() {
+                let _ = i;
+                chart
+                    .draw_series(std::iter::once(Text::new(
+                        label.clone(),
+                        (last.0 - 0.45, last.1 - 0.1),
+                        ("sans-serif", 11).into_font().color(&RED),
+                    )))
+                    .map_err(err(path))?;
+            }
+        }
+    }
+    root.present().map_err(err(path))?;
+    Ok(())
+}

@@ -136,6 +136,23 @@ pub struct TimeSpec {
     pub scene: Option<String>,
 }
 
+/// A two-size study: the two bodies refined independently (`study::two_size`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TwoSizeSpec {
+    /// The level a body is held at while the other is swept over `mesh.levels`: finer than
+    /// every grid level (by 2 or more, so that its own error is small against the swept
+    /// one's; the study measures it at (fixed, fixed) and leaves out sweep levels within 5x).
+    pub fixed: usize,
+    /// The bodies (surface names) that carry the constraint in turn; default the scene's
+    /// slave only.
+    #[serde(default)]
+    pub slaves: Vec<String>,
+    /// The diagonal study on the same family (its report under reports/), whose errors the
+    /// grid's equal-level pairs (the same meshes) are compared with in the report.
+    pub diagonal: Option<String>,
+}
+
 /// A study file.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -162,6 +179,8 @@ pub struct StudyFile {
     pub thresholds: ThresholdSpec,
     /// Optional time study.
     pub time: Option<TimeSpec>,
+    /// A two-size study: `mesh.levels` are each body's grid levels.
+    pub two_size: Option<TwoSizeSpec>,
 }
 
 fn default_solver() -> SolverKind {
@@ -311,6 +330,34 @@ impl StudyFile {
                 "thresholds.tolerance",
                 format!("the tolerance must lie in [0, 0.05], got {}", t.tolerance),
             );
+        }
+        if let Some(two) = &s.two_size {
+            let finest = *s.mesh.levels.last().expect("at least 3 levels");
+            if two.fixed < finest + 2 {
+                return bad(
+                    "two_size.fixed",
+                    format!(
+                        "the fixed level must be at least 2 above the finest grid level {finest} (its own error must be small against the swept body's), got {}",
+                        two.fixed
+                    ),
+                );
+            }
+            if !s.reference.exact && s.mesh.levels.last().unwrap() + s.reference.levels_above <= two.fixed {
+                return bad(
+                    "reference.levels_above",
+                    format!(
+                        "the reference must be finer than the fixed level {}: give levels_above >= {}",
+                        two.fixed,
+                        two.fixed + 1 - finest
+                    ),
+                );
+            }
+            if s.time.is_some() || !s.mesh.variants.is_empty() {
+                return bad(
+                    "two_size",
+                    "a two-size study has no [time] table and no mesh.variants; run those in a diagonal study".into(),
+                );
+            }
         }
         if let Some(ts) = &s.time {
             if ts.steps.len() < super::rates::MIN_FIT_LEVELS || ts.steps.iter().any(|&n| n == 0) {

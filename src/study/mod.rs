@@ -21,6 +21,7 @@ pub mod quantity;
 pub mod rates;
 pub mod speed;
 pub mod stability;
+pub mod two_size;
 
 pub use convergence::{ErrorRow, LevelInfo, RateRow, StudyResult, run, run_mode};
 
@@ -36,6 +37,8 @@ use std::time::Instant;
 pub enum Kind {
     /// A convergence study file.
     Convergence(PathBuf),
+    /// A two-size study file (one with a `[two_size]` table).
+    TwoSize(PathBuf),
     /// The paper's tests.
     Paper,
     /// The speed study.
@@ -49,6 +52,8 @@ pub enum Kind {
 pub enum Outcome {
     /// A convergence study.
     Convergence(StudyResult),
+    /// A two-size study.
+    TwoSize(two_size::TwoSizeResult),
     /// The paper's tests.
     Paper(paper::PaperResult),
     /// The speed study.
@@ -69,9 +74,15 @@ impl Kind {
     pub fn resolve(name: &str) -> Result<Kind> {
         match Self::BUILT_IN.iter().find(|(n, _, _)| *n == name) {
             Some((_, kind, _)) => Ok(kind.clone()),
-            None => file::resolve(name)
-                .map(Kind::Convergence)
-                .ok_or_else(|| unknown_study(name)),
+            None => {
+                let path = file::resolve(name).ok_or_else(|| unknown_study(name))?;
+                let two_size = file::StudyFile::load(&path)?.two_size.is_some();
+                Ok(if two_size {
+                    Kind::TwoSize(path)
+                } else {
+                    Kind::Convergence(path)
+                })
+            }
         }
     }
 
@@ -90,7 +101,7 @@ impl Kind {
     /// The study's name: its report folder under reports/.
     pub fn name(&self) -> String {
         match self {
-            Kind::Convergence(path) => path.file_stem().map_or_else(
+            Kind::Convergence(path) | Kind::TwoSize(path) => path.file_stem().map_or_else(
                 || path.display().to_string(),
                 |s| s.to_string_lossy().to_string(),
             ),
@@ -116,6 +127,9 @@ impl Kind {
             Kind::Convergence(path) => {
                 run_mode(&path.display().to_string(), mode)?.map(Outcome::Convergence)
             }
+            Kind::TwoSize(path) => Some(Outcome::TwoSize(two_size::run(
+                &path.display().to_string(),
+            )?)),
             Kind::Paper => Some(Outcome::Paper(paper::run()?)),
             Kind::Speed => Some(Outcome::Speed(speed::run()?)),
             Kind::Stability => Some(Outcome::Stability(stability::run()?)),
@@ -141,6 +155,7 @@ impl Outcome {
     pub fn warnings(&self) -> &[String] {
         match self {
             Outcome::Convergence(r) => &r.warnings,
+            Outcome::TwoSize(r) => &r.warnings,
             _ => &[],
         }
     }

@@ -1,0 +1,471 @@
+//! The report of a two-size study: grid.csv and fits.csv (computing and plotting joined by
+//! them), the error maps over (slave level, master level) with the iso-dofs lines, the
+//! one-sided sweeps with their fitted slopes, and a README that answers, per cone and
+//! quantity, which mesh limits the error and which body should carry the constraint.
+
+use super::folder::{write, write_folder};
+use super::plot::{self, GridPanel, Series};
+use crate::contact::Method;
+use crate::error::Result;
+use crate::io::{csv_bytes, fmt3};
+use crate::study::quantity::Quantity;
+use crate::study::rates::{Assessment, Verdict};
+use crate::study::two_size::{SizeFit, TwoSizeResult, lemma_exponents};
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The quantities drawn as maps.
+const MAPPED: [Quantity; 4] = [
+    Quantity::Theorem,
+    Quantity::L2Pressure,
+    Quantity::BandStress,
+    Quantity::MaxPenetration,
+];
+
+/// One row of fits.csv.
+#[derive(Debug, Serialize)]
+struct FitCsv {
+    slave: String,
+    method: Method,
+    quantity: Quantity,
+    a1: f64,
+    se_a1: f64,
+    a2: f64,
+    se_a2: f64,
+    c1: f64,
+    c2: f64,
+    rms_log_residual: f64,
+    lemma_a1: f64,
+    lemma_a2: f64,
+    rate_h1: f64,
+    stderr_h1: f64,
+    levels_h1: String,
+    verdict_h1: &'static str,
+    rate_h2: f64,
+    stderr_h2: f64,
+    levels_h2: String,
+    verdict_h2: &'static str,
+    floor: f64,
+    term1: f64,
+    term2: f64,
+    gain1_per_dof: f64,
+    gain2_per_dof: f64,
+}
+
+fn levels_text(levels: &[usize]) -> String {
+    levels.iter().map(|l| l.to_string()).collect::<Vec<_>>().join(" ")
+}
+
+impl FitCsv {
+    fn new(f: &SizeFit) -> Self {
+        let nan = f64::NAN;
+        let fit = f.fit;
+        let lemma = lemma_exponents(f.method);
+        let rate = |a: &Assessment| a.fit.map_or((nan, nan), |x| (x.rate, x.stderr));
+        let (r1, s1) = rate(&f.sweeps[0]);
+        let (r2, s2) = rate(&f.sweeps[1]);
+        FitCsv {
+            slave: f.slave.clone(),
+            method: f.method,
+            quantity: f.quantity,
+            a1: fit.map_or(nan, |x| x.a[0]),
+            se_a1: fit.map_or(nan, |x| x.se[0]),
+            a2: fit.map_or(nan, |x| x.a[1]),
+            se_a2: fit.map_or(nan, |x| x.se[1]),
+            c1: fit.map_or(nan, |x| x.c[0]),
+            c2: fit.map_or(nan, |x| x.c[1]),
+            rms_log_residual: fit.map_or(nan, |x| x.rms_log_residual),
+            lemma_a1: lemma[0],
+            lemma_a2: lemma[1],
+            rate_h1: r1,
+            stderr_h1: s1,
+            levels_h1: levels_text(&f.sweeps[0].used),
+            verdict_h1: f.sweeps[0].verdict.name(),
+            rate_h2: r2,
+            stderr_h2: s2,
+            levels_h2: levels_text(&f.sweeps[1].used),
+            verdict_h2: f.sweeps[1].verdict.name(),
+            floor: f.floor,
+            term1: f.terms[0],
+            term2: f.terms[1],
+            gain1_per_dof: f.gain_per_dof[0],
+            gain2_per_dof: f.gain_per_dof[1],
+        }
+    }
+}
+
+/// Write the report of a two-size study into `dir`.
+pub fn write_two_size(res: &TwoSizeResult, dir: &Path) -> Result<()> {
+    write_folder(dir, |d| {
+        write(d, "grid.csv", &csv_bytes(&res.points)?)?;
+        let fits: Vec<FitCsv> = res.fits.iter().map(FitCsv::new).collect();
+        write(d, "fits.csv", &csv_bytes(&fits)?)?;
+        for slave in &res.slaves {
+            for &method in &res.methods {
+                maps(res, slave, method, d)?;
+            }
+            sweeps(res, slave, d)?;
+        }
+        write(d, "README.md", readme(res).as_bytes())
+    })
+}
+
+fn map_file(slave: &str, method: Method) -> String {
+    format!("map_{slave}_{method}.png")
+}
+
+fn sweep_file(slave: &str) -> String {
+    format!("sweeps_{slave}.png")
+}
+
+/// Least-squares line ln N = alpha + beta l through the (level, dofs) pairs.
+fn dofs_line(pairs: &[(usize, usize)]) -> (f64, f64) {
+    let n = pairs.len() as f64;
+    let (sx, sy) = pairs.iter().fold((0.0, 0.0), |(a, b), &(l, d)| (a + l as f64, b + (d as f64).ln()));
+    let (mx, my) = (sx / n, sy / n);
+    let (sxx, sxy) = pairs.iter().fold((0.0, 0.0), |(a, b), &(l, d)| {
+        let x = l as f64 - mx;
+        (a + x * x, b + x * ((d as f64).ln() - my))
+    });
+    let beta = sxy / sxx.max(f64::MIN_POSITIVE);
+    (my - beta * mx, beta)
+}
+
+/// The error maps of one slave choice and cone, with the iso-dofs line through every grid
+/// diagonal point (N1(l1) + N2(l2) constant, each N_b ~ exp(alpha_b + beta_b l) fitted).
+fn maps(res: &TwoSizeResult, slave: &str, method: Method, d: &Path) -> Result<()> {
+    let grid = |p: &&crate::study::two_size::SizePoint| {
+        res.levels.contains(&p.slave_level) && res.levels.contains(&p.master_level)
+    };
+    let theorem: Vec<_> = res.of(slave, method, Quantity::Theorem).filter(grid).collect();
+    let d1: Vec<(usize, usize)> = theorem.iter().map(|p| (p.slave_level, p.dofs1)).collect();
+    let d2: Vec<(usize, usize)> = theorem.iter().map(|p| (p.master_level, p.dofs2)).collect();
+    let (a1, b1) = dofs_line(&d1);
+    let (a2, b2) = dofs_line(&d2);
+    let (lo, hi) = (
+        *res.levels.first().expect("levels") as f64,
+        *res.levels.last().expect("levels") as f64,
+    );
+    let lines: Vec<(String, Vec<(f64, f64)>)> = res
+        .levels
+        .iter()
+        .map(|&l| {
+            let total = (a1 + b1 * l as f64).exp() + (a2 + b2 * l as f64).exp();
+            let pts = (0..=60)
+                .filter_map(|i| {
+                    let x = lo - 0.5 + (hi - lo + 1.0) * i as f64 / 60.0;
+                    let rest = total - (a1 + b1 * x).exp();
+                    let y = (rest.ln() - a2) / b2;
+                    (rest > 0.0 && y >= lo - 0.5 && y <= hi + 0.5).then_some((x, y))
+                })
+                .collect();
+            (format!("{:.0} dofs", total), pts)
+        })
+        .collect();
+    let panels: Vec<GridPanel> = MAPPED
+        .iter()
+        .filter(|q| res.quantities.contains(q))
+        .map(|&q| GridPanel {
+            title: q.name().to_string(),
+            cells: res
+                .of(slave, method, q)
+                .filter(grid)
+                .map(|p| (p.slave_level as f64, p.master_level as f64, p.error))
+                .collect(),
+            lines: lines.clone(),
+        })
+        .collect();
+    plot::grid_panels(
+        &d.join(map_file(slave, method)),
+        &format!("{}: relative error over the two mesh levels ({method}, slave '{slave}'); red: iso-dofs", res.name),
+        "slave level (body 1)",
+        "master level (body 2)",
+        &panels,
+    )
+}
+
+/// The one-sided sweeps of one slave choice: the theorem error against the swept body's h,
+/// both cones, fitted slopes in the legend.
+fn sweeps(res: &TwoSizeResult, slave: &str, d: &Path) -> Result<()> {
+    let mut series = Vec::new();
+    for (i, &method) in res.methods.iter().enumerate() {
+        let f = res
+            .fits
+            .iter()
+            .find(|f| f.slave == slave && f.method == method && f.quantity == Quantity::Theorem)
+            .expect("the theorem fit");
+        for b in 0..2 {
+            let pts: Vec<(f64, f64)> = res
+                .of(slave, method, Quantity::Theorem)
+                .filter(|p| {
+                    if b == 0 {
+                        p.master_level == res.fixed && res.levels.contains(&p.slave_level)
+                    } else {
+                        p.slave_level == res.fixed && res.levels.contains(&p.master_level)
+                    }
+                })
+                .map(|p| (if b == 0 { p.h1 } else { p.h2 }, p.error))
+                .collect();
+            let a = &f.sweeps[b];
+            let slope = a.fit.map_or(a.verdict.name().to_string(), |x| {
+                format!("slope {:.2} ± {:.2} ({})", x.rate, x.stderr, a.verdict.name())
+            });
+            series.push(Series {
+                label: format!(
+                    "{method}: {} swept, {} at level {}: {slope}",
+                    ["slave", "master"][b],
+                    ["master", "slave"][b],
+                    res.fixed
+                ),
+                points: pts,
+                markers: true,
+                line: true,
+                color: 2 * i + b,
+                thin: b == 1,
+            });
+        }
+    }
+    plot::loglog(
+        &d.join(sweep_file(slave)),
+        &format!("{}: one-sided sweeps (slave '{slave}', theorem norm)", res.name),
+        "h of the swept body",
+        "relative error (theorem norm)",
+        &series,
+        &[(0.5, "1/2"), (0.75, "3/4"), (1.0, "1")],
+    )
+}
+
+fn fmt_fit(f: &SizeFit, b: usize) -> String {
+    f.fit.map_or("no fit".into(), |x| format!("{:.3} ± {:.3}", x.a[b], x.se[b]))
+}
+
+fn fmt_sweep(a: &Assessment) -> String {
+    match a.fit {
+        Some(x) if a.verdict != Verdict::NotConverging => format!(
+            "{:.3} ± {:.3} ({}, levels {})",
+            x.rate,
+            x.stderr,
+            a.verdict.name(),
+            levels_text(&a.used)
+        ),
+        _ => a.verdict.name().to_string(),
+    }
+}
+
+/// The plain answer for one fit: which body's term dominates at the finest diagonal point
+/// and which refinement buys more per dof.
+fn answer(res: &TwoSizeResult, f: &SizeFit) -> String {
+    let master = res
+        .scene
+        .bodies
+        .iter()
+        .map(|b| b.surface.as_str())
+        .find(|s| *s != f.slave)
+        .unwrap_or("?");
+    if !(f.terms[0].is_finite() && f.terms[1].is_finite()) {
+        return "no fit: nothing to say".into();
+    }
+    let names = [format!("the slave '{}'", f.slave), format!("the master '{master}'")];
+    let big = usize::from(f.terms[1] > f.terms[0]);
+    let ratio = f.terms[big] / f.terms[1 - big].max(f64::MIN_POSITIVE);
+    let better = usize::from(f.gain_per_dof[1] > f.gain_per_dof[0]);
+    format!(
+        "{}'s mesh dominates ({:.2e} against {:.2e}, {ratio:.1}x); per added dof, refining {} buys {:.2e}, {} {:.2e}: refine {} first",
+        names[big],
+        f.terms[big],
+        f.terms[1 - big],
+        names[0],
+        f.gain_per_dof[0],
+        names[1],
+        f.gain_per_dof[1],
+        names[better]
+    )
+}
+
+/// The diagonal pairs against the diagonal study's committed errors (same meshes).
+fn diagonal(res: &TwoSizeResult, s: &mut String) {
+    let Some(name) = &res.diagonal else { return };
+    let path = super::reports_dir().join(name).join("errors.csv");
+    #[derive(serde::Deserialize)]
+    struct Row {
+        method: String,
+        level: usize,
+        quantity: String,
+        error: f64,
+    }
+    let rows: Vec<Row> = match csv::Reader::from_path(&path) {
+        Ok(mut r) => r.deserialize().filter_map(|x| x.ok()).collect(),
+        Err(_) => return,
+    };
+    let slave = &res.scene.bodies[0].surface;
+    let mut worst: Vec<(String, f64, usize)> = Vec::new();
+    for &q in &res.quantities {
+        let mut w = 0.0f64;
+        let mut n = 0;
+        for &m in &res.methods {
+            for &l in &res.levels {
+                let (Some(a), Some(b)) = (
+                    res.error(slave, m, q, [l, l]),
+                    rows.iter()
+                        .find(|r| r.method == m.name() && r.level == l && r.quantity == q.name())
+                        .map(|r| r.error),
+                ) else {
+                    continue;
+                };
+                w = w.max((a - b).abs() / b.abs().max(f64::MIN_POSITIVE));
+                n += 1;
+            }
+        }
+        if n > 0 {
+            worst.push((q.name().to_string(), w, n));
+        }
+    }
+    let _ = writeln!(
+        s,
+        "## The diagonal against `{name}`\n\nWhere both bodies have the same level the mesh is the diagonal study's (each body split from the same gmsh level-0 mesh; slave '{slave}'), so its errors must agree with [`reports/{name}`](../{name}/README.md) to the solver tolerance (this study's {} time steps against its own; a quantity taken as the max over the steps may differ where they do). Largest relative difference per quantity over both cones and levels {}:\n\n| quantity | pairs | largest relative difference |\n|---|---|---|",
+        res.steps,
+        levels_text(&res.levels)
+    );
+    for (q, w, n) in worst {
+        let _ = writeln!(s, "| {q} | {n} | {w:.2e} |");
+    }
+    let _ = writeln!(s);
+}
+
+fn readme(res: &TwoSizeResult) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "# Study `{}`\n\n{}\n", res.name, res.description);
+    let _ = writeln!(s, "Scene `{}`: {}\n", res.scene.name, res.scene.description);
+    let _ = writeln!(
+        s,
+        "Regenerate with `cargo run --release -- study {}` ({:.0} s on this machine, {} cores). Grid: every pair of levels {} of the slave (body 1) and the master (body 2); one-sided sweeps: each body over those levels with the other at level {}; and (level {0}, level {0}) as their floor. Slave choices: {}. {} time steps.\n",
+        res.name,
+        res.wall_s,
+        res.provenance.get("cores").cloned().unwrap_or_default(),
+        levels_text(&res.levels),
+        res.fixed,
+        res.slaves.join(", "),
+        res.steps
+    );
+    // The lead: the exponents per cone and slave against the Lemma.
+    let _ = writeln!(
+        s,
+        "## Exponents in h1 (slave) and h2 (master)\n\nThe grid fitted to E = C1 h1^a1 + C2 h2^a2 (nonlinear least squares in log space, ± standard errors, rms of the log residuals), beside Lemma 3.1's consistency exponents (K_h^pi: h1^(3/4) + h2; K_h^I: (h1^(1/2) ||e||)^(1/2) + h1^(3/4) + h2^(3/4), i.e. h1^(1/2) + h2^(3/4)); the finite elements' own approximation adds h1 + h2 in the theorem norm. The one-sided rates: the slave swept with the master at level {fixed}, the master swept with the slave at level {fixed} (a sweep level within 5x of the error at ({fixed}, {fixed}), the fixed body's own error, is left out: that is how the fixed level is checked to be fine enough).\n\n| slave | method | quantity | a1 (h1) | a2 (h2) | Lemma (a1, a2) | rms log residual | rate in h1, master fixed | rate in h2, slave fixed | floor ({fixed}, {fixed}) |\n|---|---|---|---|---|---|---|---|---|---|",
+        fixed = res.fixed
+    );
+    for f in &res.fits {
+        let lemma = lemma_exponents(f.method);
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | ({}, {}) | {} | {} | {} | {:.3e} |",
+            f.slave,
+            f.method,
+            f.quantity,
+            fmt_fit(f, 0),
+            fmt_fit(f, 1),
+            lemma[0],
+            lemma[1],
+            fmt3(f.fit.map_or(f64::NAN, |x| x.rms_log_residual)),
+            fmt_sweep(&f.sweeps[0]),
+            fmt_sweep(&f.sweeps[1]),
+            f.floor
+        );
+    }
+    let finest = *res.levels.last().expect("levels");
+    let _ = writeln!(
+        s,
+        "\n## Which mesh limits the error\n\nAt the finest grid diagonal point (level {finest} for both bodies), each body's fitted term C_b h_b^a_b, and the error removed per added dof by refining that body, a_b C_b h_b^a_b / (2 N_b) (N_b its dofs, N_b ~ h_b^-2).\n"
+    );
+    for f in &res.fits {
+        let _ = writeln!(s, "- {} / {} / {}: {}.", f.slave, f.method, f.quantity, answer(res, f));
+    }
+    if res.slaves.len() > 1 {
+        let _ = writeln!(
+            s,
+            "\n## Which body should be the slave\n\nThe same meshes (level {finest} for both bodies) with each body carrying the constraint in turn:\n\n| method | quantity | {} | smaller error with slave |\n|---|---|{}---|",
+            res.slaves.iter().map(|x| format!("slave '{x}'")).collect::<Vec<_>>().join(" | "),
+            "---|".repeat(res.slaves.len())
+        );
+        for &m in &res.methods {
+            for &q in &res.quantities {
+                let e: Vec<Option<f64>> = res
+                    .slaves
+                    .iter()
+                    .map(|x| res.error(x, m, q, [finest, finest]))
+                    .collect();
+                let best = e
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(i, v)| v.map(|v| (i, v)))
+                    .min_by(|a, b| a.1.total_cmp(&b.1))
+                    .map(|(i, _)| res.slaves[i].clone())
+                    .unwrap_or_default();
+                let _ = writeln!(
+                    s,
+                    "| {m} | {q} | {} | {best} |",
+                    e.iter()
+                        .map(|v| v.map_or("-".into(), |v| format!("{v:.3e}")))
+                        .collect::<Vec<_>>()
+                        .join(" | ")
+                );
+            }
+        }
+        let _ = writeln!(s);
+    }
+    diagonal(res, &mut s);
+    let _ = writeln!(s, "## Maps and sweeps\n");
+    for slave in &res.slaves {
+        for &m in &res.methods {
+            let _ = writeln!(s, "![{m}, slave {slave}]({})\n", map_file(slave, m));
+        }
+        let _ = writeln!(s, "![sweeps, slave {slave}]({})\n", sweep_file(slave));
+    }
+    match (&res.exact_quadrature, res.references.is_empty()) {
+        (Some(points), _) => {
+            let _ = writeln!(
+                s,
+                "## Truth\n\nThe exact solution of scene `{}`, integrated with {points} x {points} Gauss points per triangle split along its kinks (as in the diagonal exact studies).\n",
+                res.scene.name
+            );
+        }
+        (None, false) => {
+            let _ = writeln!(s, "## Truth\n\nA reference on matching meshes per slave choice (the bodies are numbered by it):\n");
+            for (slave, r) in &res.references {
+                let _ = writeln!(
+                    s,
+                    "- slave '{slave}': level {} (h = {:.4}, {} dofs, {:.1} s), estimated error {:.3e} in the theorem norm (rate {:.2}).",
+                    r.level, r.h, r.dofs, r.wall_s, r.error, r.error_rate
+                );
+            }
+            let _ = writeln!(s);
+        }
+        _ => {}
+    }
+    let _ = writeln!(s, "## Provenance\n");
+    for (k, v) in &res.provenance {
+        let _ = writeln!(s, "- {k}: {v}");
+    }
+    let _ = writeln!(s, "\nData: `grid.csv` (every pair and quantity), `fits.csv` (every fit).");
+    s
+}
+
+/// What `study NAME` prints for a two-size study.
+pub fn console(res: &TwoSizeResult, dir: &Path) -> String {
+    let mut s = String::new();
+    for f in res.fits.iter().filter(|f| f.quantity == Quantity::Theorem) {
+        let _ = writeln!(
+            s,
+            "slave {:6} {:6} theorem: a1 {} a2 {} (Lemma {:?}); rate in h1 {}; rate in h2 {}",
+            f.slave,
+            f.method.name(),
+            fmt_fit(f, 0),
+            fmt_fit(f, 1),
+            lemma_exponents(f.method),
+            fmt_sweep(&f.sweeps[0]),
+            fmt_sweep(&f.sweeps[1])
+        );
+    }
+    let _ = writeln!(s, "study {:.1} s\nwrote {}", res.wall_s, dir.display());
+    s
+}

@@ -1,0 +1,410 @@
+//! Two-size convergence studies: the two bodies refined independently, to separate what
+//! each mesh contributes. Lemma 3.1 bounds the consistency error by one term per body,
+//! h1^(3/4) + h2 for K_h^pi and (h1^(1/2) ||e||)^(1/2) + h1^(3/4) + h2^(3/4) for K_h^I (body
+//! 1 the slave); the diagonal studies refine both at a fixed ratio and see only their sum.
+//!
+//! [`run`] reads like the description of the study:
+//! 1. plan, for every slave choice and cone, the grid of (slave level, master level) pairs,
+//!    the two one-sided sweeps (each body swept with the other held at `fixed`, finer than
+//!    every grid level) and the pair (fixed, fixed), the floor of both sweeps;
+//! 2. solve them (meshes: each body split from the same gmsh family to its own level, so a
+//!    pair of equal levels is the diagonal study's mesh), and the reference where the study
+//!    has no exact solution (one per slave choice: the bodies are numbered by it);
+//! 3. measure every pair against the truth ([`Truth`], shared with the diagonal studies);
+//! 4. fit: the rate in h1 along the sweep at fixed h2 and the rate in h2 along the other
+//!    ([`rates::assess`], with the (fixed, fixed) error as the floor: a sweep level within
+//!    5x of it is left out), and the whole grid to E = C1 h1^a1 + C2 h2^a2
+//!    ([`rates::fit_power_sum`]).
+
+use super::convergence::{Reference, Study, Truth, provenance, reference};
+use super::jobs::{self, Job, JobId, Mode};
+use super::quantity::Quantity;
+use super::rates::{self, Assessment, LevelError, PowerSumFit};
+use crate::case::Case;
+use crate::contact::Method;
+use crate::error::{Error, Result};
+use crate::progress::Progress;
+use crate::scene::Scene;
+use crate::solve::Solution;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+/// Lemma 3.1's exponents of the consistency error in (h1, h2): K_h^pi h1^(3/4) + h2,
+/// K_h^I h1^(1/2) (from (h1^(1/2) ||e||)^(1/2) with ||e|| bounded) + h2^(3/4).
+pub fn lemma_exponents(method: Method) -> [f64; 2] {
+    match method {
+        Method::Mortar => [0.75, 1.0],
+        Method::Nts => [0.5, 0.75],
+    }
+}
+
+/// One measured pair of sizes.
+#[derive(Debug, Clone, Serialize)]
+pub struct SizePoint {
+    /// The body carrying the constraint.
+    pub slave: String,
+    /// Cone.
+    pub method: Method,
+    /// Level of the slave's mesh.
+    pub slave_level: usize,
+    /// Level of the master's mesh.
+    pub master_level: usize,
+    /// Max element diameter of the slave (length).
+    pub h1: f64,
+    /// Max element diameter of the master (length).
+    pub h2: f64,
+    /// Free dofs on the slave's nodes.
+    pub dofs1: usize,
+    /// Free dofs on the master's nodes.
+    pub dofs2: usize,
+    /// Quantity.
+    pub quantity: Quantity,
+    /// Relative error (max over time steps).
+    pub error: f64,
+    /// Wall time of the solve (s).
+    pub wall_s: f64,
+}
+
+/// What one slave choice, cone and quantity measured and fitted.
+#[derive(Debug, Clone)]
+pub struct SizeFit {
+    /// The body carrying the constraint.
+    pub slave: String,
+    /// Cone.
+    pub method: Method,
+    /// Quantity.
+    pub quantity: Quantity,
+    /// The grid fit E = C1 h1^a1 + C2 h2^a2 (None: no finite fit).
+    pub fit: Option<PowerSumFit>,
+    /// The rate in h1 at fixed h2 and the rate in h2 at fixed h1 (levels are the swept
+    /// body's).
+    pub sweeps: [Assessment; 2],
+    /// The error at (fixed, fixed): the floor of both sweeps.
+    pub floor: f64,
+    /// At the finest grid diagonal point: each body's fitted term C_b h_b^a_b.
+    pub terms: [f64; 2],
+    /// At the same point: the error removed per added dof by refining each body,
+    /// a_b C_b h_b^a_b / (2 N_b) (N_b the body's dofs, ~ h_b^-2).
+    pub gain_per_dof: [f64; 2],
+}
+
+/// Everything a two-size study measured.
+#[derive(Debug, Clone)]
+pub struct TwoSizeResult {
+    /// Study name.
+    pub name: String,
+    /// Study description.
+    pub description: String,
+    /// The scene (as its file names the slave).
+    pub scene: Scene,
+    /// The grid levels of each body.
+    pub levels: Vec<usize>,
+    /// The level a body is held at while the other is swept.
+    pub fixed: usize,
+    /// The slave choices, in order.
+    pub slaves: Vec<String>,
+    /// The diagonal study on the same family, if named.
+    pub diagonal: Option<String>,
+    /// The cones.
+    pub methods: Vec<Method>,
+    /// The quantities.
+    pub quantities: Vec<Quantity>,
+    /// Time steps per solve.
+    pub steps: usize,
+    /// Every measured pair.
+    pub points: Vec<SizePoint>,
+    /// Every fit.
+    pub fits: Vec<SizeFit>,
+    /// The reference of each slave choice (empty: against the exact solution).
+    pub references: Vec<(String, Reference)>,
+    /// Gauss points per direction of the exact-error rule (None: a reference solve).
+    pub exact_quadrature: Option<usize>,
+    /// gmsh version, .geo hash, solver, cores, commit.
+    pub provenance: BTreeMap<String, String>,
+    /// Total wall time (s).
+    pub wall_s: f64,
+    /// Scene warnings.
+    pub warnings: Vec<String>,
+}
+
+impl TwoSizeResult {
+    /// The points of one slave choice, cone and quantity.
+    pub fn of(&self, slave: &str, method: Method, q: Quantity) -> impl Iterator<Item = &SizePoint> {
+        self.points
+            .iter()
+            .filter(move |p| p.slave == slave && p.method == method && p.quantity == q)
+    }
+
+    /// The error at (slave level, master level), if measured.
+    pub fn error(&self, slave: &str, method: Method, q: Quantity, levels: [usize; 2]) -> Option<f64> {
+        self.of(slave, method, q)
+            .find(|p| [p.slave_level, p.master_level] == levels)
+            .map(|p| p.error)
+    }
+}
+
+/// The (slave, master) level pairs of one slave choice and cone: the grid, the two sweeps
+/// and (fixed, fixed).
+fn pairs(levels: &[usize], fixed: usize) -> Vec<[usize; 2]> {
+    let mut out: Vec<[usize; 2]> = Vec::new();
+    for &a in levels {
+        for &b in levels {
+            out.push([a, b]);
+        }
+    }
+    for &l in levels {
+        out.push([l, fixed]);
+        out.push([fixed, l]);
+    }
+    out.push([fixed, fixed]);
+    out
+}
+
+/// The planned solves.
+struct Plan {
+    jobs: Vec<Job>,
+    /// Per slave choice, its reference levels (none against the exact solution).
+    references: Vec<Option<[JobId; 3]>>,
+    /// (slave choice, cone, levels, job).
+    pairs: Vec<(usize, Method, [usize; 2], JobId)>,
+}
+
+impl Plan {
+    fn new(study: &Study, slaves: usize, fixed: usize) -> Self {
+        let sf = &study.file;
+        let family = sf.family_parameters();
+        let reference_parameters = sf.reference_parameters();
+        let mut jobs: Vec<Job> = Vec::new();
+        let mut add = |label: String, method: Method, levels: [usize; 2], params: &[(String, f64)], scene: usize| {
+            jobs.push(Job {
+                id: jobs.len(),
+                label,
+                method,
+                level: levels[0].max(levels[1]),
+                body_levels: levels,
+                params: params.to_vec(),
+                steps: sf.steps,
+                scene,
+            });
+            jobs.len() - 1
+        };
+        let r = study.reference_level();
+        let mut references = Vec::new();
+        let mut planned = Vec::new();
+        for s in 0..slaves {
+            references.push((!sf.reference.exact).then(|| {
+                [r - 2, r - 1, r].map(|l| {
+                    add(format!("reference {s} level {l}"), Method::Mortar, [l, l], &reference_parameters, s)
+                })
+            }));
+            for &method in &sf.methods {
+                for levels in pairs(&sf.mesh.levels, fixed) {
+                    let label = format!("slave {s} {method} levels {levels:?}");
+                    planned.push((s, method, levels, add(label, method, levels, &family, s)));
+                }
+            }
+        }
+        Plan {
+            jobs,
+            references,
+            pairs: planned,
+        }
+    }
+}
+
+/// Free dofs on the nodes of each body.
+fn body_dofs(case: &Case) -> [usize; 2] {
+    let m = &case.problem.model;
+    [0, 1].map(|b| {
+        let range = m.node_offset[b]..m.node_offset[b] + m.meshes[b].nodes.len();
+        range
+            .flat_map(|n| [2 * n, 2 * n + 1])
+            .filter(|&d| m.equation[d] != crate::fe::FIXED)
+            .count()
+    })
+}
+
+/// Run the two-size study `name` (built-in name or path).
+pub fn run(name: &str) -> Result<TwoSizeResult> {
+    let t0 = Instant::now();
+    let study = Study::load(name)?;
+    let sf = &study.file;
+    let spec = sf.two_size.as_ref().ok_or_else(|| {
+        Error::input(&study.path, "two_size", "not a two-size study: add a [two_size] table")
+    })?;
+    // Step 1: the plan, a scene per slave choice.
+    let slaves: Vec<String> = if spec.slaves.is_empty() {
+        vec![study.scene.bodies[0].surface.clone()]
+    } else {
+        spec.slaves.clone()
+    };
+    let scenes: Vec<Scene> = slaves
+        .iter()
+        .map(|s| study.scene.with_slave(s))
+        .collect::<Result<_>>()?;
+    let plan = Plan::new(&study, slaves.len(), spec.fixed);
+    // Step 2: every solve.
+    let progress = Progress::new(plan.jobs.len() as u64, &study.name);
+    let scene_refs: Vec<&Scene> = scenes.iter().collect();
+    let outputs = jobs::execute(&plan.jobs, &scene_refs, sf.solver, &study.text, Mode::All, &|l| progress.tick(l))?;
+    progress.finish();
+    let mut solved = jobs::Solved::complete(outputs).expect("every job ran");
+    let truths: Vec<Truth> = plan
+        .references
+        .iter()
+        .zip(&scenes)
+        .map(|(ids, scene)| match ids {
+            Some(ids) => Truth::Solved(reference(*ids, &mut solved, study.reference_level())),
+            None => Truth::Exact(
+                scene.exact.as_deref().expect("checked when the study was read"),
+                sf.reference.quadrature,
+            ),
+        })
+        .collect();
+    // Step 3: every pair against its truth.
+    let runs: Vec<(usize, Method, [usize; 2], Case, Solution)> = plan
+        .pairs
+        .iter()
+        .map(|&(s, m, l, id)| {
+            let (case, sol) = solved.take(id);
+            (s, m, l, case, sol)
+        })
+        .collect();
+    let measured: Vec<BTreeMap<Quantity, f64>> = runs
+        .par_iter()
+        .map(|(s, _, _, case, sol)| truths[*s].relative_errors(case, sol))
+        .collect();
+    let mut points = Vec::new();
+    for ((s, method, levels, case, sol), errors) in runs.iter().zip(&measured) {
+        let m = &case.problem.model;
+        let dofs = body_dofs(case);
+        for &quantity in &sf.quantities {
+            let error = errors[&quantity];
+            if !error.is_finite() {
+                return Err(Error::NotConverged(format!(
+                    "slave {} {method} levels {levels:?}: the {quantity} error is not finite",
+                    slaves[*s]
+                )));
+            }
+            points.push(SizePoint {
+                slave: slaves[*s].clone(),
+                method: *method,
+                slave_level: levels[0],
+                master_level: levels[1],
+                h1: m.meshes[0].h(),
+                h2: m.meshes[1].h(),
+                dofs1: dofs[0],
+                dofs2: dofs[1],
+                quantity,
+                error,
+                wall_s: sol.wall_s,
+            });
+        }
+    }
+    // Step 4: the fits.
+    let mut fits = Vec::new();
+    for (s, slave) in slaves.iter().enumerate() {
+        for &method in &sf.methods {
+            for &quantity in &sf.quantities {
+                fits.push(fit(&points, slave, method, quantity, &sf.mesh.levels, spec.fixed, truths[s].quantity_error(quantity), &study.path)?);
+            }
+        }
+    }
+    let references = truths
+        .iter()
+        .zip(&slaves)
+        .filter_map(|(t, s)| match t {
+            Truth::Solved(r) => Some((s.clone(), r.facts)),
+            Truth::Exact(..) => None,
+        })
+        .collect();
+    let first = &runs[0].3;
+    let provenance = provenance(&study, &first.mesh);
+    Ok(TwoSizeResult {
+        name: study.name.clone(),
+        description: sf.description.clone(),
+        levels: sf.mesh.levels.clone(),
+        fixed: spec.fixed,
+        methods: sf.methods.clone(),
+        quantities: sf.quantities.clone(),
+        steps: sf.steps,
+        diagonal: spec.diagonal.clone(),
+        slaves,
+        points,
+        fits,
+        references,
+        exact_quadrature: sf.reference.exact.then_some(sf.reference.quadrature),
+        provenance,
+        wall_s: t0.elapsed().as_secs_f64(),
+        warnings: first.warnings.clone(),
+        scene: study.scene,
+    })
+}
+
+/// Step 4 for one slave choice, cone and quantity.
+#[allow(clippy::too_many_arguments)]
+fn fit(
+    points: &[SizePoint],
+    slave: &str,
+    method: Method,
+    quantity: Quantity,
+    levels: &[usize],
+    fixed: usize,
+    truth_error: f64,
+    path: &std::path::Path,
+) -> Result<SizeFit> {
+    let mine: Vec<&SizePoint> = points
+        .iter()
+        .filter(|p| p.slave == slave && p.method == method && p.quantity == quantity)
+        .collect();
+    let at = |l: [usize; 2]| mine.iter().find(|p| [p.slave_level, p.master_level] == l).copied();
+    let floor = at([fixed, fixed]).map_or(0.0, |p| p.error);
+    // The sweeps: a level is left out where its error is within 5x of the floor (the
+    // fixed body's own error) or of the truth's.
+    let sweep = |b: usize| -> Result<Assessment> {
+        let rows: Vec<LevelError> = levels
+            .iter()
+            .filter_map(|&l| {
+                let p = at(if b == 0 { [l, fixed] } else { [fixed, l] })?;
+                Some(LevelError {
+                    level: l,
+                    h: if b == 0 { p.h1 } else { p.h2 },
+                    dofs: (if b == 0 { p.dofs1 } else { p.dofs2 }) as f64,
+                    error: p.error,
+                })
+            })
+            .collect();
+        rates::assess(&rows, floor.max(truth_error)).map_err(|e| {
+            Error::input(path, "mesh.levels", format!("{slave} {method} {quantity}: {e}"))
+        })
+    };
+    let sweeps = [sweep(0)?, sweep(1)?];
+    let grid: Vec<(f64, f64, f64)> = mine
+        .iter()
+        .filter(|p| levels.contains(&p.slave_level) && levels.contains(&p.master_level))
+        .filter(|p| p.error > rates::ROUNDOFF)
+        .map(|p| (p.h1, p.h2, p.error))
+        .collect();
+    let fit = rates::fit_power_sum(&grid);
+    let finest = *levels.last().expect("levels");
+    let (terms, gain_per_dof) = match (fit, at([finest, finest])) {
+        (Some(f), Some(p)) => {
+            let t = f.terms([p.h1, p.h2]);
+            let n = [p.dofs1 as f64, p.dofs2 as f64];
+            (t, [0, 1].map(|b| f.a[b] * t[b] / (2.0 * n[b])))
+        }
+        _ => ([f64::NAN; 2], [f64::NAN; 2]),
+    };
+    Ok(SizeFit {
+        slave: slave.to_string(),
+        method,
+        quantity,
+        fit,
+        sweeps,
+        floor,
+        terms,
+        gain_per_dof,
+    })
+}
