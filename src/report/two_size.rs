@@ -236,8 +236,22 @@ fn sweeps(res: &TwoSizeResult, slave: &str, d: &Path) -> Result<()> {
     )
 }
 
+/// Largest rms log residual of a grid fit that is reported (the errors within ~28 % of it).
+const FIT_RMS: f64 = 0.25;
+/// Largest standard error of an exponent that is reported.
+const FIT_SE: f64 = 0.5;
+
+/// Exponent `b` of the grid fit, or why the numbers do not support one: a poor fit overall,
+/// or a term too small on the grid to identify its exponent.
 fn fmt_fit(f: &SizeFit, b: usize) -> String {
-    f.fit.map_or("no fit".into(), |x| format!("{:.3} ± {:.3}", x.a[b], x.se[b]))
+    match f.fit {
+        None => "no fit".into(),
+        Some(x) if x.rms_log_residual > FIT_RMS => format!("poor fit (rms {:.2})", x.rms_log_residual),
+        Some(x) if !(x.se[b] <= FIT_SE) || !(0.0..6.0).contains(&x.a[b]) => {
+            format!("not identified ({:.2} ± {:.2})", x.a[b], x.se[b])
+        }
+        Some(x) => format!("{:.3} ± {:.3}", x.a[b], x.se[b]),
+    }
 }
 
 fn fmt_sweep(a: &Assessment) -> String {
@@ -253,8 +267,9 @@ fn fmt_sweep(a: &Assessment) -> String {
     }
 }
 
-/// The plain answer for one fit: which body's term dominates at the finest diagonal point
-/// and which refinement buys more per dof.
+/// The plain answer for one slave choice, cone and quantity, from the measured errors
+/// alone: from the finest grid diagonal point (L, L), refining the slave to the fixed level
+/// (fixed, L) against refining the master (L, fixed), each gain divided by the dofs it adds.
 fn answer(res: &TwoSizeResult, f: &SizeFit) -> String {
     let master = res
         .scene
@@ -263,23 +278,45 @@ fn answer(res: &TwoSizeResult, f: &SizeFit) -> String {
         .map(|b| b.surface.as_str())
         .find(|s| *s != f.slave)
         .unwrap_or("?");
-    if !(f.terms[0].is_finite() && f.terms[1].is_finite()) {
-        return "no fit: nothing to say".into();
-    }
+    let finest = *res.levels.last().expect("levels");
+    let at = |l: [usize; 2]| {
+        res.of(&f.slave, f.method, f.quantity)
+            .find(|p| [p.slave_level, p.master_level] == l)
+    };
+    let (Some(base), Some(s1), Some(s2)) = (
+        at([finest, finest]),
+        at([res.fixed, finest]),
+        at([finest, res.fixed]),
+    ) else {
+        return "not measured".into();
+    };
+    let gain = [
+        (base.error - s1.error) / (s1.dofs1 as f64 - base.dofs1 as f64),
+        (base.error - s2.error) / (s2.dofs2 as f64 - base.dofs2 as f64),
+    ];
     let names = [format!("the slave '{}'", f.slave), format!("the master '{master}'")];
-    let big = usize::from(f.terms[1] > f.terms[0]);
-    let ratio = f.terms[big] / f.terms[1 - big].max(f64::MIN_POSITIVE);
-    let better = usize::from(f.gain_per_dof[1] > f.gain_per_dof[0]);
+    let better = usize::from(gain[1] > gain[0]);
+    let words = |g: f64, e: f64| {
+        if g > 0.0 {
+            format!("to {e:.3e}")
+        } else {
+            format!("not at all ({e:.3e})")
+        }
+    };
     format!(
-        "{}'s mesh dominates ({:.2e} against {:.2e}, {ratio:.1}x); per added dof, refining {} buys {:.2e}, {} {:.2e}: refine {} first",
-        names[big],
-        f.terms[big],
-        f.terms[1 - big],
-        names[0],
-        f.gain_per_dof[0],
-        names[1],
-        f.gain_per_dof[1],
-        names[better]
+        "from {:.3e} at ({finest}, {finest}), refining the slave to level {} brings it {}, the master {}; per added dof {:.2e} against {:.2e}: {} limits the error{}",
+        base.error,
+        res.fixed,
+        words(gain[0], s1.error),
+        words(gain[1], s2.error),
+        gain[0],
+        gain[1],
+        names[better],
+        if gain[0].max(gain[1]) > 0.0 && gain[0].min(gain[1]) > 0.0 {
+            format!(" ({:.1}x more per dof)", gain[better] / gain[1 - better])
+        } else {
+            String::new()
+        }
     )
 }
 
@@ -339,22 +376,32 @@ fn readme(res: &TwoSizeResult) -> String {
     let _ = writeln!(s, "Scene `{}`: {}\n", res.scene.name, res.scene.description);
     let _ = writeln!(
         s,
-        "Regenerate with `cargo run --release -- study {}` ({:.0} s on this machine, {} cores). Grid: every pair of levels {} of the slave (body 1) and the master (body 2); one-sided sweeps: each body over those levels with the other at level {}; and (level {0}, level {0}) as their floor. Slave choices: {}. {} time steps.\n",
+        "Regenerate with `cargo run --release -- study {}` ({:.0} s on this machine, {} cores). Grid: every pair of levels {} of the slave (body 1) and the master (body 2); one-sided sweeps: each body over those levels with the other at level {fixed}; and (level {fixed}, level {fixed}) as their floor. Slave choices: {}. {} time steps.\n",
         res.name,
         res.wall_s,
         res.provenance.get("cores").cloned().unwrap_or_default(),
         levels_text(&res.levels),
-        res.fixed,
         res.slaves.join(", "),
-        res.steps
+        res.steps,
+        fixed = res.fixed
     );
     // The lead: the exponents per cone and slave against the Lemma.
     let _ = writeln!(
         s,
-        "## Exponents in h1 (slave) and h2 (master)\n\nThe grid fitted to E = C1 h1^a1 + C2 h2^a2 (nonlinear least squares in log space, ± standard errors, rms of the log residuals), beside Lemma 3.1's consistency exponents (K_h^pi: h1^(3/4) + h2; K_h^I: (h1^(1/2) ||e||)^(1/2) + h1^(3/4) + h2^(3/4), i.e. h1^(1/2) + h2^(3/4)); the finite elements' own approximation adds h1 + h2 in the theorem norm. The one-sided rates: the slave swept with the master at level {fixed}, the master swept with the slave at level {fixed} (a sweep level within 5x of the error at ({fixed}, {fixed}), the fixed body's own error, is left out: that is how the fixed level is checked to be fine enough).\n\n| slave | method | quantity | a1 (h1) | a2 (h2) | Lemma (a1, a2) | rms log residual | rate in h1, master fixed | rate in h2, slave fixed | floor ({fixed}, {fixed}) |\n|---|---|---|---|---|---|---|---|---|---|",
+        "## What differs between the cones: exponents in h1 (slave) and h2 (master)\n\nRows of the two cones side by side (the quantities mapped below; every quantity in `fits.csv`). The grid fitted to E = C1 h1^a1 + C2 h2^a2 (nonlinear least squares in log space, ± standard errors, rms of the log residuals), beside Lemma 3.1's consistency exponents (K_h^pi: h1^(3/4) + h2; K_h^I: (h1^(1/2) ||e||)^(1/2) + h1^(3/4) + h2^(3/4), i.e. h1^(1/2) + h2^(3/4)); the finite elements' own approximation adds h1 + h2 in the theorem norm. The one-sided rates: the slave swept with the master at level {fixed}, the master swept with the slave at level {fixed} (a sweep level within 5x of the error at ({fixed}, {fixed}), which bounds the fixed body's own error, is left out: that is how the fixed level is checked to be fine enough; `too few levels` there means the swept body's error is swamped by that floor from the second level on: its mesh does not limit the error). Thresholds: the fitted a1 of the threshold quantity must reach the study's rate threshold minus its tolerance where the fit identifies it ({:.2} mortar, {:.2} nts).\n\n| slave | method | quantity | a1 (h1) | a2 (h2) | Lemma (a1, a2) | rms log residual | rate in h1, master fixed | rate in h2, slave fixed | floor ({fixed}, {fixed}) |\n|---|---|---|---|---|---|---|---|---|---|",
+        res.thresholds[0],
+        res.thresholds[1],
         fixed = res.fixed
     );
-    for f in &res.fits {
+    let mut rows: Vec<&SizeFit> = res.fits.iter().filter(|f| MAPPED.contains(&f.quantity)).collect();
+    rows.sort_by_key(|f| {
+        (
+            res.slaves.iter().position(|x| *x == f.slave),
+            MAPPED.iter().position(|q| *q == f.quantity),
+            f.method.name(),
+        )
+    });
+    for f in rows {
         let lemma = lemma_exponents(f.method);
         let _ = writeln!(
             s,
@@ -375,9 +422,10 @@ fn readme(res: &TwoSizeResult) -> String {
     let finest = *res.levels.last().expect("levels");
     let _ = writeln!(
         s,
-        "\n## Which mesh limits the error\n\nAt the finest grid diagonal point (level {finest} for both bodies), each body's fitted term C_b h_b^a_b, and the error removed per added dof by refining that body, a_b C_b h_b^a_b / (2 N_b) (N_b its dofs, N_b ~ h_b^-2).\n"
+        "\n## Which mesh limits the error\n\nMeasured, no model: from the finest grid diagonal point (level {finest} for both bodies), the error with the slave refined to level {} and with the master refined to it, each gain divided by the dofs the refinement adds (every quantity in `fits.csv`: the fitted terms C_b h_b^a_b at that point and a_b C_b h_b^a_b / (2 N_b), the model's gain per dof).\n",
+        res.fixed
     );
-    for f in &res.fits {
+    for f in res.fits.iter().filter(|f| MAPPED.contains(&f.quantity)) {
         let _ = writeln!(s, "- {} / {} / {}: {}.", f.slave, f.method, f.quantity, answer(res, f));
     }
     if res.slaves.len() > 1 {
@@ -394,13 +442,20 @@ fn readme(res: &TwoSizeResult) -> String {
                     .iter()
                     .map(|x| res.error(x, m, q, [finest, finest]))
                     .collect();
-                let best = e
+                let shown: Vec<String> = e
                     .iter()
-                    .enumerate()
-                    .filter_map(|(i, v)| v.map(|v| (i, v)))
-                    .min_by(|a, b| a.1.total_cmp(&b.1))
-                    .map(|(i, _)| res.slaves[i].clone())
-                    .unwrap_or_default();
+                    .map(|v| v.map_or("-".into(), |v| format!("{v:.3e}")))
+                    .collect();
+                let best = if shown.windows(2).all(|w| w[0] == w[1]) {
+                    "the same to the digits shown".to_string()
+                } else {
+                    e.iter()
+                        .enumerate()
+                        .filter_map(|(i, v)| v.map(|v| (i, v)))
+                        .min_by(|a, b| a.1.total_cmp(&b.1))
+                        .map(|(i, _)| res.slaves[i].clone())
+                        .unwrap_or_default()
+                };
                 let _ = writeln!(
                     s,
                     "| {m} | {q} | {} | {best} |",

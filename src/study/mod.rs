@@ -164,6 +164,7 @@ impl Outcome {
     pub fn failures(&self) -> Vec<String> {
         match self {
             Outcome::Convergence(r) => r.failures(),
+            Outcome::TwoSize(r) => r.failures(),
             _ => Vec::new(),
         }
     }

@@ -113,6 +113,10 @@ pub struct TwoSizeResult {
     pub quantities: Vec<Quantity>,
     /// Time steps per solve.
     pub steps: usize,
+    /// The quantity the thresholds apply to.
+    pub threshold_quantity: Quantity,
+    /// The required a1 of mortar and nts (rate threshold minus tolerance).
+    pub thresholds: [f64; 2],
     /// Every measured pair.
     pub points: Vec<SizePoint>,
     /// Every fit.
@@ -130,6 +134,28 @@ pub struct TwoSizeResult {
 }
 
 impl TwoSizeResult {
+    /// Theorem 3.1's thresholds carried to the grid fit (Lemma 3.1: the slave's term is
+    /// h1^(3/4) for K_h^pi and h1^(1/2) for K_h^I, the approximation error h1): the fitted
+    /// exponent a1 of the threshold quantity must reach the study's rate threshold minus its
+    /// tolerance wherever the fit identifies it (standard error <= 0.5, rms log residual
+    /// <= 0.25). One sentence per miss.
+    pub fn failures(&self) -> Vec<String> {
+        self.fits
+            .iter()
+            .filter(|f| f.quantity == self.threshold_quantity)
+            .filter_map(|f| {
+                let x = f.fit.filter(|x| x.se[0] <= 0.5 && x.rms_log_residual <= 0.25)?;
+                let need = self.thresholds[usize::from(f.method == Method::Nts)];
+                (x.a[0] < need).then(|| {
+                    format!(
+                        "slave {} {} {}: a1 = {:.3} < {need:.3}",
+                        f.slave, f.method, f.quantity, x.a[0]
+                    )
+                })
+            })
+            .collect()
+    }
+
     /// The points of one slave choice, cone and quantity.
     pub fn of(&self, slave: &str, method: Method, q: Quantity) -> impl Iterator<Item = &SizePoint> {
         self.points
@@ -330,6 +356,8 @@ pub fn run(name: &str) -> Result<TwoSizeResult> {
         methods: sf.methods.clone(),
         quantities: sf.quantities.clone(),
         steps: sf.steps,
+        threshold_quantity: sf.thresholds.quantity,
+        thresholds: [Method::Mortar, Method::Nts].map(|m| sf.thresholds.of(m).value()),
         diagonal: spec.diagonal.clone(),
         slaves,
         points,
