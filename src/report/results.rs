@@ -272,8 +272,123 @@ pub fn section(reports: &Path) -> Result<String> {
         }
         let _ = writeln!(s);
     }
+    for (name, what) in TWO_SIZE {
+        two_size_headline(reports, name, what, &mut s)?;
+    }
     speed_and_stability(reports, &mut s)?;
     Ok(s)
+}
+
+/// The two-size studies whose reports the section summarises.
+pub const TWO_SIZE: [(&str, &str); 2] = [
+    (
+        "two-size-exact",
+        "the slave's and the master's mesh refined independently, `contact-mms` against its exact solution",
+    ),
+    (
+        "two-size-rates",
+        "the same on the viscoplastic `rates` scene against a matching-mesh reference",
+    ),
+];
+
+/// One row of a two-size report's fits.csv (the columns read here).
+#[derive(Debug, Deserialize)]
+struct SizeFitLine {
+    slave: String,
+    method: String,
+    quantity: String,
+    a1: Option<f64>,
+    se_a1: Option<f64>,
+    a2: Option<f64>,
+    se_a2: Option<f64>,
+    rms_log_residual: Option<f64>,
+}
+
+/// One row of a two-size report's grid.csv (the columns read here).
+#[derive(Debug, Deserialize)]
+struct SizePointLine {
+    slave: String,
+    method: String,
+    slave_level: usize,
+    master_level: usize,
+    quantity: String,
+    error: f64,
+}
+
+/// The theorem norm's exponents per slave choice and cone, and what refining each body
+/// alone from the finest grid diagonal point does to the theorem error and the penetration.
+fn two_size_headline(reports: &Path, name: &str, what: &str, s: &mut String) -> Result<()> {
+    let dir = reports.join(name);
+    let fits: Vec<SizeFitLine> = read(&dir.join("fits.csv"))?;
+    let grid: Vec<SizePointLine> = read(&dir.join("grid.csv"))?;
+    let _ = writeln!(s, "### [`{name}`](reports/{name}/README.md): {what}
+");
+    let exponent = |v: Option<f64>, se: Option<f64>, rms: Option<f64>| match (v, se, rms) {
+        (Some(v), Some(se), Some(rms)) if se <= 0.5 && rms <= 0.25 => format!("{v:.2} ± {se:.2}"),
+        _ => "not identified".into(),
+    };
+    let mut slaves: Vec<&str> = fits.iter().map(|f| f.slave.as_str()).collect();
+    slaves.dedup();
+    for slave in &slaves {
+        let parts: Vec<String> = fits
+            .iter()
+            .filter(|f| f.slave == *slave && f.quantity == "theorem")
+            .map(|f| {
+                format!(
+                    "{} a1 {}, a2 {}",
+                    f.method,
+                    exponent(f.a1, f.se_a1, f.rms_log_residual),
+                    exponent(f.a2, f.se_a2, f.rms_log_residual)
+                )
+            })
+            .collect();
+        let _ = writeln!(
+            s,
+            "- Theorem norm, E = C1 h1^a1 + C2 h2^a2 with slave '{slave}' (Lemma 3.1: mortar (0.75, 1), nts (0.5, 0.75)): {}.",
+            parts.join("; ")
+        );
+    }
+    // From the finest diagonal point, each body refined alone to the fixed level.
+    let levels: Vec<usize> = grid.iter().map(|p| p.slave_level.min(p.master_level)).collect();
+    let top = grid.iter().map(|p| p.slave_level.max(p.master_level)).max().unwrap_or(0);
+    let finest = grid
+        .iter()
+        .zip(&levels)
+        .filter(|(p, _)| p.slave_level == p.master_level && p.slave_level < top)
+        .map(|(p, _)| p.slave_level)
+        .max()
+        .unwrap_or(0);
+    let error = |slave: &str, m: &str, q: &str, l: [usize; 2]| {
+        grid.iter()
+            .find(|p| p.slave == slave && p.method == m && p.quantity == q && [p.slave_level, p.master_level] == l)
+            .map(|p| p.error)
+    };
+    if let Some(slave) = slaves.first() {
+        let mut parts = Vec::new();
+        for m in ["mortar", "nts"] {
+            for q in ["theorem", "max_penetration"] {
+                let (Some(base), Some(s1), Some(s2)) = (
+                    error(slave, m, q, [finest, finest]),
+                    error(slave, m, q, [top, finest]),
+                    error(slave, m, q, [finest, top]),
+                ) else {
+                    continue;
+                };
+                parts.push(format!(
+                    "{m} {q} {base:.2e} -> slave refined {s1:.2e} (x{:.2}), master refined {s2:.2e} (x{:.2})",
+                    s1 / base,
+                    s2 / base
+                ));
+            }
+        }
+        let _ = writeln!(
+            s,
+            "- From ({finest}, {finest}), slave '{slave}', one body refined to level {top}: {}.",
+            parts.join("; ")
+        );
+    }
+    let _ = writeln!(s);
+    Ok(())
 }
 
 /// One row of a report's levels.csv (the columns read here).

@@ -446,7 +446,9 @@ fn readme(res: &TwoSizeResult) -> String {
                     .iter()
                     .map(|v| v.map_or("-".into(), |v| format!("{v:.3e}")))
                     .collect();
-                let best = if shown.windows(2).all(|w| w[0] == w[1]) {
+                let best = if e.iter().all(|v| v.is_some_and(|v| v <= crate::study::rates::ROUNDOFF)) {
+                    "both at round-off".to_string()
+                } else if shown.windows(2).all(|w| w[0] == w[1]) {
                     "the same to the digits shown".to_string()
                 } else {
                     e.iter()
