@@ -296,6 +296,12 @@ fn answer(res: &TwoSizeResult, f: &SizeFit) -> String {
     ];
     let names = [format!("the slave '{}'", f.slave), format!("the master '{master}'")];
     let better = usize::from(gain[1] > gain[0]);
+    if gain[0] <= 0.0 && gain[1] <= 0.0 {
+        return format!(
+            "from {:.3e} at ({finest}, {finest}), refining the slave to level {} gives {:.3e}, the master {:.3e}: neither refinement alone reduces it (the error depends on both meshes together)",
+            base.error, res.fixed, s1.error, s2.error
+        );
+    }
     let words = |g: f64, e: f64| {
         if g > 0.0 {
             format!("to {e:.3e}")
@@ -336,10 +342,12 @@ fn diagonal(res: &TwoSizeResult, s: &mut String) {
         Err(_) => return,
     };
     let slave = &res.scene.bodies[0].surface;
-    let mut worst: Vec<(String, f64, usize)> = Vec::new();
+    let mut worst: Vec<(String, f64, usize, bool)> = Vec::new();
     for &q in &res.quantities {
         let mut w = 0.0f64;
         let mut n = 0;
+        // Errors at round-off on both sides agree to round-off, not relatively.
+        let mut roundoff = true;
         for &m in &res.methods {
             for &l in &res.levels {
                 let (Some(a), Some(b)) = (
@@ -350,12 +358,16 @@ fn diagonal(res: &TwoSizeResult, s: &mut String) {
                 ) else {
                     continue;
                 };
-                w = w.max((a - b).abs() / b.abs().max(f64::MIN_POSITIVE));
+                let tiny = crate::study::rates::ROUNDOFF;
+                if a > tiny || b > tiny {
+                    roundoff = false;
+                    w = w.max((a - b).abs() / b.abs().max(f64::MIN_POSITIVE));
+                }
                 n += 1;
             }
         }
         if n > 0 {
-            worst.push((q.name().to_string(), w, n));
+            worst.push((q.name().to_string(), w, n, roundoff));
         }
     }
     let _ = writeln!(
@@ -364,8 +376,12 @@ fn diagonal(res: &TwoSizeResult, s: &mut String) {
         res.steps,
         levels_text(&res.levels)
     );
-    for (q, w, n) in worst {
-        let _ = writeln!(s, "| {q} | {n} | {w:.2e} |");
+    for (q, w, n, roundoff) in worst {
+        if roundoff {
+            let _ = writeln!(s, "| {q} | {n} | both at round-off (<= {:.0e}) |", crate::study::rates::ROUNDOFF);
+        } else {
+            let _ = writeln!(s, "| {q} | {n} | {w:.2e} |");
+        }
     }
     let _ = writeln!(s);
 }
@@ -419,6 +435,10 @@ fn readme(res: &TwoSizeResult) -> String {
             f.floor
         );
     }
+    let _ = writeln!(
+        s,
+        "\n`poor fit`: the grid fit misses the errors by more than 28 % rms (rms log residual > {FIT_RMS}): the additive model does not describe them. Where an error grows when one body alone is refined (below: K_h^I's contact quantities when the master is refined past the slave, whose nodes alone carry the constraint), no sum of two positive terms C1 h1^a1 + C2 h2^a2 can fit it: the error depends on the ratio h1/h2, not on each size separately. `not identified`: a term too small on the grid for its exponent to be measured (standard error > {FIT_SE})."
+    );
     let finest = *res.levels.last().expect("levels");
     let _ = writeln!(
         s,

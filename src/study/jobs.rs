@@ -88,6 +88,8 @@ fn key(job: &Job, scene: &Scene, kind: SolverKind, study_text: &str) -> Result<S
         job.steps
     );
     k.push_str(&gmsh::sha256_hex(&scene_text));
+    // The slave choice: a two-size study solves one scene file with either body as slave.
+    k.push_str(&scene.bodies[0].surface);
     k.push_str(&gmsh::sha256_hex(&geo));
     k.push_str(&gmsh::sha256_hex(study_text.as_bytes()));
     Ok(gmsh::sha256_hex(k.as_bytes())[..24].to_string())
