@@ -77,6 +77,23 @@ pub fn support_warnings(
     Ok(out)
 }
 
+/// The scene's gmsh parameters overridden by `params`, checked against the .geo.
+fn checked_parameters(scene: &Scene, params: &[(String, f64)]) -> Result<Vec<(String, f64)>> {
+    let mut all: Vec<(String, f64)> = scene
+        .parameters
+        .iter()
+        .map(|(k, v)| (k.clone(), *v))
+        .collect();
+    for (k, v) in params {
+        match all.iter_mut().find(|(kk, _)| kk == k) {
+            Some(e) => e.1 = *v,
+            None => all.push((k.clone(), *v)),
+        }
+    }
+    check_parameters(scene, &all)?;
+    Ok(all)
+}
+
 impl Case {
     /// Mesh `scene` at `level` (gmsh parameters from the scene, overridden by `params`),
     /// and build the problem for `method`.
@@ -87,18 +104,7 @@ impl Case {
         params: &[(String, f64)],
     ) -> Result<Self> {
         let t0 = Instant::now();
-        let mut all: Vec<(String, f64)> = scene
-            .parameters
-            .iter()
-            .map(|(k, v)| (k.clone(), *v))
-            .collect();
-        for (k, v) in params {
-            match all.iter_mut().find(|(kk, _)| kk == k) {
-                Some(e) => e.1 = *v,
-                None => all.push((k.clone(), *v)),
-            }
-        }
-        check_parameters(scene, &all)?;
+        let all = checked_parameters(scene, params)?;
         if level > 0 {
             check_memory(scene, &all, level)?;
         }
@@ -120,18 +126,7 @@ impl Case {
             return Self::build(scene, levels[0], method, params);
         }
         let t0 = Instant::now();
-        let mut all: Vec<(String, f64)> = scene
-            .parameters
-            .iter()
-            .map(|(k, v)| (k.clone(), *v))
-            .collect();
-        for (k, v) in params {
-            match all.iter_mut().find(|(kk, _)| kk == k) {
-                Some(e) => e.1 = *v,
-                None => all.push((k.clone(), *v)),
-            }
-        }
-        check_parameters(scene, &all)?;
+        let all = checked_parameters(scene, params)?;
         let top = levels[0].max(levels[1]);
         if top > 0 {
             check_memory(scene, &all, top)?;

@@ -91,7 +91,11 @@ impl StressSpec {
         fn tensor(t: &[[String; 2]; 2], field: String) -> (String, [&String; 3], Option<&String>) {
             let same = t[0][1].split_whitespace().collect::<String>()
                 == t[1][0].split_whitespace().collect::<String>();
-            (field, [&t[0][0], &t[1][1], &t[0][1]], (!same).then_some(&t[1][0]))
+            (
+                field,
+                [&t[0][0], &t[1][1], &t[0][1]],
+                (!same).then_some(&t[1][0]),
+            )
         }
         match self {
             StressSpec::Both(s) => ("exact.stress".into(), [&s[0], &s[1], &s[2]], None),
@@ -288,7 +292,11 @@ impl Scene {
                     "contact.slave_body",
                     format!(
                         "'{surface}' is not the surface of either body ({}); name one of them as the slave",
-                        sf.bodies.iter().map(|b| b.surface.as_str()).collect::<Vec<_>>().join(", ")
+                        sf.bodies
+                            .iter()
+                            .map(|b| b.surface.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", ")
                     ),
                 ));
             }

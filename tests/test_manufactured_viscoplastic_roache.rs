@@ -80,14 +80,20 @@ fn fields_affine_in_t_satisfy_the_time_discrete_law_at_every_quadrature_point() 
     for steps in [1, 4, 7] {
         let (r, scale) = law_residual("contact-mms-vp", steps);
         println!("contact-mms-vp, {steps} steps: residual {r:?}, stress scale {scale:.3}");
-        assert!(r.iter().all(|&v| v <= 1e-12 * scale), "{r:?} against {scale}");
+        assert!(
+            r.iter().all(|&v| v <= 1e-12 * scale),
+            "{r:?} against {scale}"
+        );
     }
     // The variant's uniform history c t (t - 1) in s11 leaves -k^2 c per step there (its
     // local truncation error; c = 200) and nothing elsewhere.
     let steps = 4;
     let k = 1.0 / steps as f64;
     let (r, scale) = law_residual("contact-mms-vp-time", steps);
-    println!("contact-mms-vp-time, {steps} steps: residual {r:?}, expected [{}, 0, 0]", k * k * 200.0);
+    println!(
+        "contact-mms-vp-time, {steps} steps: residual {r:?}, expected [{}, 0, 0]",
+        k * k * 200.0
+    );
     assert!((r[0] - k * k * 200.0).abs() <= 1e-12 * scale);
     assert!(r[1] <= 1e-12 * scale && r[2] <= 1e-12 * scale);
 }
@@ -106,7 +112,11 @@ fn derived_body_force_and_source_match_central_differences() {
         for i in 1..10 {
             for j in 1..10 {
                 // Away from the kink x = 0.5871 by more than the difference step.
-                let (x, y, t) = (0.1 * i as f64 + 0.013, y0 + 0.1 * j as f64, 0.37 + 0.05 * j as f64);
+                let (x, y, t) = (
+                    0.1 * i as f64 + 0.013,
+                    y0 + 0.1 * j as f64,
+                    0.37 + 0.05 * j as f64,
+                );
                 let s = |x: f64, y: f64, t: f64| Stress::from(ex.stress_at(b, x, y, t).unwrap());
                 let u = |x: f64, y: f64, t: f64| ex.displacement_at(b, x, y, t).unwrap();
                 // f = -div sigma by central differences in x and y.
@@ -132,12 +142,17 @@ fn derived_body_force_and_source_match_central_differences() {
                 let s_fd = dsdt - m.elastic.apply(&e_rate) - m.g(&s(x, y, t));
                 let src = ex.source_at(b, m, x, y, t).unwrap();
                 for c in 0..3 {
-                    worst.1 = worst.1.max((src[c] - s_fd[c]).abs() / src[c].abs().max(1.0));
+                    worst.1 = worst
+                        .1
+                        .max((src[c] - s_fd[c]).abs() / src[c].abs().max(1.0));
                 }
             }
         }
     }
-    println!("largest difference to central differences: body force {:.2e}, source {:.2e}", worst.0, worst.1);
+    println!(
+        "largest difference to central differences: body force {:.2e}, source {:.2e}",
+        worst.0, worst.1
+    );
     // Central differences with step 1e-5: truncation ~1e-10, round-off ~1e-16/1e-5^2 for the
     // nested ones (the source's strain rate); 1e-5 leaves a wide margin over both.
     assert!(worst.0 < 1e-6 && worst.1 < 1e-5, "{worst:?}");
@@ -186,7 +201,9 @@ fn derived_tractions_and_body_force_balance_the_stress_at_every_free_dof_off_gam
                 checked += 1;
             }
         }
-        println!("{scene}: {checked} free dofs off Gamma_C, largest |F - int sigma : eps(phi)| {worst:.2e} (load scale {scale:.3e})");
+        println!(
+            "{scene}: {checked} free dofs off Gamma_C, largest |F - int sigma : eps(phi)| {worst:.2e} (load scale {scale:.3e})"
+        );
         assert!(worst <= 1e-11 * scale, "{worst} against {scale}");
     }
 }
@@ -195,22 +212,42 @@ fn scene_error(text: &str) -> String {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("s.toml");
     let geo = contact_rates::scene::builtin_dir().join("../meshes/two_blocks.geo");
-    std::fs::write(&file, text.replace("../meshes/two_blocks.geo", &geo.display().to_string())).unwrap();
-    let out = common::run(&["solve", "--scene", file.to_str().unwrap(), "--out", dir.path().join("out").to_str().unwrap()], &[]);
+    std::fs::write(
+        &file,
+        text.replace("../meshes/two_blocks.geo", &geo.display().to_string()),
+    )
+    .unwrap();
+    let out = common::run(
+        &[
+            "solve",
+            "--scene",
+            file.to_str().unwrap(),
+            "--out",
+            dir.path().join("out").to_str().unwrap(),
+        ],
+        &[],
+    );
     assert!(!out.status.success(), "the scene must be refused");
     String::from_utf8_lossy(&out.stderr).to_string()
 }
 
 #[test]
 fn a_viscoplastic_body_without_stress_and_a_non_symmetric_stress_are_refused() {
-    let text = std::fs::read_to_string(contact_rates::scene::builtin_dir().join("contact-mms-vp.toml")).unwrap();
+    let text =
+        std::fs::read_to_string(contact_rates::scene::builtin_dir().join("contact-mms-vp.toml"))
+            .unwrap();
     // No exact.stress: the source cannot be derived.
     let start = text.find("stress = [").unwrap();
     let end = start + text[start..].find("\n]\n").unwrap() + 3;
     let without = format!("{}{}", &text[..start], &text[end..]);
     let msg = scene_error(&without);
     println!("{msg}");
-    assert!(msg.contains("exact.stress") && msg.contains("viscoplastic") && msg.contains("give exact.stress"), "{msg}");
+    assert!(
+        msg.contains("exact.stress")
+            && msg.contains("viscoplastic")
+            && msg.contains("give exact.stress"),
+        "{msg}"
+    );
     // A full tensor whose s21 is not s12: refused before solving, naming the body and the fix.
     let tensor = format!(
         "{}stress = [\n  [[\"1\", \"x\"], [\"y\", \"2\"]],\n  [[\"1\", \"0\"], [\"0\", \"2\"]],\n]\n{}",
@@ -219,7 +256,10 @@ fn a_viscoplastic_body_without_stress_and_a_non_symmetric_stress_are_refused() {
     );
     let msg = scene_error(&tensor);
     println!("{msg}");
-    assert!(msg.contains("not symmetric") && msg.contains("exact.stress") && msg.contains("s21"), "{msg}");
+    assert!(
+        msg.contains("not symmetric") && msg.contains("exact.stress") && msg.contains("s21"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -227,21 +267,45 @@ fn quick_viscoplastic_exact_study_meets_the_thresholds_and_its_rate_in_k_is_back
     contact_rates::init();
     let res = study::run("rates-exact-vp-quick").unwrap();
     for r in res.rates.iter().filter(|r| r.quantity == Quantity::Theorem) {
-        println!("{}: rate {:.3} +- {:.3} over {:?}", r.method, r.rate(), r.stderr(), r.assessment.used);
+        println!(
+            "{}: rate {:.3} +- {:.3} over {:?}",
+            r.method,
+            r.rate(),
+            r.stderr(),
+            r.assessment.used
+        );
         assert_eq!(r.assessment.used, vec![0, 1, 2]);
-        assert_eq!(r.pass, Some(true), "{} rate {} below {:?}", r.method, r.rate(), r.threshold);
+        assert_eq!(
+            r.pass,
+            Some(true),
+            "{} rate {} below {:?}",
+            r.method,
+            r.rate(),
+            r.threshold
+        );
     }
     // Both bodies flow: the plastic fraction at T lies well inside (0.2, 0.8) on every level.
     for l in &res.levels {
-        assert!(l.plastic_fraction > 0.2 && l.plastic_fraction < 0.8, "{l:?}");
+        assert!(
+            l.plastic_fraction > 0.2 && l.plastic_fraction < 0.8,
+            "{l:?}"
+        );
     }
-    let ts = res.time_study.as_ref().expect("the quick tier has a time study");
+    let ts = res
+        .time_study
+        .as_ref()
+        .expect("the quick tier has a time study");
     for r in &ts.runs {
         println!("time study: {} steps, error {:.4e}", r.steps, r.error);
     }
     let a = &ts.assessment;
     let fit = a.fit.expect("a rate in k");
-    println!("rate in k {:.3} +- {:.3} ({})", fit.rate, fit.stderr, a.verdict.name());
+    println!(
+        "rate in k {:.3} +- {:.3} ({})",
+        fit.rate,
+        fit.stderr,
+        a.verdict.name()
+    );
     // Theorem 3.1's k term: backward Euler is first order; a window rate within 0.1 of it.
     assert_eq!(a.verdict, Verdict::Fitted);
     assert!((fit.rate - 1.0).abs() < 0.1, "{}", fit.rate);

@@ -52,7 +52,12 @@ fn agree_to(scene: &str, times: &[f64], tol: f64, bound: f64) {
                 method.name(),
                 kind.name()
             );
-            assert!(d < bound, "{scene} {} {}: {d:e}", method.name(), kind.name());
+            assert!(
+                d < bound,
+                "{scene} {} {}: {d:e}",
+                method.name(),
+                kind.name()
+            );
         }
     }
 }

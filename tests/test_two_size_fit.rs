@@ -25,7 +25,10 @@ fn grid(noise: impl Fn(usize) -> f64) -> Vec<(f64, f64, f64)> {
 #[test]
 fn exact_data_give_the_exponents_back() {
     let f = fit_power_sum(&grid(|_| 1.0)).expect("a fit");
-    println!("noiseless: a1 = {:.10} +- {:.2e}, a2 = {:.10} +- {:.2e}, C = {:?}, rms {:.2e}", f.a[0], f.se[0], f.a[1], f.se[1], f.c, f.rms_log_residual);
+    println!(
+        "noiseless: a1 = {:.10} +- {:.2e}, a2 = {:.10} +- {:.2e}, C = {:?}, rms {:.2e}",
+        f.a[0], f.se[0], f.a[1], f.se[1], f.c, f.rms_log_residual
+    );
     assert!((f.a[0] - 0.75).abs() < 1e-8 && (f.a[1] - 1.0).abs() < 1e-8);
     assert!((f.c[0] - 2.0).abs() < 1e-7 && (f.c[1] - 3.0).abs() < 1e-7);
     assert!(f.rms_log_residual < 1e-10);
@@ -37,14 +40,29 @@ fn noisy_data_give_the_exponents_within_two_standard_errors() {
     let mut state = 12345u64;
     let draws: Vec<f64> = (0..25)
         .map(|_| {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
         })
         .collect();
     let f = fit_power_sum(&grid(|i| 1.0 + 0.02 * draws[i])).expect("a fit");
-    println!("2 % noise: a1 = {:.4} +- {:.4}, a2 = {:.4} +- {:.4}, C = {:?}, rms {:.2e}", f.a[0], f.se[0], f.a[1], f.se[1], f.c, f.rms_log_residual);
-    assert!((f.a[0] - 0.75).abs() <= 2.0 * f.se[0], "a1 {} +- {}", f.a[0], f.se[0]);
-    assert!((f.a[1] - 1.0).abs() <= 2.0 * f.se[1], "a2 {} +- {}", f.a[1], f.se[1]);
+    println!(
+        "2 % noise: a1 = {:.4} +- {:.4}, a2 = {:.4} +- {:.4}, C = {:?}, rms {:.2e}",
+        f.a[0], f.se[0], f.a[1], f.se[1], f.c, f.rms_log_residual
+    );
+    assert!(
+        (f.a[0] - 0.75).abs() <= 2.0 * f.se[0],
+        "a1 {} +- {}",
+        f.a[0],
+        f.se[0]
+    );
+    assert!(
+        (f.a[1] - 1.0).abs() <= 2.0 * f.se[1],
+        "a2 {} +- {}",
+        f.a[1],
+        f.se[1]
+    );
     // The noise is 2 %: the standard errors are small but not zero.
     assert!(f.se[0] > 1e-4 && f.se[0] < 0.1 && f.se[1] > 1e-4 && f.se[1] < 0.1);
     assert!(f.rms_log_residual > 0.005 && f.rms_log_residual < 0.02);

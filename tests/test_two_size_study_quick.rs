@@ -27,7 +27,10 @@ fn quick_two_size_study_meets_the_lemma_and_reproduces_the_diagonal() {
             "{} {}: a1 = {:.3} +- {:.3}, a2 = {:.3} +- {:.3}, rms {:.3}",
             f.slave, f.method, x.a[0], x.se[0], x.a[1], x.se[1], x.rms_log_residual
         );
-        assert!(x.se[0] <= 0.5 && x.rms_log_residual <= 0.25, "a1 identified");
+        assert!(
+            x.se[0] <= 0.5 && x.rms_log_residual <= 0.25,
+            "a1 identified"
+        );
         let need = two_size::lemma_exponents(f.method)[0] - 0.05;
         assert!(x.a[0] >= need, "{}: a1 {} < {need}", f.method, x.a[0]);
     }
@@ -41,11 +44,20 @@ fn quick_two_size_study_meets_the_lemma_and_reproduces_the_diagonal() {
         let c: Vec<&str> = line.split(',').collect();
         let (method, level, quantity, error): (&str, usize, &str, f64) =
             (c[0], c[1].parse().unwrap(), c[5], c[6].parse().unwrap());
-        let m = if method == "mortar" { Method::Mortar } else { Method::Nts };
-        let Some(q) = res.quantities.iter().find(|q| q.name() == quantity) else { continue };
+        let m = if method == "mortar" {
+            Method::Mortar
+        } else {
+            Method::Nts
+        };
+        let Some(q) = res.quantities.iter().find(|q| q.name() == quantity) else {
+            continue;
+        };
         if let Some(e) = res.error("upper", m, *q, [level, level]) {
             let d = (e - error).abs() / error.abs();
-            assert!(d < 1e-9, "{method} level {level} {quantity}: {e} against {error} ({d:e})");
+            assert!(
+                d < 1e-9,
+                "{method} level {level} {quantity}: {e} against {error} ({d:e})"
+            );
             checked += 1;
         }
     }

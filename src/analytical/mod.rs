@@ -144,7 +144,14 @@ impl Exact {
     /// its `material`) at (x, y, t), stress per time; None when the law needs none. Added
     /// as `k s(t_n)` to the backward-Euler update, it makes fields affine in t satisfy the
     /// time-discrete law exactly.
-    pub fn source_at(&self, b: usize, material: &Material, x: f64, y: f64, t: f64) -> Option<[f64; 3]> {
+    pub fn source_at(
+        &self,
+        b: usize,
+        material: &Material,
+        x: f64,
+        y: f64,
+        t: f64,
+    ) -> Option<[f64; 3]> {
         let rate = &self.source_rate.as_ref()?[b];
         let sigma = nalgebra::Vector3::from(self.stress_at(b, x, y, t)?);
         let g = material.g(&sigma);

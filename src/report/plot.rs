@@ -457,7 +457,13 @@ pub struct GridPanel {
 
 /// Maps side by side (two per row), each with its own colour scale on log10 of the values,
 /// the value written in every cell.
-pub fn grid_panels(path: &Path, title: &str, xlabel: &str, ylabel: &str, panels: &[GridPanel]) -> Result<()> {
+pub fn grid_panels(
+    path: &Path,
+    title: &str,
+    xlabel: &str,
+    ylabel: &str,
+    panels: &[GridPanel],
+) -> Result<()> {
     register();
     let rows = panels.len().div_ceil(2) as u32;
     let root = BitMapBackend::new(path, (1100, 520 * rows + 40)).into_drawing_area();
@@ -510,7 +516,11 @@ pub fn grid_panels(path: &Path, title: &str, xlabel: &str, ylabel: &str, panels:
             chart
                 .draw_series(LineSeries::new(pts.iter().copied(), style))
                 .map_err(err(path))?;
-            if let Some(&last) = pts.iter().filter(|q| q.1 <= y1 + 0.5 && q.0 <= x1 + 0.5).last() {
+            if let Some(&last) = pts
+                .iter()
+                .filter(|q| q.1 <= y1 + 0.5 && q.0 <= x1 + 0.5)
+                .last()
+            {
                 let _ = i;
                 chart
                     .draw_series(std::iter::once(Text::new(

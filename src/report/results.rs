@@ -321,8 +321,11 @@ fn two_size_headline(reports: &Path, name: &str, what: &str, s: &mut String) -> 
     let dir = reports.join(name);
     let fits: Vec<SizeFitLine> = read(&dir.join("fits.csv"))?;
     let grid: Vec<SizePointLine> = read(&dir.join("grid.csv"))?;
-    let _ = writeln!(s, "### [`{name}`](reports/{name}/README.md): {what}
-");
+    let _ = writeln!(
+        s,
+        "### [`{name}`](reports/{name}/README.md): {what}
+"
+    );
     let exponent = |v: Option<f64>, se: Option<f64>, rms: Option<f64>| match (v, se, rms) {
         (Some(v), Some(se), Some(rms)) if se <= 0.5 && rms <= 0.25 => format!("{v:.2} ± {se:.2}"),
         _ => "not identified".into(),
@@ -349,8 +352,15 @@ fn two_size_headline(reports: &Path, name: &str, what: &str, s: &mut String) -> 
         );
     }
     // From the finest diagonal point, each body refined alone to the fixed level.
-    let levels: Vec<usize> = grid.iter().map(|p| p.slave_level.min(p.master_level)).collect();
-    let top = grid.iter().map(|p| p.slave_level.max(p.master_level)).max().unwrap_or(0);
+    let levels: Vec<usize> = grid
+        .iter()
+        .map(|p| p.slave_level.min(p.master_level))
+        .collect();
+    let top = grid
+        .iter()
+        .map(|p| p.slave_level.max(p.master_level))
+        .max()
+        .unwrap_or(0);
     let finest = grid
         .iter()
         .zip(&levels)
@@ -360,7 +370,12 @@ fn two_size_headline(reports: &Path, name: &str, what: &str, s: &mut String) -> 
         .unwrap_or(0);
     let error = |slave: &str, m: &str, q: &str, l: [usize; 2]| {
         grid.iter()
-            .find(|p| p.slave == slave && p.method == m && p.quantity == q && [p.slave_level, p.master_level] == l)
+            .find(|p| {
+                p.slave == slave
+                    && p.method == m
+                    && p.quantity == q
+                    && [p.slave_level, p.master_level] == l
+            })
             .map(|p| p.error)
     };
     if let Some(slave) = slaves.first() {
@@ -419,7 +434,11 @@ fn plasticity_and_time(dir: &Path, s: &mut String) -> Result<()> {
         .map(|l| format!("{} {:.3}", l.method, l.plastic_fraction))
         .collect();
     if !plastic.is_empty() {
-        let _ = writeln!(s, "- Plastic fraction at T, level {finest}: {}.", plastic.join(", "));
+        let _ = writeln!(
+            s,
+            "- Plastic fraction at T, level {finest}: {}.",
+            plastic.join(", ")
+        );
     }
     let path = dir.join("time.csv");
     if !path.exists() {
@@ -440,10 +459,19 @@ fn plasticity_and_time(dir: &Path, s: &mut String) -> Result<()> {
         .map_err(|e| Error::input(&path, "k", format!("{e}; regenerate the report")))?;
     let steps: Vec<String> = a.used.iter().map(|&i| runs[i].steps.to_string()).collect();
     let rate = match a.fit {
-        Some(f) => format!("{:.3} ± {:.3} ({}, steps {})", f.rate, f.stderr, a.verdict.name(), steps.join(" ")),
+        Some(f) => format!(
+            "{:.3} ± {:.3} ({}, steps {})",
+            f.rate,
+            f.stderr,
+            a.verdict.name(),
+            steps.join(" ")
+        ),
         None => a.verdict.name().to_string(),
     };
-    let _ = writeln!(s, "- Rate in k (time study, backward Euler's k term: 1): {rate}.");
+    let _ = writeln!(
+        s,
+        "- Rate in k (time study, backward Euler's k term: 1): {rate}."
+    );
     Ok(())
 }
 

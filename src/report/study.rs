@@ -287,7 +287,12 @@ fn error_vs_k(res: &StudyResult, ts: &TimeStudy, d: &Path) -> Result<()> {
             used.iter().copied().fold(0.0, f64::max),
         ];
         series.push(Series {
-            label: format!("fit: slope {:.2} ± {:.2} ({})", fit.rate, fit.stderr, a.verdict.name()),
+            label: format!(
+                "fit: slope {:.2} ± {:.2} ({})",
+                fit.rate,
+                fit.stderr,
+                a.verdict.name()
+            ),
             points: ks
                 .iter()
                 .map(|&k| (k, (fit.intercept + fit.rate * k.ln()).exp()))
@@ -300,7 +305,10 @@ fn error_vs_k(res: &StudyResult, ts: &TimeStudy, d: &Path) -> Result<()> {
     }
     plot::loglog(
         &d.join("error_vs_k.png"),
-        &format!("{}: error against the time step ({}, level {})", res.name, ts.scene, ts.level),
+        &format!(
+            "{}: error against the time step ({}, level {})",
+            res.name, ts.scene, ts.level
+        ),
         "k (time step)",
         "relative error (theorem norm)",
         &series,
@@ -539,7 +547,12 @@ fn readme(res: &StudyResult) -> String {
                 2 * points - 2,
                 2 * points
             );
-            if res.scene.exact.as_deref().is_some_and(|e| e.source_rate.is_some()) {
+            if res
+                .scene
+                .exact
+                .as_deref()
+                .is_some_and(|e| e.source_rate.is_some())
+            {
                 let _ = writeln!(
                     s,
                     "The scene is a manufactured viscoplastic solution: its constitutive law carries the source s = d sigma/dt - E eps(du/dt) - G(sigma), each triangle's mean (2 x 2 collapsed Gauss rule, split along the kinks) added as k s(t_n) to the backward-Euler update. Where its fields are affine in t (contact-mms-vp), the time-discrete law holds exactly and every error in h is spatial; a t^2 part (contact-mms-vp-time) is what the time study measures.\n"
@@ -580,7 +593,9 @@ fn readme(res: &StudyResult) -> String {
 /// The rate in time: the runs, the truth they are measured against, and the judged rate.
 fn time_section(s: &mut String, ts: &TimeStudy) {
     let truth = match ts.reference_steps {
-        Some(r) => format!("a reference with {r} steps on the same mesh, at the common time points"),
+        Some(r) => {
+            format!("a reference with {r} steps on the same mesh, at the common time points")
+        }
         None => format!(
             "the exact solution of scene `{}` at every step (no reference in time)",
             ts.scene
@@ -615,13 +630,21 @@ Scene `{}`, {}, fixed mesh (level {}, h = {:.4}, {} dofs), k halved from run to 
         );
     }
     let a = &ts.assessment;
-    let steps: Vec<String> = a.used.iter().map(|&i| ts.runs[i].steps.to_string()).collect();
+    let steps: Vec<String> = a
+        .used
+        .iter()
+        .map(|&i| ts.runs[i].steps.to_string())
+        .collect();
     let _ = writeln!(
         s,
         "\nRate in k: **{}**, verdict `{}`, fitted on the step counts {} (backward Euler: 1).\n",
         fmt_assessment(a),
         a.verdict.name(),
-        if steps.is_empty() { "-".into() } else { steps.join(", ") }
+        if steps.is_empty() {
+            "-".into()
+        } else {
+            steps.join(", ")
+        }
     );
 }
 
@@ -673,7 +696,11 @@ pub fn console(res: &StudyResult, dir: &Path) -> String {
             "time study rate in k {:>6} +- {} (steps {}) {}",
             fmt3(a.fit.map_or(f64::NAN, |f| f.rate)),
             fmt3(a.fit.map_or(f64::NAN, |f| f.stderr)),
-            a.used.iter().map(|&i| ts.runs[i].steps.to_string()).collect::<Vec<_>>().join(" "),
+            a.used
+                .iter()
+                .map(|&i| ts.runs[i].steps.to_string())
+                .collect::<Vec<_>>()
+                .join(" "),
             a.verdict.name()
         );
     }

@@ -54,7 +54,11 @@ struct FitCsv {
 }
 
 fn levels_text(levels: &[usize]) -> String {
-    levels.iter().map(|l| l.to_string()).collect::<Vec<_>>().join(" ")
+    levels
+        .iter()
+        .map(|l| l.to_string())
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 impl FitCsv {
@@ -122,7 +126,9 @@ fn sweep_file(slave: &str) -> String {
 /// Least-squares line ln N = alpha + beta l through the (level, dofs) pairs.
 fn dofs_line(pairs: &[(usize, usize)]) -> (f64, f64) {
     let n = pairs.len() as f64;
-    let (sx, sy) = pairs.iter().fold((0.0, 0.0), |(a, b), &(l, d)| (a + l as f64, b + (d as f64).ln()));
+    let (sx, sy) = pairs.iter().fold((0.0, 0.0), |(a, b), &(l, d)| {
+        (a + l as f64, b + (d as f64).ln())
+    });
     let (mx, my) = (sx / n, sy / n);
     let (sxx, sxy) = pairs.iter().fold((0.0, 0.0), |(a, b), &(l, d)| {
         let x = l as f64 - mx;
@@ -138,7 +144,10 @@ fn maps(res: &TwoSizeResult, slave: &str, method: Method, d: &Path) -> Result<()
     let grid = |p: &&crate::study::two_size::SizePoint| {
         res.levels.contains(&p.slave_level) && res.levels.contains(&p.master_level)
     };
-    let theorem: Vec<_> = res.of(slave, method, Quantity::Theorem).filter(grid).collect();
+    let theorem: Vec<_> = res
+        .of(slave, method, Quantity::Theorem)
+        .filter(grid)
+        .collect();
     let d1: Vec<(usize, usize)> = theorem.iter().map(|p| (p.slave_level, p.dofs1)).collect();
     let d2: Vec<(usize, usize)> = theorem.iter().map(|p| (p.master_level, p.dofs2)).collect();
     let (a1, b1) = dofs_line(&d1);
@@ -178,7 +187,10 @@ fn maps(res: &TwoSizeResult, slave: &str, method: Method, d: &Path) -> Result<()
         .collect();
     plot::grid_panels(
         &d.join(map_file(slave, method)),
-        &format!("{}: relative error over the two mesh levels ({method}, slave '{slave}'); red: iso-dofs", res.name),
+        &format!(
+            "{}: relative error over the two mesh levels ({method}, slave '{slave}'); red: iso-dofs",
+            res.name
+        ),
         "slave level (body 1)",
         "master level (body 2)",
         &panels,
@@ -209,7 +221,12 @@ fn sweeps(res: &TwoSizeResult, slave: &str, d: &Path) -> Result<()> {
                 .collect();
             let a = &f.sweeps[b];
             let slope = a.fit.map_or(a.verdict.name().to_string(), |x| {
-                format!("slope {:.2} ± {:.2} ({})", x.rate, x.stderr, a.verdict.name())
+                format!(
+                    "slope {:.2} ± {:.2} ({})",
+                    x.rate,
+                    x.stderr,
+                    a.verdict.name()
+                )
             });
             series.push(Series {
                 label: format!(
@@ -228,7 +245,10 @@ fn sweeps(res: &TwoSizeResult, slave: &str, d: &Path) -> Result<()> {
     }
     plot::loglog(
         &d.join(sweep_file(slave)),
-        &format!("{}: one-sided sweeps (slave '{slave}', theorem norm)", res.name),
+        &format!(
+            "{}: one-sided sweeps (slave '{slave}', theorem norm)",
+            res.name
+        ),
         "h of the swept body",
         "relative error (theorem norm)",
         &series,
@@ -246,7 +266,9 @@ const FIT_SE: f64 = 0.5;
 fn fmt_fit(f: &SizeFit, b: usize) -> String {
     match f.fit {
         None => "no fit".into(),
-        Some(x) if x.rms_log_residual > FIT_RMS => format!("poor fit (rms {:.2})", x.rms_log_residual),
+        Some(x) if x.rms_log_residual > FIT_RMS => {
+            format!("poor fit (rms {:.2})", x.rms_log_residual)
+        }
         Some(x) if !(x.se[b] <= FIT_SE) || !(0.0..6.0).contains(&x.a[b]) => {
             format!("not identified ({:.2} ± {:.2})", x.a[b], x.se[b])
         }
@@ -294,7 +316,10 @@ fn answer(res: &TwoSizeResult, f: &SizeFit) -> String {
         (base.error - s1.error) / (s1.dofs1 as f64 - base.dofs1 as f64),
         (base.error - s2.error) / (s2.dofs2 as f64 - base.dofs2 as f64),
     ];
-    let names = [format!("the slave '{}'", f.slave), format!("the master '{master}'")];
+    let names = [
+        format!("the slave '{}'", f.slave),
+        format!("the master '{master}'"),
+    ];
     let better = usize::from(gain[1] > gain[0]);
     if gain[0] <= 0.0 && gain[1] <= 0.0 {
         return format!(
@@ -378,7 +403,11 @@ fn diagonal(res: &TwoSizeResult, s: &mut String) {
     );
     for (q, w, n, roundoff) in worst {
         if roundoff {
-            let _ = writeln!(s, "| {q} | {n} | both at round-off (<= {:.0e}) |", crate::study::rates::ROUNDOFF);
+            let _ = writeln!(
+                s,
+                "| {q} | {n} | both at round-off (<= {:.0e}) |",
+                crate::study::rates::ROUNDOFF
+            );
         } else {
             let _ = writeln!(s, "| {q} | {n} | {w:.2e} |");
         }
@@ -409,7 +438,11 @@ fn readme(res: &TwoSizeResult) -> String {
         res.thresholds[1],
         fixed = res.fixed
     );
-    let mut rows: Vec<&SizeFit> = res.fits.iter().filter(|f| MAPPED.contains(&f.quantity)).collect();
+    let mut rows: Vec<&SizeFit> = res
+        .fits
+        .iter()
+        .filter(|f| MAPPED.contains(&f.quantity))
+        .collect();
     rows.sort_by_key(|f| {
         (
             res.slaves.iter().position(|x| *x == f.slave),
@@ -446,13 +479,24 @@ fn readme(res: &TwoSizeResult) -> String {
         res.fixed
     );
     for f in res.fits.iter().filter(|f| MAPPED.contains(&f.quantity)) {
-        let _ = writeln!(s, "- {} / {} / {}: {}.", f.slave, f.method, f.quantity, answer(res, f));
+        let _ = writeln!(
+            s,
+            "- {} / {} / {}: {}.",
+            f.slave,
+            f.method,
+            f.quantity,
+            answer(res, f)
+        );
     }
     if res.slaves.len() > 1 {
         let _ = writeln!(
             s,
             "\n## Which body should be the slave\n\nThe same meshes (level {finest} for both bodies) with each body carrying the constraint in turn:\n\n| method | quantity | {} | smaller error with slave |\n|---|---|{}---|",
-            res.slaves.iter().map(|x| format!("slave '{x}'")).collect::<Vec<_>>().join(" | "),
+            res.slaves
+                .iter()
+                .map(|x| format!("slave '{x}'"))
+                .collect::<Vec<_>>()
+                .join(" | "),
             "---|".repeat(res.slaves.len())
         );
         for &m in &res.methods {
@@ -466,7 +510,10 @@ fn readme(res: &TwoSizeResult) -> String {
                     .iter()
                     .map(|v| v.map_or("-".into(), |v| format!("{v:.3e}")))
                     .collect();
-                let best = if e.iter().all(|v| v.is_some_and(|v| v <= crate::study::rates::ROUNDOFF)) {
+                let best = if e
+                    .iter()
+                    .all(|v| v.is_some_and(|v| v <= crate::study::rates::ROUNDOFF))
+                {
                     "both at round-off".to_string()
                 } else if shown.windows(2).all(|w| w[0] == w[1]) {
                     "the same to the digits shown".to_string()
@@ -507,7 +554,10 @@ fn readme(res: &TwoSizeResult) -> String {
             );
         }
         (None, false) => {
-            let _ = writeln!(s, "## Truth\n\nA reference on matching meshes per slave choice (the bodies are numbered by it):\n");
+            let _ = writeln!(
+                s,
+                "## Truth\n\nA reference on matching meshes per slave choice (the bodies are numbered by it):\n"
+            );
             for (slave, r) in &res.references {
                 let _ = writeln!(
                     s,
@@ -523,7 +573,10 @@ fn readme(res: &TwoSizeResult) -> String {
     for (k, v) in &res.provenance {
         let _ = writeln!(s, "- {k}: {v}");
     }
-    let _ = writeln!(s, "\nData: `grid.csv` (every pair and quantity), `fits.csv` (every fit).");
+    let _ = writeln!(
+        s,
+        "\nData: `grid.csv` (every pair and quantity), `fits.csv` (every fit)."
+    );
     s
 }
 

@@ -281,7 +281,9 @@ impl StepSolver for FixedPoint<'_> {
             .iter()
             .enumerate()
             .map(|(i, e)| {
-                model.materials[e.body].elastic.apply(&e.strain(&prev.u)) - prev.sigma[i] - source[i]
+                model.materials[e.body].elastic.apply(&e.strain(&prev.u))
+                    - prev.sigma[i]
+                    - source[i]
             })
             .collect();
         let mut eta: Vec<Stress> = match &self.eta {

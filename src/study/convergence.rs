@@ -403,9 +403,10 @@ fn check_covered(file: &StudyFile, scene: &Scene, path: &Path) -> Result<()> {
 /// The time study measures the theorem norm: its scene's exact solution must give the
 /// displacement and the stress.
 fn check_time_covered(scene: &Scene, path: &Path) -> Result<()> {
-    let covered = scene.exact.as_deref().is_some_and(|e| {
-        needs(Quantity::Theorem).iter().all(|f| e.gives(*f))
-    });
+    let covered = scene
+        .exact
+        .as_deref()
+        .is_some_and(|e| needs(Quantity::Theorem).iter().all(|f| e.gives(*f)));
     if covered {
         return Ok(());
     }
@@ -496,7 +497,11 @@ impl Plan {
             for &method in &sf.methods {
                 for &level in &sf.mesh.levels {
                     let label = format!("{method} level {level} (family {coarsest})");
-                    runs.push((method, level, add(label, method, level, &params, sf.steps, 0)));
+                    runs.push((
+                        method,
+                        level,
+                        add(label, method, level, &params, sf.steps, 0),
+                    ));
                 }
             }
             variants.push((coarsest, runs));
@@ -1083,7 +1088,10 @@ fn time_study(
             .map(|(steps, case, sol)| time_reference_error(case, sol, reference, *steps))
             .collect(),
         None => {
-            let exact = scene.exact.as_deref().expect("checked when the study was read");
+            let exact = scene
+                .exact
+                .as_deref()
+                .expect("checked when the study was read");
             time_exact_errors(&runs, exact, points)
         }
     };
@@ -1117,9 +1125,8 @@ fn time_study(
             error: r.error,
         })
         .collect();
-    let assessment = rates::assess(&levels, 0.0).map_err(|e| {
-        Error::input(&study.path, "time.steps", format!("time study: {e}"))
-    })?;
+    let assessment = rates::assess(&levels, 0.0)
+        .map_err(|e| Error::input(&study.path, "time.steps", format!("time study: {e}")))?;
     Ok(Some(TimeStudy {
         scene: scene.name.clone(),
         method: case.problem.method,
@@ -1186,7 +1193,10 @@ fn time_reference_error(
 }
 
 /// Step 6: where the numbers come from.
-pub(crate) fn provenance(study: &Study, mesh: &crate::mesh::gmsh::GeneratedMesh) -> BTreeMap<String, String> {
+pub(crate) fn provenance(
+    study: &Study,
+    mesh: &crate::mesh::gmsh::GeneratedMesh,
+) -> BTreeMap<String, String> {
     let geo = study.scene.geo.file_name().unwrap().to_string_lossy();
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     BTreeMap::from([

@@ -342,7 +342,9 @@ impl StudyFile {
                     ),
                 );
             }
-            if !s.reference.exact && s.mesh.levels.last().unwrap() + s.reference.levels_above <= two.fixed {
+            if !s.reference.exact
+                && s.mesh.levels.last().unwrap() + s.reference.levels_above <= two.fixed
+            {
                 return bad(
                     "reference.levels_above",
                     format!(

@@ -431,7 +431,11 @@ impl PowerSumFit {
 pub fn fit_power_sum(points: &[(f64, f64, f64)]) -> Option<PowerSumFit> {
     use nalgebra::{Matrix4, Vector4};
     let n = points.len();
-    if n < 5 || points.iter().any(|p| !(p.0 > 0.0 && p.1 > 0.0 && p.2 > 0.0)) {
+    if n < 5
+        || points
+            .iter()
+            .any(|p| !(p.0 > 0.0 && p.1 > 0.0 && p.2 > 0.0))
+    {
         return None;
     }
     // Residuals and Jacobian of the model ln(C1 h1^a1 + C2 h2^a2) at theta.
@@ -477,7 +481,9 @@ pub fn fit_power_sum(points: &[(f64, f64, f64)]) -> Option<PowerSumFit> {
                 for k in 0..4 {
                     damped[(k, k)] += mu * jtj[(k, k)].max(1e-12);
                 }
-                let Some(step) = damped.lu().solve(&jtr) else { break };
+                let Some(step) = damped.lu().solve(&jtr) else {
+                    break;
+                };
                 let trial = th + step;
                 let (rt, jt) = evaluate(&trial);
                 let ft = ssr(&rt);

@@ -144,7 +144,9 @@ impl TwoSizeResult {
             .iter()
             .filter(|f| f.quantity == self.threshold_quantity)
             .filter_map(|f| {
-                let x = f.fit.filter(|x| x.se[0] <= 0.5 && x.rms_log_residual <= 0.25)?;
+                let x = f
+                    .fit
+                    .filter(|x| x.se[0] <= 0.5 && x.rms_log_residual <= 0.25)?;
                 let need = self.thresholds[usize::from(f.method == Method::Nts)];
                 (x.a[0] < need).then(|| {
                     format!(
@@ -164,7 +166,13 @@ impl TwoSizeResult {
     }
 
     /// The error at (slave level, master level), if measured.
-    pub fn error(&self, slave: &str, method: Method, q: Quantity, levels: [usize; 2]) -> Option<f64> {
+    pub fn error(
+        &self,
+        slave: &str,
+        method: Method,
+        q: Quantity,
+        levels: [usize; 2],
+    ) -> Option<f64> {
         self.of(slave, method, q)
             .find(|p| [p.slave_level, p.master_level] == levels)
             .map(|p| p.error)
@@ -203,7 +211,11 @@ impl Plan {
         let family = sf.family_parameters();
         let reference_parameters = sf.reference_parameters();
         let mut jobs: Vec<Job> = Vec::new();
-        let mut add = |label: String, method: Method, levels: [usize; 2], params: &[(String, f64)], scene: usize| {
+        let mut add = |label: String,
+                       method: Method,
+                       levels: [usize; 2],
+                       params: &[(String, f64)],
+                       scene: usize| {
             jobs.push(Job {
                 id: jobs.len(),
                 label,
@@ -222,7 +234,13 @@ impl Plan {
         for s in 0..slaves {
             references.push((!sf.reference.exact).then(|| {
                 [r - 2, r - 1, r].map(|l| {
-                    add(format!("reference {s} level {l}"), Method::Mortar, [l, l], &reference_parameters, s)
+                    add(
+                        format!("reference {s} level {l}"),
+                        Method::Mortar,
+                        [l, l],
+                        &reference_parameters,
+                        s,
+                    )
                 })
             }));
             for &method in &sf.methods {
@@ -258,7 +276,11 @@ pub fn run(name: &str) -> Result<TwoSizeResult> {
     let study = Study::load(name)?;
     let sf = &study.file;
     let spec = sf.two_size.as_ref().ok_or_else(|| {
-        Error::input(&study.path, "two_size", "not a two-size study: add a [two_size] table")
+        Error::input(
+            &study.path,
+            "two_size",
+            "not a two-size study: add a [two_size] table",
+        )
     })?;
     // Step 1: the plan, a scene per slave choice.
     let slaves: Vec<String> = if spec.slaves.is_empty() {
@@ -274,7 +296,14 @@ pub fn run(name: &str) -> Result<TwoSizeResult> {
     // Step 2: every solve.
     let progress = Progress::new(plan.jobs.len() as u64, &study.name);
     let scene_refs: Vec<&Scene> = scenes.iter().collect();
-    let outputs = jobs::execute(&plan.jobs, &scene_refs, sf.solver, &study.text, Mode::All, &|l| progress.tick(l))?;
+    let outputs = jobs::execute(
+        &plan.jobs,
+        &scene_refs,
+        sf.solver,
+        &study.text,
+        Mode::All,
+        &|l| progress.tick(l),
+    )?;
     progress.finish();
     let mut solved = jobs::Solved::complete(outputs).expect("every job ran");
     let truths: Vec<Truth> = plan
@@ -284,7 +313,10 @@ pub fn run(name: &str) -> Result<TwoSizeResult> {
         .map(|(ids, scene)| match ids {
             Some(ids) => Truth::Solved(reference(*ids, &mut solved, study.reference_level())),
             None => Truth::Exact(
-                scene.exact.as_deref().expect("checked when the study was read"),
+                scene
+                    .exact
+                    .as_deref()
+                    .expect("checked when the study was read"),
                 sf.reference.quadrature,
             ),
         })
@@ -334,7 +366,16 @@ pub fn run(name: &str) -> Result<TwoSizeResult> {
     for (s, slave) in slaves.iter().enumerate() {
         for &method in &sf.methods {
             for &quantity in &sf.quantities {
-                fits.push(fit(&points, slave, method, quantity, &sf.mesh.levels, spec.fixed, truths[s].quantity_error(quantity), &study.path)?);
+                fits.push(fit(
+                    &points,
+                    slave,
+                    method,
+                    quantity,
+                    &sf.mesh.levels,
+                    spec.fixed,
+                    truths[s].quantity_error(quantity),
+                    &study.path,
+                )?);
             }
         }
     }
@@ -387,7 +428,11 @@ fn fit(
         .iter()
         .filter(|p| p.slave == slave && p.method == method && p.quantity == quantity)
         .collect();
-    let at = |l: [usize; 2]| mine.iter().find(|p| [p.slave_level, p.master_level] == l).copied();
+    let at = |l: [usize; 2]| {
+        mine.iter()
+            .find(|p| [p.slave_level, p.master_level] == l)
+            .copied()
+    };
     let floor = at([fixed, fixed]).map_or(0.0, |p| p.error);
     // The sweeps: a level is left out where its error is within 5x of the floor (the
     // fixed body's own error) or of the truth's.
@@ -405,7 +450,11 @@ fn fit(
             })
             .collect();
         rates::assess(&rows, floor.max(truth_error)).map_err(|e| {
-            Error::input(path, "mesh.levels", format!("{slave} {method} {quantity}: {e}"))
+            Error::input(
+                path,
+                "mesh.levels",
+                format!("{slave} {method} {quantity}: {e}"),
+            )
         })
     };
     let sweeps = [sweep(0)?, sweep(1)?];
