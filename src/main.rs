@@ -41,7 +41,8 @@ enum Command {
         merge: bool,
     },
     /// Print the README's Results section, read from the committed reports' CSVs
-    /// (reports/rates, reports/rates-exact, reports/patch).
+    /// (reports/rates, rates-exact, rates-exact-vp, patch, two-size-exact, two-size-rates,
+    /// speed, stability).
     Results,
     /// Solve one scene on one mesh level and write solution.vtu and summary.csv.
     Solve {
