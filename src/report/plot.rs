@@ -511,7 +511,7 @@ pub fn grid_panels(
                 )))
                 .map_err(err(path))?;
         }
-        for (i, (label, pts)) in p.lines.iter().enumerate() {
+        for (label, pts) in &p.lines {
             let style = ShapeStyle::from(&RED).stroke_width(2);
             chart
                 .draw_series(LineSeries::new(pts.iter().copied(), style))
@@ -521,7 +521,6 @@ pub fn grid_panels(
                 .filter(|q| q.1 <= y1 + 0.5 && q.0 <= x1 + 0.5)
                 .last()
             {
-                let _ = i;
                 chart
                     .draw_series(std::iter::once(Text::new(
                         label.clone(),

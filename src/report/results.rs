@@ -327,7 +327,9 @@ fn two_size_headline(reports: &Path, name: &str, what: &str, s: &mut String) -> 
 "
     );
     let exponent = |v: Option<f64>, se: Option<f64>, rms: Option<f64>| match (v, se, rms) {
-        (Some(v), Some(se), Some(rms)) if se <= 0.5 && rms <= 0.25 => format!("{v:.2} ± {se:.2}"),
+        (Some(v), Some(se), Some(rms)) if rates::fit_identifies(se, rms) => {
+            format!("{v:.2} ± {se:.2}")
+        }
         _ => "not identified".into(),
     };
     let mut slaves: Vec<&str> = fits.iter().map(|f| f.slave.as_str()).collect();
@@ -352,10 +354,6 @@ fn two_size_headline(reports: &Path, name: &str, what: &str, s: &mut String) -> 
         );
     }
     // From the finest diagonal point, each body refined alone to the fixed level.
-    let levels: Vec<usize> = grid
-        .iter()
-        .map(|p| p.slave_level.min(p.master_level))
-        .collect();
     let top = grid
         .iter()
         .map(|p| p.slave_level.max(p.master_level))
@@ -363,9 +361,8 @@ fn two_size_headline(reports: &Path, name: &str, what: &str, s: &mut String) -> 
         .unwrap_or(0);
     let finest = grid
         .iter()
-        .zip(&levels)
-        .filter(|(p, _)| p.slave_level == p.master_level && p.slave_level < top)
-        .map(|(p, _)| p.slave_level)
+        .filter(|p| p.slave_level == p.master_level && p.slave_level < top)
+        .map(|p| p.slave_level)
         .max()
         .unwrap_or(0);
     let error = |slave: &str, m: &str, q: &str, l: [usize; 2]| {
@@ -445,17 +442,8 @@ fn plasticity_and_time(dir: &Path, s: &mut String) -> Result<()> {
         return Ok(());
     }
     let runs: Vec<TimeLine> = read(&path)?;
-    let levels: Vec<rates::LevelError> = runs
-        .iter()
-        .enumerate()
-        .map(|(i, r)| rates::LevelError {
-            level: i,
-            h: r.k,
-            dofs: r.steps as f64,
-            error: r.error,
-        })
-        .collect();
-    let a = rates::assess(&levels, 0.0)
+    let judged: Vec<(usize, f64, f64)> = runs.iter().map(|r| (r.steps, r.k, r.error)).collect();
+    let a = rates::assess_in_k(&judged)
         .map_err(|e| Error::input(&path, "k", format!("{e}; regenerate the report")))?;
     let steps: Vec<String> = a.used.iter().map(|&i| runs[i].steps.to_string()).collect();
     let rate = match a.fit {

@@ -614,10 +614,7 @@ Scene `{}`, {}, fixed mesh (level {}, h = {:.4}, {} dofs), k halved from run to 
         ts.runs.last().map_or(f64::NAN, |r| r.norm)
     );
     for (i, r) in ts.runs.iter().enumerate() {
-        let rate = (i > 0).then(|| {
-            let p = &ts.runs[i - 1];
-            (p.error / r.error).ln() / (p.k / r.k).ln()
-        });
+        let rate = i.checked_sub(1).and_then(|j| ts.assessment.successive[j]);
         let _ = writeln!(
             s,
             "| {} | {:.5} | {:.3e} | {} | {:.3} | {:.2} |",

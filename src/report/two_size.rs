@@ -256,10 +256,7 @@ fn sweeps(res: &TwoSizeResult, slave: &str, d: &Path) -> Result<()> {
     )
 }
 
-/// Largest rms log residual of a grid fit that is reported (the errors within ~28 % of it).
-const FIT_RMS: f64 = 0.25;
-/// Largest standard error of an exponent that is reported.
-const FIT_SE: f64 = 0.5;
+use crate::study::rates::{FIT_MAX_RMS as FIT_RMS, FIT_MAX_SE as FIT_SE};
 
 /// Exponent `b` of the grid fit, or why the numbers do not support one: a poor fit overall,
 /// or a term too small on the grid to identify its exponent.

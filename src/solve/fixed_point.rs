@@ -270,11 +270,10 @@ impl StepSolver for FixedPoint<'_> {
         let p = self.p;
         let model = &p.model;
         let f_ext = model.load(t)?;
-        // k s of a manufactured solution's constitutive source: added to sigma with k eta.
-        let source: Vec<Stress> = match model.constitutive_source(t)? {
-            Some(s) => s.iter().map(|s| k * s).collect(),
-            None => vec![Stress::zeros(); model.elements.len()],
-        };
+        // k s of a manufactured solution's constitutive source: added to sigma with k eta
+        // (zero, and nothing stored, for a scene without one).
+        let source = model.constitutive_source(t)?;
+        let k_source = |i: usize| source.as_ref().map_or(Stress::zeros(), |s| k * s[i]);
         // Shift of (4.2): E eps(u^{n-1}) - sigma^{n-1} - k s per element.
         let shift: Vec<Stress> = model
             .elements
@@ -283,7 +282,7 @@ impl StepSolver for FixedPoint<'_> {
             .map(|(i, e)| {
                 model.materials[e.body].elastic.apply(&e.strain(&prev.u))
                     - prev.sigma[i]
-                    - source[i]
+                    - k_source(i)
             })
             .collect();
         let mut eta: Vec<Stress> = match &self.eta {
@@ -326,7 +325,7 @@ impl StepSolver for FixedPoint<'_> {
                             .elastic
                             .apply(&(e.strain(&u) - e.strain(&prev.u)))
                         + k * eta[i]
-                        + source[i]
+                        + k_source(i)
                 })
                 .collect();
             let eta_new: Vec<Stress> = model

@@ -1115,17 +1115,8 @@ fn time_study(
             r.steps
         )));
     }
-    let levels: Vec<LevelError> = runs
-        .iter()
-        .enumerate()
-        .map(|(i, r)| LevelError {
-            level: i,
-            h: r.k,
-            dofs: r.steps as f64,
-            error: r.error,
-        })
-        .collect();
-    let assessment = rates::assess(&levels, 0.0)
+    let judged: Vec<(usize, f64, f64)> = runs.iter().map(|r| (r.steps, r.k, r.error)).collect();
+    let assessment = rates::assess_in_k(&judged)
         .map_err(|e| Error::input(&study.path, "time.steps", format!("time study: {e}")))?;
     Ok(Some(TimeStudy {
         scene: scene.name.clone(),

@@ -523,3 +523,31 @@ pub fn fit_power_sum(points: &[(f64, f64, f64)]) -> Option<PowerSumFit> {
     };
     (fit.a.iter().chain(&fit.c).all(|v| v.is_finite())).then_some(fit)
 }
+
+/// Judge a rate in the time step k as a rate in h is judged ([`assess`] with k in place of
+/// h, the runs in order of halving k, the truth exact in time): one rule for the time
+/// studies and for the README's reading of their `time.csv`. `runs` are (steps, k, error).
+pub fn assess_in_k(runs: &[(usize, f64, f64)]) -> Result<Assessment, EqualH> {
+    let levels: Vec<LevelError> = runs
+        .iter()
+        .enumerate()
+        .map(|(i, &(steps, k, error))| LevelError {
+            level: i,
+            h: k,
+            dofs: steps as f64,
+            error,
+        })
+        .collect();
+    assess(&levels, 0.0)
+}
+
+/// Largest standard error of an exponent of a [`PowerSumFit`] that counts as measured.
+pub const FIT_MAX_SE: f64 = 0.5;
+/// Largest rms log residual of a [`PowerSumFit`] that describes its errors (within ~28 %).
+pub const FIT_MAX_RMS: f64 = 0.25;
+
+/// Whether a power-sum fit identifies an exponent with standard error `se` given its rms
+/// log residual `rms` (NaN never does).
+pub fn fit_identifies(se: f64, rms: f64) -> bool {
+    se <= FIT_MAX_SE && rms <= FIT_MAX_RMS
+}

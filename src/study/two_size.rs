@@ -137,8 +137,8 @@ impl TwoSizeResult {
     /// Theorem 3.1's thresholds carried to the grid fit (Lemma 3.1: the slave's term is
     /// h1^(3/4) for K_h^pi and h1^(1/2) for K_h^I, the approximation error h1): the fitted
     /// exponent a1 of the threshold quantity must reach the study's rate threshold minus its
-    /// tolerance wherever the fit identifies it (standard error <= 0.5, rms log residual
-    /// <= 0.25). One sentence per miss.
+    /// tolerance wherever the fit identifies it ([`rates::fit_identifies`]). One sentence
+    /// per miss.
     pub fn failures(&self) -> Vec<String> {
         self.fits
             .iter()
@@ -146,7 +146,7 @@ impl TwoSizeResult {
             .filter_map(|f| {
                 let x = f
                     .fit
-                    .filter(|x| x.se[0] <= 0.5 && x.rms_log_residual <= 0.25)?;
+                    .filter(|x| rates::fit_identifies(x.se[0], x.rms_log_residual))?;
                 let need = self.thresholds[usize::from(f.method == Method::Nts)];
                 (x.a[0] < need).then(|| {
                     format!(
