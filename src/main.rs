@@ -5,7 +5,7 @@ use clap::{Parser, Subcommand};
 use contact_rates::case::{Case, PeakMemory, RunSummary};
 use contact_rates::contact::Method;
 use contact_rates::progress::Progress;
-use contact_rates::report;
+use contact_rates::report::{self, Output, Staging};
 use contact_rates::scene::Scene;
 use contact_rates::solve::{self, Settings, SolverKind};
 use contact_rates::study::Kind;
@@ -44,9 +44,15 @@ enum Command {
     /// (reports/rates, rates-exact, rates-exact-vp, patch, two-size-exact, two-size-rates,
     /// speed, stability).
     Results,
-    /// Solve one scene on one mesh level and write solution.vtu and summary.csv.
+    /// The built-in scenes (`scene list`).
+    Scene {
+        #[command(subcommand)]
+        action: SceneAction,
+    },
+    /// Solve one scene on one mesh level and write its time series (binary VTU), contact.csv
+    /// and summary.csv into --out, all or nothing.
     Solve {
-        /// Built-in scene name or path to a scene .toml.
+        /// Built-in scene name (`scene list` lists them) or path to a scene .toml.
         #[arg(long)]
         scene: String,
         /// Contact condition: mortar (K_h^pi) or nts (K_h^I).
@@ -86,6 +92,12 @@ enum Command {
     },
 }
 
+#[derive(Subcommand)]
+enum SceneAction {
+    /// List the built-in scenes with their descriptions.
+    List,
+}
+
 fn parse_sets(set: &[String]) -> anyhow::Result<Vec<(String, f64)>> {
     set.iter()
         .map(|s| {
@@ -111,6 +123,14 @@ fn run() -> anyhow::Result<()> {
         } => study(&name, out, shard.as_deref(), merge),
         Command::Results => {
             print!("{}", report::results::section(&report::reports_dir())?);
+            Ok(())
+        }
+        Command::Scene {
+            action: SceneAction::List,
+        } => {
+            for (name, description) in contact_rates::scene::builtin_list()? {
+                println!("{name:20} {description}");
+            }
             Ok(())
         }
         Command::Solve {
@@ -176,7 +196,9 @@ fn study(name: &str, out: Option<PathBuf>, shard: Option<&str>, merge: bool) -> 
     let dir = out.unwrap_or_else(|| report::reports_dir().join(kind.name()));
     // The report folder is checked before any computing (a shard writes no report).
     if shard.is_none() {
-        report::check_writable(&dir)?;
+        for n in report::check_writable(&dir, Output::Report)? {
+            eprintln!("note: {n}");
+        }
     }
     let Some(outcome) = kind.run(mode)? else {
         return Ok(());
@@ -219,37 +241,37 @@ fn solve_one(req: &SolveRequest) -> anyhow::Result<()> {
     if req.every == 0 {
         anyhow::bail!("--every: write every K-th step with K >= 1, got 0");
     }
-    // The output folder is checked (and created) before any computing.
-    report::check_writable(&req.out.join("solution"))?;
+    // The output folder is checked before any computing; the run writes into a staging
+    // folder that replaces it only at the end (dropped on any error).
+    let (staging, notes) = Staging::begin(&req.out, Output::Solve)?;
+    for n in notes {
+        eprintln!("note: {n}");
+    }
     let t0 = std::time::Instant::now();
     let case = Case::build(&scene, req.level, req.method, &req.params)?;
     for w in &case.warnings {
         eprintln!("warning: {w}");
     }
-    let mut series = report::run::Series::new(&req.out, &case.problem, req.every);
+    let mut series = report::run::Series::new(staging.path(), &case.problem, req.every);
     let progress = Progress::new(steps as u64, "solve");
     let memory = PeakMemory::start();
-    let solved = solve::solve_observed(
-        &case.problem,
-        &req.settings,
-        steps,
-        &mut |n, total, state, step| {
-            progress.tick(&format!(
-                "step {n} of {total}: {} iterations",
-                step.iterations
-            ));
-            series.step(n, total, state)
-        },
-    );
+    let solved = series.write_during(|on_step| {
+        solve::solve_observed(
+            &case.problem,
+            &req.settings,
+            steps,
+            &mut |n, total, state, step| {
+                progress.tick(&format!(
+                    "step {n} of {total}: {} iterations",
+                    step.iterations
+                ));
+                on_step(n, total, state)
+            },
+        )
+    });
     progress.finish();
     let peak = memory.peak_gib();
-    let sol = match solved {
-        Ok(sol) => sol,
-        Err(e) => {
-            series.abandon();
-            return Err(e.into());
-        }
-    };
+    let sol = solved?;
     let floor_s = match req.floor {
         true => {
             // Cold, as the solve was (see PeakMemory::start).
@@ -260,8 +282,9 @@ fn solve_one(req: &SolveRequest) -> anyhow::Result<()> {
     };
     let run = RunSummary::new(&case, req.settings.kind, &sol, floor_s, peak);
     let wall_s = t0.elapsed().as_secs_f64();
-    series.finish(&run, wall_s)?;
-    print!("{}", report::run::console(&run, wall_s, &req.out));
+    let written = series.finish(&run, wall_s)?;
+    staging.commit()?;
+    print!("{}", report::run::console(&run, wall_s, &written, &req.out));
     Ok(())
 }
 

@@ -244,6 +244,14 @@ pub fn builtin_names() -> Vec<String> {
     v
 }
 
+/// Every built-in scene, name and one-line description, sorted by name.
+pub fn builtin_list() -> Result<Vec<(String, String)>> {
+    builtin_names()
+        .into_iter()
+        .map(|n| Ok((n.clone(), Scene::load(&n)?.description)))
+        .collect()
+}
+
 fn check_positive(file: &Path, field: &str, v: f64, what: &str) -> Result<()> {
     if !(v > 0.0 && v.is_finite()) {
         return Err(Error::input(
@@ -268,7 +276,7 @@ impl Scene {
                     name_or_path,
                     "scene",
                     format!(
-                        "no built-in scene named '{name_or_path}' and no such file; built-in scenes: {}",
+                        "no built-in scene named '{name_or_path}' and no such file; built-in scenes (`contact-rates scene list` describes them): {}",
                         builtin_names().join(", ")
                     ),
                 ));

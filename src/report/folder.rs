@@ -1,5 +1,8 @@
-//! Report folders: checked before any computing, written whole into a temporary sibling
-//! and swapped in, so a failed run leaves the previous report intact.
+//! Output folders written all or nothing, for study reports and `solve` alike: the files go
+//! into a staging sibling `.NAME.staging-PID`, which replaces NAME only once the run has
+//! succeeded. A failed run removes its staging folder; a killed one leaves it, and the next
+//! run into the same folder removes it with a one-line note. The previous folder is never
+//! touched before the swap, so it survives any failure byte for byte.
 
 use crate::error::{Error, Result};
 use std::path::{Path, PathBuf};
@@ -9,70 +12,253 @@ pub fn reports_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("reports")
 }
 
-/// Check, before any computing, that the report folder `dir` can be written (its parent is
-/// created when missing): a study that runs for minutes must not fail at the end.
-pub fn check_writable(dir: &Path) -> Result<()> {
-    let parent = dir.parent().unwrap_or(Path::new("."));
-    let fix = "pass --out with a writable folder, or make this one writable";
-    std::fs::create_dir_all(parent).map_err(|e| {
+/// What kind of output a folder holds, known by a file every such output has: an existing
+/// non-empty folder without it is someone else's and is not replaced.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Output {
+    /// A study report (README.md).
+    Report,
+    /// The output of `solve` (summary.csv).
+    Solve,
+}
+
+impl Output {
+    /// The file every output of this kind holds.
+    pub fn signature(self) -> &'static str {
+        match self {
+            Output::Report => "README.md",
+            Output::Solve => "summary.csv",
+        }
+    }
+
+    fn what(self) -> &'static str {
+        match self {
+            Output::Report => "reports folder",
+            Output::Solve => "--out",
+        }
+    }
+}
+
+const FIX: &str = "pass --out with a writable folder, or make this one writable";
+
+/// Check, before any computing, that `dir` can receive an output of kind `kind`: its parent
+/// can be created and written, and `dir` is missing, empty, or an earlier output of the same
+/// kind. Creates the parent, never `dir`. Also removes staging debris of killed runs (see
+/// [`Staging`]), returning one note per folder removed.
+pub fn check_writable(dir: &Path, kind: Output) -> Result<Vec<String>> {
+    let parent = parent(dir);
+    std::fs::create_dir_all(&parent).map_err(|e| {
         Error::input(
-            parent,
-            "reports folder",
-            format!("cannot create it ({e}); {fix}"),
+            &parent,
+            kind.what(),
+            format!("cannot create it ({e}); {FIX}"),
         )
     })?;
-    if dir.exists() && !dir.is_dir() {
-        return Err(Error::input(
-            dir,
-            "reports folder",
-            format!("exists and is not a folder; {fix}"),
-        ));
+    if dir.exists() {
+        if !dir.is_dir() {
+            return Err(Error::input(
+                dir,
+                kind.what(),
+                format!("exists and is not a folder; {FIX}"),
+            ));
+        }
+        let empty = std::fs::read_dir(dir)
+            .map_err(|e| Error::io(dir, e))?
+            .next()
+            .is_none();
+        if !empty && !dir.join(kind.signature()).exists() {
+            return Err(Error::input(
+                dir,
+                kind.what(),
+                format!(
+                    "holds files but no {}, so it is not an earlier output and would be replaced whole; pass --out with a new or empty folder",
+                    kind.signature()
+                ),
+            ));
+        }
     }
-    let name = dir.file_name().unwrap_or_default().to_string_lossy();
-    let probe = parent.join(format!(".{name}.probe-{}", std::process::id()));
+    let probe = sibling(dir, "probe", std::process::id());
     std::fs::create_dir(&probe).map_err(|e| {
         Error::input(
-            parent,
-            "reports folder",
-            format!("cannot write here ({e}); {fix}"),
+            &parent,
+            kind.what(),
+            format!("cannot write here ({e}); {FIX}"),
         )
     })?;
     let _ = std::fs::remove_dir(&probe);
-    Ok(())
+    Ok(remove_stale(dir))
 }
 
-/// Write a report folder atomically: fill a temporary sibling, then swap it in, so a failed
-/// run leaves the previous report intact.
+/// A folder being written: files go into [`Staging::path`]; [`Staging::commit`] swaps it
+/// in for the target, and dropping it uncommitted removes it (a failed run).
+pub struct Staging {
+    target: PathBuf,
+    path: PathBuf,
+    committed: bool,
+}
+
+impl Staging {
+    /// Check `dir` as [`check_writable`] does and create its staging folder; the notes say
+    /// which stale staging folders were removed.
+    pub fn begin(dir: &Path, kind: Output) -> Result<(Staging, Vec<String>)> {
+        let notes = check_writable(dir, kind)?;
+        let path = sibling(dir, "staging", std::process::id());
+        let _ = std::fs::remove_dir_all(&path);
+        std::fs::create_dir(&path).map_err(|e| {
+            Error::input(
+                parent(dir),
+                kind.what(),
+                format!("cannot write here ({e}); {FIX}"),
+            )
+        })?;
+        let staging = Staging {
+            target: dir.to_path_buf(),
+            path,
+            committed: false,
+        };
+        Ok((staging, notes))
+    }
+
+    /// The folder to write into.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Replace the target by the staging folder: one atomic exchange where the file system
+    /// has it (Linux renameat2), two renames otherwise; then remove the previous output.
+    pub fn commit(mut self) -> Result<()> {
+        let old = sibling(&self.target, "old", std::process::id());
+        if self.target.exists() {
+            if !exchange(&self.path, &self.target) {
+                std::fs::rename(&self.target, &old).map_err(|e| Error::io(&self.target, e))?;
+                std::fs::rename(&self.path, &self.target)
+                    .map_err(|e| Error::io(&self.target, e))?;
+                self.committed = true;
+                let _ = std::fs::remove_dir_all(&old);
+                return Ok(());
+            }
+            // The staging path now holds the previous output.
+            let _ = std::fs::remove_dir_all(&self.path);
+        } else {
+            std::fs::rename(&self.path, &self.target).map_err(|e| Error::io(&self.target, e))?;
+        }
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for Staging {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_dir_all(&self.path);
+        }
+    }
+}
+
+/// Write a report folder all or nothing (see [`Staging`]).
 pub fn write_folder(dir: &Path, fill: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-    let parent = dir.parent().unwrap_or(Path::new("."));
-    std::fs::create_dir_all(parent).map_err(|e| Error::io(parent, e))?;
-    let name = dir.file_name().unwrap().to_string_lossy().to_string();
-    let tmp = parent.join(format!(".{name}.tmp-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&tmp);
-    std::fs::create_dir_all(&tmp).map_err(|e| {
-        Error::input(
-            parent,
-            "reports folder",
-            format!(
-                "cannot write here ({e}); make the folder writable or run from a writable checkout"
-            ),
-        )
-    })?;
-    if let Err(e) = fill(&tmp) {
-        let _ = std::fs::remove_dir_all(&tmp);
-        return Err(e);
+    let (staging, notes) = Staging::begin(dir, Output::Report)?;
+    for n in notes {
+        eprintln!("note: {n}");
     }
-    let old = parent.join(format!(".{name}.old-{}", std::process::id()));
-    if dir.exists() {
-        std::fs::rename(dir, &old).map_err(|e| Error::io(dir, e))?;
-    }
-    std::fs::rename(&tmp, dir).map_err(|e| Error::io(dir, e))?;
-    let _ = std::fs::remove_dir_all(&old);
-    Ok(())
+    fill(staging.path())?;
+    staging.commit()
 }
 
 /// Write `bytes` as the file `name` in `dir`.
 pub fn write(dir: &Path, name: &str, bytes: &[u8]) -> Result<()> {
     let p = dir.join(name);
     std::fs::write(&p, bytes).map_err(|e| Error::io(p, e))
+}
+
+fn parent(dir: &Path) -> PathBuf {
+    match dir.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// `.NAME.ROLE-PID` beside `dir`.
+fn sibling(dir: &Path, role: &str, pid: u32) -> PathBuf {
+    let name = dir.file_name().unwrap_or_default().to_string_lossy();
+    parent(dir).join(format!(".{name}.{role}-{pid}"))
+}
+
+/// Remove the staging and old folders of `dir` left by runs whose process is gone; when a
+/// killed run got between its two renames (no atomic exchange), put the previous output
+/// back first. One note per folder.
+fn remove_stale(dir: &Path) -> Vec<String> {
+    let name = dir
+        .file_name()
+        .unwrap_or_default()
+        .to_string_lossy()
+        .to_string();
+    let Ok(entries) = std::fs::read_dir(parent(dir)) else {
+        return Vec::new();
+    };
+    let mut notes = Vec::new();
+    let mut found: Vec<(String, u32, PathBuf)> = entries
+        .filter_map(|e| e.ok())
+        .filter_map(|e| {
+            let file = e.file_name().to_string_lossy().to_string();
+            let rest = file.strip_prefix(&format!(".{name}."))?;
+            let (role, pid) = rest.rsplit_once('-')?;
+            let pid: u32 = pid.parse().ok()?;
+            (matches!(role, "staging" | "old") && !alive(pid))
+                .then(|| (role.to_string(), pid, e.path()))
+        })
+        .collect();
+    found.sort();
+    for (role, pid, path) in found {
+        if role == "old" && !dir.exists() && std::fs::rename(&path, dir).is_ok() {
+            notes.push(format!(
+                "restored {} from {} (run {pid} was killed while swapping it)",
+                dir.display(),
+                path.display()
+            ));
+            continue;
+        }
+        if std::fs::remove_dir_all(&path).is_ok() {
+            notes.push(format!(
+                "removed {}, left by run {pid}, which was killed before it finished",
+                path.display()
+            ));
+        }
+    }
+    notes
+}
+
+/// Whether process `pid` runs (Linux: /proc; elsewhere every other process counts as gone,
+/// so its debris is removed).
+fn alive(pid: u32) -> bool {
+    pid == std::process::id() || Path::new(&format!("/proc/{pid}")).exists()
+}
+
+/// Exchange two paths atomically (Linux renameat2 RENAME_EXCHANGE); false where the system
+/// or the file system cannot.
+#[cfg(target_os = "linux")]
+fn exchange(a: &Path, b: &Path) -> bool {
+    use std::os::unix::ffi::OsStrExt;
+    let (Ok(a), Ok(b)) = (
+        std::ffi::CString::new(a.as_os_str().as_bytes()),
+        std::ffi::CString::new(b.as_os_str().as_bytes()),
+    ) else {
+        return false;
+    };
+    // SAFETY: both are valid NUL-terminated paths; renameat2 only reads them.
+    let rc = unsafe {
+        libc::renameat2(
+            libc::AT_FDCWD,
+            a.as_ptr(),
+            libc::AT_FDCWD,
+            b.as_ptr(),
+            libc::RENAME_EXCHANGE,
+        )
+    };
+    rc == 0
+}
+
+#[cfg(not(target_os = "linux"))]
+fn exchange(_: &Path, _: &Path) -> bool {
+    false
 }

@@ -1,10 +1,13 @@
 //! The output of `solve`: the time series (solution_NNNN.vtu and solution.pvd), contact.csv,
-//! solution.vtu (the last step), summary.csv, and the lines printed on the console.
+//! solution.vtu (the last step), summary.csv, and the lines printed on the console. The
+//! files go into a staging folder (see [`super::folder::Staging`]) that replaces the output
+//! folder once the run has succeeded.
 
+use super::folder::write;
 use crate::case::RunSummary;
 use crate::contact::Method;
 use crate::error::Result;
-use crate::io::{self, csv_bytes, write_atomic};
+use crate::io::{self, csv_bytes};
 use crate::metrics::{ContactNode, contact_nodes};
 use crate::solve::{Problem, SolverKind, State};
 use serde::Serialize;
@@ -41,6 +44,12 @@ struct SummaryCsv<'a> {
     solver_setup_s: f64,
     floor_s: Option<f64>,
     ratio_to_floor: Option<f64>,
+    /// Building, compressing and writing the step files, on a second thread (s).
+    output_s: f64,
+    /// Of that, the time the solve waited for it (s), part of `wall_s`.
+    output_wait_s: f64,
+    /// Size of the step files (MB = 1e6 bytes; solution.vtu is the last one's second name).
+    output_mb: f64,
 }
 
 /// One row of contact.csv: a slave node of Gamma_C at a written time step.
@@ -62,18 +71,37 @@ struct ContactCsv {
     active: bool,
 }
 
-/// The time series of a `solve` run, written as the steps come: every `every`-th step and
-/// the last as `solution_NNNN.vtu` (the last also as solution.vtu) with its rows of
-/// contact.csv. [`Series::finish`] writes the collection `solution.pvd`, contact.csv and
-/// summary.csv; [`Series::abandon`] removes the step files of a run that failed.
+/// The time series of a `solve` run: every `every`-th step and the last as
+/// `solution_NNNN.vtu` (the last also as solution.vtu) with its rows of contact.csv.
+/// [`Series::write_during`] runs the solve and writes the step files on a second thread, so
+/// compressing one step overlaps solving the next; [`Series::finish`] then writes the
+/// collection `solution.pvd`, contact.csv and summary.csv.
 pub struct Series<'a> {
     dir: &'a Path,
     problem: &'a Problem,
     every: usize,
     written: Vec<(f64, String)>,
     contact: Vec<ContactCsv>,
-    last_contact: Vec<ContactNode>,
+    output: Written,
 }
+
+/// What a series wrote: step files, their bytes and the time it took.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Written {
+    /// Step files (solution_NNNN.vtu).
+    pub files: usize,
+    /// Their size (bytes).
+    pub bytes: u64,
+    /// Building, compressing and writing them, on the writer thread (s).
+    pub seconds: f64,
+    /// Of that, the time the solve waited for the writer (s): the part of the run's wall
+    /// time the output costs.
+    pub waited_s: f64,
+}
+
+/// A step for the writer thread: the file name, whether it is the last step, the state and
+/// its contact nodes.
+type StepFile = (String, bool, State, Vec<ContactNode>);
 
 impl<'a> Series<'a> {
     /// A series of `problem`'s steps into `dir`, every `every`-th step (>= 1).
@@ -84,25 +112,83 @@ impl<'a> Series<'a> {
             every: every.max(1),
             written: Vec::new(),
             contact: Vec::new(),
-            last_contact: Vec::new(),
+            output: Written::default(),
         }
     }
 
-    /// Write step `n` of `steps` when it is due (the last one also as solution.vtu).
-    pub fn step(&mut self, n: usize, steps: usize, state: &State) -> Result<()> {
-        if n % self.every != 0 && n != steps {
-            return Ok(());
-        }
-        let nodes = contact_nodes(self.problem, state);
-        let name = format!("solution_{n:04}.vtu");
-        let vtu = io::vtu(&self.problem.model, state, &nodes);
-        write_atomic(&self.dir.join(&name), vtu.as_bytes())?;
-        if n == steps {
-            write_atomic(&self.dir.join("solution.vtu"), vtu.as_bytes())?;
-        }
-        self.written.push((state.time, name));
+    /// Run `solve`, giving it the observer that hands each due step to a writer thread (at
+    /// most one step waits; the solve blocks when the writer falls behind). The writer
+    /// compresses on one core, the solve goes on on the other. An error of either stops
+    /// both and is returned (the writer's first).
+    pub fn write_during<T>(
+        &mut self,
+        solve: impl FnOnce(&mut dyn FnMut(usize, usize, &State) -> Result<()>) -> Result<T>,
+    ) -> Result<T> {
+        let (dir, model) = (self.dir, &self.problem.model);
+        std::thread::scope(|scope| {
+            let (send, receive) = std::sync::mpsc::sync_channel::<StepFile>(1);
+            let writer = scope.spawn(move || -> Result<(u64, f64)> {
+                let (mut bytes, mut seconds) = (0u64, 0.0);
+                let mut vtu: Option<io::vtu::StateFile> = None;
+                for (name, last, state, nodes) in receive {
+                    let t0 = std::time::Instant::now();
+                    let file = vtu
+                        .get_or_insert_with(|| io::vtu::StateFile::new(model))
+                        .file(&state, &nodes);
+                    write(dir, &name, &file)?;
+                    bytes += file.len() as u64;
+                    if last {
+                        // The last step again, as a second name of the same file (a copy
+                        // where the file system has no hard links).
+                        let (step, last) = (dir.join(&name), dir.join("solution.vtu"));
+                        if std::fs::hard_link(&step, &last).is_err() {
+                            write(dir, "solution.vtu", &file)?;
+                        }
+                    }
+                    seconds += t0.elapsed().as_secs_f64();
+                }
+                Ok((bytes, seconds))
+            });
+            let mut waited_s = 0.0;
+            let solved = solve(&mut |n, steps, state| {
+                if n % self.every != 0 && n != steps {
+                    return Ok(());
+                }
+                let nodes = contact_nodes(self.problem, state);
+                self.record(state.time, &nodes, format!("solution_{n:04}.vtu"));
+                let t0 = std::time::Instant::now();
+                let sent = send.send((
+                    self.written.last().unwrap().1.clone(),
+                    n == steps,
+                    state.clone(),
+                    nodes,
+                ));
+                waited_s += t0.elapsed().as_secs_f64();
+                // A closed channel means the writer failed: its error is returned below.
+                sent.map_err(|_| {
+                    crate::Error::io(dir, std::io::Error::other("the VTU writer stopped"))
+                })
+            });
+            drop(send);
+            let t0 = std::time::Instant::now();
+            let wrote = writer.join().expect("the VTU writer thread panicked");
+            waited_s += t0.elapsed().as_secs_f64();
+            let (bytes, seconds) = wrote?;
+            self.output = Written {
+                files: self.written.len(),
+                bytes,
+                seconds,
+                waited_s,
+            };
+            solved
+        })
+    }
+
+    /// Record a written step: its time and file, and its contact rows.
+    fn record(&mut self, time: f64, nodes: &[ContactNode], file: String) {
+        self.written.push((time, file));
         self.contact.extend(nodes.iter().map(|c| ContactCsv {
-            time: state.time,
+            time,
             piece: c.piece,
             arc_length: c.arc_length,
             x: c.position[0],
@@ -111,31 +197,20 @@ impl<'a> Series<'a> {
             normal_jump: c.normal_jump,
             active: c.active,
         }));
-        self.last_contact = nodes;
-        Ok(())
     }
 
     /// Write solution.pvd, contact.csv and summary.csv; `wall_s` is the whole run's wall
     /// time.
-    pub fn finish(self, run: &RunSummary, wall_s: f64) -> Result<()> {
-        write_atomic(
-            &self.dir.join("solution.pvd"),
-            io::pvd(&self.written).as_bytes(),
-        )?;
-        write_atomic(&self.dir.join("contact.csv"), &csv_bytes(&self.contact)?)?;
-        write_summary(self.dir, run, wall_s)
-    }
-
-    /// Remove the step files written so far (the run failed).
-    pub fn abandon(self) {
-        for (_, name) in &self.written {
-            let _ = std::fs::remove_file(self.dir.join(name));
-        }
+    pub fn finish(self, run: &RunSummary, wall_s: f64) -> Result<Written> {
+        write(self.dir, "solution.pvd", io::pvd(&self.written).as_bytes())?;
+        write(self.dir, "contact.csv", &csv_bytes(&self.contact)?)?;
+        write_summary(self.dir, run, wall_s, &self.output)?;
+        Ok(self.output)
     }
 }
 
 /// Write `dir/summary.csv`; `wall_s` is the whole run's wall time.
-fn write_summary(dir: &Path, run: &RunSummary, wall_s: f64) -> Result<()> {
+fn write_summary(dir: &Path, run: &RunSummary, wall_s: f64, output: &Written) -> Result<()> {
     let t = &run.timings;
     let row = SummaryCsv {
         scene: &run.scene,
@@ -164,12 +239,15 @@ fn write_summary(dir: &Path, run: &RunSummary, wall_s: f64) -> Result<()> {
         solver_setup_s: t.setup_s,
         floor_s: run.floor_s,
         ratio_to_floor: run.ratio_to_floor(),
+        output_s: output.seconds,
+        output_wait_s: output.waited_s,
+        output_mb: output.bytes as f64 / 1e6,
     };
-    write_atomic(&dir.join("summary.csv"), &csv_bytes(&[row])?)
+    write(dir, "summary.csv", &csv_bytes(&[row])?)
 }
 
 /// What `solve` prints: the run, its cost split, and where the files went.
-pub fn console(run: &RunSummary, wall_s: f64, dir: &Path) -> String {
+pub fn console(run: &RunSummary, wall_s: f64, written: &Written, dir: &Path) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -213,8 +291,12 @@ pub fn console(run: &RunSummary, wall_s: f64, dir: &Path) -> String {
     );
     let _ = writeln!(
         s,
-        "wrote {} and {}",
-        dir.join("solution.vtu").display(),
+        "wrote {} step files ({:.1} MB, binary zlib VTU) in {:.3} s on a second thread, {:.3} s of it waited for; {} and {}",
+        written.files,
+        written.bytes as f64 / 1e6,
+        written.seconds,
+        written.waited_s,
+        dir.join("solution.pvd").display(),
         dir.join("summary.csv").display()
     );
     s
