@@ -401,17 +401,23 @@ fn reports_folder_that_cannot_be_written_fails_before_computing() {
     } else {
         ro.join("report")
     };
-    for args in [
-        vec!["study", "rates-quick", "--out", target.to_str().unwrap()],
-        vec![
-            "solve",
-            "--scene",
-            "rates",
+    for (args, field) in [
+        (
+            vec!["study", "rates-quick", "--out", target.to_str().unwrap()],
+            "reports folder",
+        ),
+        (
+            vec![
+                "solve",
+                "--scene",
+                "rates",
+                "--out",
+                target.to_str().unwrap(),
+            ],
             "--out",
-            target.to_str().unwrap(),
-        ],
+        ),
     ] {
-        fails_with(&common::run(&args, &[]), &["reports folder", "writable"]);
+        fails_with(&common::run(&args, &[]), &[field, "writable"]);
     }
 }
 
@@ -421,6 +427,8 @@ fn failed_study_leaves_the_previous_report_intact() {
     let out = dir.path().join("report");
     std::fs::create_dir(&out).unwrap();
     std::fs::write(out.join("rates.csv"), "previous report\n").unwrap();
+    // An earlier report (README.md marks one; any other non-empty folder is refused).
+    std::fs::write(out.join("README.md"), "# previous report\n").unwrap();
     // The scene's mesh lacks the physical group the scene asks for: found while computing.
     let scene = scene_file(dir.path(), |t| {
         t.replace("curve = \"top\"", "curve = \"roof\"")

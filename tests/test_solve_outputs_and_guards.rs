@@ -35,24 +35,6 @@ fn fails_short(out: &Output, needles: &[&str]) {
     }
 }
 
-/// The data lines of the point-data array `name` of a VTU file.
-fn point_array(vtu: &str, name: &str) -> Vec<f64> {
-    let start = vtu
-        .find(&format!("Name=\"{name}\""))
-        .unwrap_or_else(|| panic!("no array {name}"));
-    let body = &vtu[start..];
-    let body = &body[body.find('\n').unwrap() + 1..];
-    let body = &body[..body.find("</DataArray>").unwrap()];
-    body.lines()
-        .map(|l| l.split_whitespace().next().unwrap().parse().unwrap())
-        .collect()
-}
-
-fn number_of_points(vtu: &str) -> usize {
-    let k = vtu.find("NumberOfPoints=\"").unwrap() + 16;
-    vtu[k..k + vtu[k..].find('"').unwrap()].parse().unwrap()
-}
-
 /// Reference: issue 15, acceptance 1. Data: scenes/patch.toml, level 1, 4 steps, newton,
 /// both cones. The pressure is >= 0, the rows where it is positive are active, its
 /// resultant (trapezoid over the arc length) equals the load 10 t on the unit-wide top to
@@ -133,16 +115,16 @@ fn solve_writes_contact_csv_and_a_paraview_time_series() {
         assert_eq!(sets.len(), 4, "{method}: 4 steps in the .pvd");
         assert!(sets.windows(2).all(|w| w[1].0 > w[0].0), "times increase");
         for (t, file) in &sets {
-            let vtu = std::fs::read_to_string(file).unwrap();
-            let n = number_of_points(&vtu);
-            let pressure = point_array(&vtu, "pressure");
+            let vtu = common::vtu::read(file);
+            let n = vtu.points;
+            let (pressure, _) = vtu.f64("PointData", "pressure");
             assert_eq!(
                 pressure.len(),
                 n,
                 "{}: one pressure per point",
                 file.display()
             );
-            assert_eq!(point_array(&vtu, "normal_jump").len(), n);
+            assert_eq!(vtu.f64("PointData", "normal_jump").0.len(), n);
             let csv_max = rows
                 .iter()
                 .filter(|r| f(r, 0) == *t)
@@ -155,8 +137,8 @@ fn solve_writes_contact_csv_and_a_paraview_time_series() {
             );
         }
         // solution.vtu is the last step.
-        let last = std::fs::read_to_string(out.join("solution.vtu")).unwrap();
-        let last_step = std::fs::read_to_string(&sets[3].1).unwrap();
+        let last = std::fs::read(out.join("solution.vtu")).unwrap();
+        let last_step = std::fs::read(&sets[3].1).unwrap();
         assert_eq!(last, last_step);
     }
 }

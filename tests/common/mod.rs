@@ -1,6 +1,8 @@
 //! Shared helpers for the integration tests.
 #![allow(dead_code)]
 
+pub mod vtu;
+
 use contact_rates::case::Case;
 use contact_rates::contact::Method;
 use contact_rates::scene::Scene;
