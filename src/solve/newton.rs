@@ -45,6 +45,10 @@ pub struct Newton<'a> {
     clock: std::rc::Rc<Clock>,
     /// Seconds building the pattern, slot maps and symbolic analysis (once per mesh).
     setup_s: f64,
+    /// Print one line per iteration to stderr (environment CONTACT_RATES_TRACE set): the
+    /// distances, the active set and its flips, the plastic triangles and how many switched,
+    /// the line search's step length.
+    trace: bool,
     /// The elastic stiffness in pattern order.
     elastic_values: Vec<f64>,
     /// Lower triangle of the symmetric stiffness handed to the LDL^T (pattern order).
@@ -244,6 +248,7 @@ impl<'a> Newton<'a> {
             symmetric_values: Vec::new(),
             fresh_iterations: 0,
             predicted_changes: 0,
+            trace: std::env::var_os("CONTACT_RATES_TRACE").is_some(),
         })
     }
 
@@ -625,7 +630,7 @@ impl Newton<'_> {
         lambda: &[f64],
         step: &[f64],
         reference: f64,
-    ) -> (Vec<f64>, Vec<f64>, Evaluation) {
+    ) -> (Vec<f64>, Vec<f64>, Evaluation, f64) {
         let (n, c) = (self.n, self.c_scale);
         let trial = |alpha: f64| -> (Vec<f64>, Vec<f64>) {
             let mut ut = u.to_vec();
@@ -640,22 +645,22 @@ impl Newton<'_> {
             (ut, lt)
         };
         let mut alpha = 1.0;
-        let mut best: Option<(f64, (Vec<f64>, Vec<f64>), Evaluation)> = None;
+        let mut best: Option<(f64, (Vec<f64>, Vec<f64>), Evaluation, f64)> = None;
         for _ in 0..12 {
             let (ut, lt) = trial(alpha);
             let ev = self.evaluate(data, &ut, &lt);
             let merit = self.merit(&ev, &lt);
             let done = merit <= (1.0 - 1e-4 * alpha) * reference;
             if best.as_ref().is_none_or(|b| merit < b.0) {
-                best = Some((merit, (ut, lt), ev));
+                best = Some((merit, (ut, lt), ev, alpha));
             }
             if done {
                 break;
             }
             alpha *= 0.5;
         }
-        let (_, (u, lambda), ev) = best.expect("at least one trial");
-        (u, lambda, ev)
+        let (_, (u, lambda), ev, alpha) = best.expect("at least one trial");
+        (u, lambda, ev, alpha)
     }
 }
 
@@ -729,10 +734,36 @@ impl StepSolver for Newton<'_> {
                 )));
             }
             let reference = self.merit(ev, &lambda);
+            let ev_before = self.trace.then(|| Evaluation {
+                sigma: Vec::new(),
+                tangents: ev.tangents.clone(),
+                residual: Vec::new(),
+                gaps: Vec::new(),
+                scale: 0.0,
+            });
             let (step, set, factorized) = self.newton_step(ev, &lambda, active, &distance)?;
             debug_assert_eq!(step.len(), n + m);
             factorizations += factorized as usize;
-            (u, lambda, evaluation) = self.line_search(&data, &u, &lambda, &step, reference);
+            let alpha;
+            (u, lambda, evaluation, alpha) =
+                self.line_search(&data, &u, &lambda, &step, reference);
+            if self.trace {
+                let plastic = |ev: &Evaluation| -> Vec<bool> {
+                    ev.tangents
+                        .iter()
+                        .zip(&model.elements)
+                        .map(|(d, e)| *d != model.materials[e.body].elastic.matrix())
+                        .collect()
+                };
+                let (before, after) = (plastic(ev_before.as_ref().unwrap()), plastic(&evaluation));
+                let switched = before.iter().zip(&after).filter(|(a, b)| a != b).count();
+                let flips = set.iter().zip(last_active.as_deref().unwrap_or(&set)).filter(|(a, b)| a != b).count();
+                eprintln!(
+                    "trace t={t:.4} it={iterations} res={res:.3e} compl={compl:.3e} active={} flips={flips} plastic={} switched={switched} alpha={alpha} factorized={factorized}",
+                    set.iter().filter(|&&a| a).count(),
+                    after.iter().filter(|&&a| a).count(),
+                );
+            }
             last_active = Some(set);
             iterations += 1;
         }
