@@ -651,6 +651,13 @@ impl Newton<'_> {
             let ev = self.evaluate(data, &ut, &lt);
             let merit = self.merit(&ev, &lt);
             let done = merit <= (1.0 - 1e-4 * alpha) * reference;
+            if self.trace {
+                let res = (ev.residual.iter().map(|v| v * v).sum::<f64>()).sqrt();
+                eprintln!(
+                    "    trial alpha={alpha} merit/ref={:.4e} |r|={res:.4e}",
+                    merit / reference
+                );
+            }
             if best.as_ref().is_none_or(|b| merit < b.0) {
                 best = Some((merit, (ut, lt), ev, alpha));
             }
@@ -734,30 +741,47 @@ impl StepSolver for Newton<'_> {
                 )));
             }
             let reference = self.merit(ev, &lambda);
-            let ev_before = self.trace.then(|| Evaluation {
-                sigma: Vec::new(),
-                tangents: ev.tangents.clone(),
-                residual: Vec::new(),
-                gaps: Vec::new(),
-                scale: 0.0,
-            });
+            let tangents_before = self.trace.then(|| ev.tangents.clone());
             let (step, set, factorized) = self.newton_step(ev, &lambda, active, &distance)?;
             debug_assert_eq!(step.len(), n + m);
+            if self.trace {
+                let rhs = self.right_hand_side(ev, &lambda, &set);
+                let mut y = vec![0.0; n + m];
+                self.kkt_product(&set, &step, &mut y);
+                let lin = y
+                    .iter()
+                    .zip(&rhs)
+                    .map(|(a, b)| (a - b).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+                    / rhs.iter().map(|b| b * b).sum::<f64>().sqrt();
+                eprintln!(
+                    "    linear residual {lin:.2e}, |du|/|u| = {:.3e}",
+                    inf_norm(&step[..n]) / inf_norm(&u).max(1e-300)
+                );
+            }
             factorizations += factorized as usize;
             let alpha;
-            (u, lambda, evaluation, alpha) =
-                self.line_search(&data, &u, &lambda, &step, reference);
+            (u, lambda, evaluation, alpha) = self.line_search(&data, &u, &lambda, &step, reference);
             if self.trace {
-                let plastic = |ev: &Evaluation| -> Vec<bool> {
-                    ev.tangents
+                // A triangle is plastic where its tangent is not the elastic one.
+                let plastic = |tangents: &[Matrix3<f64>]| -> Vec<bool> {
+                    tangents
                         .iter()
                         .zip(&model.elements)
                         .map(|(d, e)| *d != model.materials[e.body].elastic.matrix())
                         .collect()
                 };
-                let (before, after) = (plastic(ev_before.as_ref().unwrap()), plastic(&evaluation));
+                let (before, after) = (
+                    plastic(tangents_before.as_deref().unwrap()),
+                    plastic(&evaluation.tangents),
+                );
                 let switched = before.iter().zip(&after).filter(|(a, b)| a != b).count();
-                let flips = set.iter().zip(last_active.as_deref().unwrap_or(&set)).filter(|(a, b)| a != b).count();
+                let flips = set
+                    .iter()
+                    .zip(last_active.as_deref().unwrap_or(&set))
+                    .filter(|(a, b)| a != b)
+                    .count();
                 eprintln!(
                     "trace t={t:.4} it={iterations} res={res:.3e} compl={compl:.3e} active={} flips={flips} plastic={} switched={switched} alpha={alpha} factorized={factorized}",
                     set.iter().filter(|&&a| a).count(),
