@@ -40,6 +40,7 @@ use faer::sparse::linalg::cholesky::{
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Accum, Conj, Mat, Par, Side};
+use rayon::prelude::*;
 use std::cell::Cell;
 use std::time::Instant;
 
@@ -47,23 +48,25 @@ use std::time::Instant;
 type InterfaceRow = Vec<(usize, usize, f64)>;
 
 /// The factorization of one symmetric stiffness with the interface last (see the module).
+/// The stiffness is block diagonal (the bodies share no node): each diagonal block (a body)
+/// is factorized on its own, with its own interface unknowns last, the blocks on rayon's
+/// threads side by side; the interface's Schur complement is the blocks' trailing blocks
+/// side by side.
 pub struct InterfaceFactorization {
     n: usize,
-    /// Free equations on Gamma_C, in the order of the trailing block.
+    /// Free equations on Gamma_C, in the order of the dense interface system: block after
+    /// block, each block's in equation order.
     interface: Vec<usize>,
     /// Contact rows over the interface.
     rows: Vec<InterfaceRow>,
     /// 1 / |C_i| (Euclidean norm of row i; 1 for an empty row): scales the multiplier rows
     /// of the dense saddle-point matrix to the size of the stiffness.
     row_scale: Vec<f64>,
-    /// Position of each equation in the elimination order.
-    position: Vec<usize>,
-    symbolic: SymbolicCholesky<usize>,
-    /// Pattern of the stiffness (lower triangle read) and the slots of its diagonal
-    /// entries, in equation order.
-    pattern: SymbolicSparseColMat<usize>,
-    diagonal: Vec<usize>,
-    numeric: Option<Numeric>,
+    /// The diagonal blocks, in equation order.
+    blocks: Vec<Block>,
+    /// S: the Schur complement of the stiffness onto the interface (b x b, force/length),
+    /// block diagonal.
+    schur: Option<Mat<f64>>,
     /// Seconds in numeric work: sparse LDL^T, interface block, dense LUs.
     pub factor_s: Cell<f64>,
     /// Seconds in the symbolic analysis (ordering, elimination tree), once per mesh.
@@ -74,7 +77,25 @@ pub struct InterfaceFactorization {
     pub solves: Cell<usize>,
 }
 
-/// The numeric part: values of the factor and the interface's dense blocks.
+/// One diagonal block of the stiffness: equations `first..first + n`, no entry outside.
+struct Block {
+    first: usize,
+    n: usize,
+    /// The block's entries in the values of the whole stiffness (its columns are contiguous).
+    entries: std::ops::Range<usize>,
+    /// The block's equations on Gamma_C (local numbers, increasing), last in its order.
+    interface: Vec<usize>,
+    /// Position of each local equation in the block's elimination order.
+    position: Vec<usize>,
+    symbolic: SymbolicCholesky<usize>,
+    /// Pattern of the block (lower triangle read) and the slots of its diagonal entries,
+    /// in local equation order.
+    pattern: SymbolicSparseColMat<usize>,
+    diagonal: Vec<usize>,
+    numeric: Option<Numeric>,
+}
+
+/// The numeric part of a block: values of the factor and the interface's dense blocks.
 struct Numeric {
     /// Values of the supernodal L (unit diagonal) with D on its diagonal.
     values: Vec<f64>,
@@ -83,13 +104,11 @@ struct Numeric {
     /// The values of L rounded to single precision, for the solves (see
     /// [`InterfaceFactorization::factor`]).
     single: Option<Vec<f32>>,
-    /// Symmetric scaling W (equation order): W (K + sigma P^T P) W was factorized.
+    /// Symmetric scaling W (local equation order): W (K + sigma P^T P) W was factorized.
     scaling: Vec<f64>,
-    /// The trailing b x b block of L (unit lower triangular) and of D.
+    /// The trailing block of L (unit lower triangular) and of D.
     l_interface: Mat<f64>,
     d_interface: Vec<f64>,
-    /// S: the Schur complement of the stiffness onto the interface (b x b, force/length).
-    schur: Mat<f64>,
 }
 
 /// A stored value of the factor: f64, or f32 for the solves of a preconditioner.
@@ -133,8 +152,8 @@ fn is_regular(lu: &PartialPivLu<f64>) -> bool {
 
 /// A load after the forward substitution (see [`InterfaceFactorization::condense`]).
 pub struct Condensed {
-    /// The forward-substituted, scaled and permuted load.
-    y: Vec<f64>,
+    /// The forward-substituted, scaled and permuted load, block by block.
+    y: Vec<Vec<f64>>,
     /// What the interface sees of the load: `f_I - K_Ir K_rr^{-1} f_r` (force, b values).
     pub load: Vec<f64>,
 }
@@ -160,53 +179,38 @@ impl ActiveSet {
 const PIVOT_EPSILON: f64 = 1e-12;
 const PIVOT_REPLACEMENT: f64 = 1e-6;
 
-impl InterfaceFactorization {
-    /// Order the stiffness with pattern `pattern` (n x n, both triangles) with the interface
-    /// of `rows` (contact rows as (equation, coefficient)) last, and analyze it.
-    pub fn new(pattern: &Pattern, rows: &[Vec<(usize, f64)>]) -> Result<Self> {
-        let t = Instant::now();
-        let n = pattern.n;
-        let mut on_interface = vec![false; n];
-        for row in rows {
-            for &(eq, _) in row {
-                on_interface[eq] = true;
-            }
-        }
-        let interface: Vec<usize> = (0..n).filter(|&e| on_interface[e]).collect();
-        let mut local = vec![usize::MAX; n];
-        for (l, &e) in interface.iter().enumerate() {
-            local[e] = l;
-        }
-        let interface_rows: Vec<InterfaceRow> = rows
-            .iter()
-            .map(|r| r.iter().map(|&(eq, v)| (local[eq], eq, v)).collect())
-            .collect();
-        let row_scale = rows
-            .iter()
-            .map(|r| {
-                let norm = r.iter().map(|&(_, v)| v * v).sum::<f64>().sqrt();
-                if norm > 0.0 { 1.0 / norm } else { 1.0 }
-            })
-            .collect();
-        // AMD of the interior block, then the interface.
-        let interior: Vec<usize> = (0..n).filter(|&e| !on_interface[e]).collect();
+impl Block {
+    /// The block of equations `range` of `pattern`, with its equations on the interface
+    /// (`on_interface`, global) last: AMD of the interior, then the interface.
+    fn new(
+        pattern: &Pattern,
+        range: std::ops::Range<usize>,
+        on_interface: &[bool],
+    ) -> Result<Self> {
+        let (first, n) = (range.start, range.len());
+        let (block, entries) = pattern.block(&range);
+        let Pattern {
+            col_ptr, row_idx, ..
+        } = block;
+        let interface: Vec<usize> = (0..n).filter(|&e| on_interface[first + e]).collect();
+        let interior: Vec<usize> = (0..n).filter(|&e| !on_interface[first + e]).collect();
         let mut interior_index = vec![usize::MAX; n];
         for (k, &e) in interior.iter().enumerate() {
             interior_index[e] = k;
         }
-        let (mut col_ptr, mut row_idx) = (vec![0usize], Vec::new());
+        let (mut interior_ptr, mut interior_rows) = (vec![0usize], Vec::new());
         for &e in &interior {
-            let rows_of_e = &pattern.row_idx[pattern.col_ptr[e]..pattern.col_ptr[e + 1]];
-            row_idx.extend(
-                rows_of_e
+            interior_rows.extend(
+                row_idx[col_ptr[e]..col_ptr[e + 1]]
                     .iter()
                     .map(|&r| interior_index[r])
                     .filter(|&r| r != usize::MAX),
             );
-            col_ptr.push(row_idx.len());
+            interior_ptr.push(interior_rows.len());
         }
         let ni = interior.len();
-        let interior_pattern = SymbolicSparseColMat::new_checked(ni, ni, col_ptr, None, row_idx);
+        let interior_pattern =
+            SymbolicSparseColMat::new_checked(ni, ni, interior_ptr, None, interior_rows);
         let (mut fwd, mut inv) = (vec![0usize; ni], vec![0usize; ni]);
         let mut buffer = MemBuffer::try_new(amd::order_scratch::<usize>(
             ni,
@@ -230,16 +234,16 @@ impl InterfaceFactorization {
         for (p, &e) in order.iter().enumerate() {
             position[e] = p;
         }
-        let full = SymbolicSparseColMat::new_checked(
-            n,
-            n,
-            pattern.col_ptr.clone(),
-            None,
-            pattern.row_idx.clone(),
-        );
+        let diagonal: Vec<usize> = (0..n)
+            .map(|e| {
+                let rows = &row_idx[col_ptr[e]..col_ptr[e + 1]];
+                col_ptr[e] + rows.binary_search(&e).expect("diagonal entry in pattern")
+            })
+            .collect();
+        let block_pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         let perm = PermRef::new_checked(&order, &position, n);
         let symbolic = factorize_symbolic_cholesky(
-            full.as_ref(),
+            block_pattern.as_ref(),
             Side::Lower,
             SymmetricOrdering::Custom(perm),
             CholeskySymbolicParams {
@@ -248,21 +252,16 @@ impl InterfaceFactorization {
             },
         )
         .map_err(|e| Error::NotConverged(format!("symbolic LDLT failed: {e:?}")))?;
-        let diagonal = (0..n).map(|e| pattern.slot(e, e)).collect();
-        Ok(InterfaceFactorization {
+        Ok(Block {
+            first,
             n,
+            entries,
             interface,
-            rows: interface_rows,
-            row_scale,
             position,
             symbolic,
-            pattern: full,
+            pattern: block_pattern,
             diagonal,
             numeric: None,
-            factor_s: Cell::new(0.0),
-            symbolic_s: t.elapsed().as_secs_f64(),
-            factorizations: 0,
-            solves: Cell::new(0),
         })
     }
 
@@ -273,24 +272,10 @@ impl InterfaceFactorization {
         }
     }
 
-    /// Factorize the symmetric positive (semi)definite stiffness whose lower triangle is
-    /// `values` (pattern order; overwritten: scaled and shifted). `shift` is sigma, the
-    /// stiffness scale (force/length) added on the interface diagonal.
-    ///
-    /// With `single_precision_solves`, the sparse substitutions read L rounded to f32
-    /// (arithmetic in f64, the interface's dense blocks in f64): a solve reads the factor
-    /// once and is bound by memory, so it costs about half (measured: see the module). The
-    /// solve is then exact for a matrix within about 1e-7 cond(K) of K: for a
-    /// preconditioner of GMRES that already corrects a tangent 10% away from the factored
-    /// one (viscoplastic bodies) the rounding changes nothing; an elastic problem, where
-    /// the solve is the answer, keeps f64.
-    pub fn factor(
-        &mut self,
-        values: &mut [f64],
-        shift: f64,
-        single_precision_solves: bool,
-    ) -> Result<()> {
-        let t = Instant::now();
+    /// Factorize the block whose lower-triangle values are `values` (overwritten) and
+    /// return its Schur complement onto its interface (see
+    /// [`InterfaceFactorization::factor`]).
+    fn factor(&mut self, values: &mut [f64], shift: f64, single: bool) -> Result<Mat<f64>> {
         for &e in &self.interface {
             values[self.diagonal[e]] += shift;
         }
@@ -358,7 +343,7 @@ impl InterfaceFactorization {
                 inverse_diagonal[start + j] = 1.0 / values[j * rows + j];
             }
         }
-        let single = single_precision_solves.then(|| l_values.iter().map(|&v| v as f32).collect());
+        let single = single.then(|| l_values.iter().map(|&v| v as f32).collect());
         self.numeric = Some(Numeric {
             single,
             inverse_diagonal,
@@ -366,12 +351,8 @@ impl InterfaceFactorization {
             scaling,
             l_interface,
             d_interface,
-            schur,
         });
-        self.factorizations += 1;
-        self.factor_s
-            .set(self.factor_s.get() + t.elapsed().as_secs_f64());
-        Ok(())
+        Ok(schur)
     }
 
     /// The trailing b x b blocks of L (unit lower triangular) and D, read from the
@@ -409,6 +390,170 @@ impl InterfaceFactorization {
         (l, d)
     }
 
+    /// Forward substitution of the block's load `f` (local equations): the substituted
+    /// vector and what the block's interface sees of the load.
+    fn condense(&self, f: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let numeric = self.numeric.as_ref().expect("factor before solve");
+        let (n, b) = (self.n, self.interface.len());
+        let mut y = vec![0.0; n];
+        for (e, &p) in self.position.iter().enumerate() {
+            y[p] = numeric.scaling[e] * f[e];
+        }
+        self.forward(numeric, &mut y);
+        // The condensed load W_I^{-1} L_II y_I.
+        let first = n - b;
+        let mut load = vec![0.0; b];
+        for j in 0..b {
+            let yj = y[first + j];
+            if yj != 0.0 {
+                for i in j..b {
+                    load[i] += numeric.l_interface[(i, j)] * yj;
+                }
+            }
+        }
+        for (i, &e) in self.interface.iter().enumerate() {
+            load[i] /= numeric.scaling[e];
+        }
+        (y, load)
+    }
+
+    /// The block's displacement (local equations) whose interface values are
+    /// `x_interface`, from its forward substitution `y`.
+    fn expand(&self, mut y: Vec<f64>, x_interface: &[f64]) -> Vec<f64> {
+        let numeric = self.numeric.as_ref().expect("factor before solve");
+        let (n, b) = (self.n, self.interface.len());
+        let first = n - b;
+        let scaled: Vec<f64> = (0..b)
+            .map(|i| x_interface[i] / numeric.scaling[self.interface[i]])
+            .collect();
+        for j in 0..b {
+            let s: f64 = (j..b)
+                .map(|i| numeric.l_interface[(i, j)] * scaled[i])
+                .sum();
+            y[first + j] = numeric.d_interface[j] * s;
+        }
+        self.diagonal_and_back(numeric, &mut y);
+        let mut x = vec![0.0; n];
+        for (e, &p) in self.position.iter().enumerate() {
+            x[e] = numeric.scaling[e] * y[p];
+        }
+        x
+    }
+}
+
+impl InterfaceFactorization {
+    /// Order the stiffness with pattern `pattern` (n x n, both triangles) with the interface
+    /// of `rows` (contact rows as (equation, coefficient)) last in each of its diagonal
+    /// blocks, and analyze the blocks (on rayon's threads).
+    pub fn new(pattern: &Pattern, rows: &[Vec<(usize, f64)>]) -> Result<Self> {
+        let t = Instant::now();
+        let n = pattern.n;
+        let mut on_interface = vec![false; n];
+        for row in rows {
+            for &(eq, _) in row {
+                on_interface[eq] = true;
+            }
+        }
+        let blocks: Vec<Block> = pattern
+            .diagonal_blocks()
+            .into_par_iter()
+            .map(|range| Block::new(pattern, range, &on_interface))
+            .collect::<Result<_>>()?;
+        let interface: Vec<usize> = blocks
+            .iter()
+            .flat_map(|b| b.interface.iter().map(move |&e| b.first + e))
+            .collect();
+        let mut local = vec![usize::MAX; n];
+        for (l, &e) in interface.iter().enumerate() {
+            local[e] = l;
+        }
+        let interface_rows: Vec<InterfaceRow> = rows
+            .iter()
+            .map(|r| r.iter().map(|&(eq, v)| (local[eq], eq, v)).collect())
+            .collect();
+        let row_scale = rows
+            .iter()
+            .map(|r| {
+                let norm = r.iter().map(|&(_, v)| v * v).sum::<f64>().sqrt();
+                if norm > 0.0 { 1.0 / norm } else { 1.0 }
+            })
+            .collect();
+        Ok(InterfaceFactorization {
+            n,
+            interface,
+            rows: interface_rows,
+            row_scale,
+            blocks,
+            schur: None,
+            factor_s: Cell::new(0.0),
+            symbolic_s: t.elapsed().as_secs_f64(),
+            factorizations: 0,
+            solves: Cell::new(0),
+        })
+    }
+
+    /// The diagonal blocks' sizes (equations), in order.
+    pub fn block_sizes(&self) -> Vec<usize> {
+        self.blocks.iter().map(|b| b.n).collect()
+    }
+
+    /// Entries of the factor L (all blocks).
+    pub fn factor_entries(&self) -> usize {
+        self.blocks.iter().map(|b| b.symbolic.len_val()).sum()
+    }
+
+    /// Factorize the symmetric positive (semi)definite stiffness whose lower triangle is
+    /// `values` (pattern order; overwritten: scaled and shifted). `shift` is sigma, the
+    /// stiffness scale (force/length) added on the interface diagonal. The blocks are
+    /// factorized on rayon's threads.
+    ///
+    /// With `single_precision_solves`, the sparse substitutions read L rounded to f32
+    /// (arithmetic in f64, the interface's dense blocks in f64): a solve reads the factor
+    /// once and is bound by memory, so it costs about half (measured: see the module). The
+    /// solve is then exact for a matrix within about 1e-7 cond(K) of K: for a
+    /// preconditioner of GMRES that already corrects a tangent 10% away from the factored
+    /// one (viscoplastic bodies) the rounding changes nothing; an elastic problem, where
+    /// the solve is the answer, keeps f64.
+    pub fn factor(
+        &mut self,
+        values: &mut [f64],
+        shift: f64,
+        single_precision_solves: bool,
+    ) -> Result<()> {
+        let t = Instant::now();
+        let mut slices: Vec<&mut [f64]> = Vec::with_capacity(self.blocks.len());
+        let mut rest = values;
+        let mut taken = 0;
+        for block in &self.blocks {
+            let (head, tail) = rest.split_at_mut(block.entries.end - taken);
+            slices.push(&mut head[block.entries.start - taken..]);
+            taken = block.entries.end;
+            rest = tail;
+        }
+        let schurs: Vec<Mat<f64>> = self
+            .blocks
+            .par_iter_mut()
+            .zip(slices)
+            .map(|(block, v)| block.factor(v, shift, single_precision_solves))
+            .collect::<Result<_>>()?;
+        let b = self.interface.len();
+        let mut schur = Mat::zeros(b, b);
+        let mut offset = 0;
+        for s in &schurs {
+            for j in 0..s.ncols() {
+                for i in 0..s.nrows() {
+                    schur[(offset + i, offset + j)] = s[(i, j)];
+                }
+            }
+            offset += s.nrows();
+        }
+        self.schur = Some(schur);
+        self.factorizations += 1;
+        self.factor_s
+            .set(self.factor_s.get() + t.elapsed().as_secs_f64());
+        Ok(())
+    }
+
     /// Factorize the dense interface system of the active set `active` (c: the scale of
     /// the contact rows, force/length).
     pub fn active_set(&mut self, active: &[bool], c: f64) -> Result<ActiveSet> {
@@ -434,13 +579,13 @@ impl InterfaceFactorization {
     /// LU of the saddle-point matrix `[S + r I, c C_A^T s; s c C_A, 0]` of the rows `rows`
     /// (s: the rows' scales, r: the regularization).
     fn saddle_point_lu(&self, rows: &[usize], c: f64, regularization: f64) -> PartialPivLu<f64> {
-        let numeric = self.numeric.as_ref().expect("factor before active_set");
+        let schur = self.schur.as_ref().expect("factor before active_set");
         let b = self.interface.len();
         let size = b + rows.len();
         let mut a = Mat::<f64>::zeros(size, size);
         for j in 0..b {
             for i in 0..b {
-                a[(i, j)] = numeric.schur[(i, j)];
+                a[(i, j)] = schur[(i, j)];
             }
             a[(j, j)] += regularization;
         }
@@ -465,29 +610,20 @@ impl InterfaceFactorization {
         f.copy_from_slice(&self.expand(condensed, &x_interface));
     }
 
-    /// Forward substitution of the load `f` (n): what the interface sees of it.
+    /// Forward substitution of the load `f` (n): what the interface sees of it (the
+    /// blocks on rayon's threads).
     pub fn condense(&self, f: &[f64]) -> Condensed {
-        let numeric = self.numeric.as_ref().expect("factor before solve");
         self.solves.set(self.solves.get() + 1);
-        let (n, b) = (self.n, self.interface.len());
-        let mut y = vec![0.0; n];
-        for (e, &p) in self.position.iter().enumerate() {
-            y[p] = numeric.scaling[e] * f[e];
-        }
-        self.forward(numeric, &mut y);
-        // The condensed load W_I^{-1} L_II y_I.
-        let first = n - b;
-        let mut load = vec![0.0; b];
-        for j in 0..b {
-            let yj = y[first + j];
-            if yj != 0.0 {
-                for i in j..b {
-                    load[i] += numeric.l_interface[(i, j)] * yj;
-                }
-            }
-        }
-        for (i, &e) in self.interface.iter().enumerate() {
-            load[i] /= numeric.scaling[e];
+        let parts: Vec<(Vec<f64>, Vec<f64>)> = self
+            .blocks
+            .par_iter()
+            .map(|b| b.condense(&f[b.first..b.first + b.n]))
+            .collect();
+        let mut load = Vec::with_capacity(self.interface.len());
+        let mut y = Vec::with_capacity(parts.len());
+        for (yb, lb) in parts {
+            y.push(yb);
+            load.extend(lb);
         }
         Condensed { y, load }
     }
@@ -529,28 +665,23 @@ impl InterfaceFactorization {
     }
 
     /// The displacement (n) whose interface values are `x_interface`, from the forward
-    /// substitution `condensed`: the trailing values that lead to x_I, D L_II^T W_I^{-1}
-    /// x_I, then the back substitution.
+    /// substitution `condensed`: per block, the trailing values that lead to x_I, D L_II^T
+    /// W_I^{-1} x_I, then the back substitution (the blocks on rayon's threads).
     pub fn expand(&self, condensed: Condensed, x_interface: &[f64]) -> Vec<f64> {
-        let numeric = self.numeric.as_ref().expect("factor before solve");
-        let (n, b) = (self.n, self.interface.len());
-        let first = n - b;
-        let mut y = condensed.y;
-        let scaled: Vec<f64> = (0..b)
-            .map(|i| x_interface[i] / numeric.scaling[self.interface[i]])
+        let mut offsets = Vec::with_capacity(self.blocks.len());
+        let mut offset = 0;
+        for b in &self.blocks {
+            offsets.push(offset);
+            offset += b.interface.len();
+        }
+        let parts: Vec<Vec<f64>> = self
+            .blocks
+            .par_iter()
+            .zip(condensed.y)
+            .zip(offsets)
+            .map(|((b, y), o)| b.expand(y, &x_interface[o..o + b.interface.len()]))
             .collect();
-        for j in 0..b {
-            let s: f64 = (j..b)
-                .map(|i| numeric.l_interface[(i, j)] * scaled[i])
-                .sum();
-            y[first + j] = numeric.d_interface[j] * s;
-        }
-        self.diagonal_and_back(numeric, &mut y);
-        let mut x = vec![0.0; n];
-        for (e, &p) in self.position.iter().enumerate() {
-            x[e] = numeric.scaling[e] * y[p];
-        }
-        x
+        parts.concat()
     }
 
     /// C_i x restricted to the interface (`x_interface`: b values).
@@ -560,7 +691,9 @@ impl InterfaceFactorization {
             .map(|&(l, _, v)| v * x_interface[l])
             .sum()
     }
+}
 
+impl Block {
     /// The supernodes as (first column, width, off-diagonal row indices, values: the
     /// columns of the width x width diagonal block and the off-diagonal rows, column-major).
     fn supernodes<'v, T>(

@@ -18,6 +18,7 @@ use crate::error::{Error, Result};
 use crate::fe::{FIXED, Pattern};
 use crate::material::Stress;
 use nalgebra::Matrix3;
+use rayon::prelude::*;
 use std::cell::Cell;
 
 /// Newton solver state (pattern, slots, factorization) for one problem.
@@ -185,19 +186,30 @@ pub fn floor_time(p: &Problem, steps: usize) -> Result<f64> {
     let model = &p.model;
     let n = model.n_free;
     let (pattern, slots) = model.stiffness_pattern(&[], n);
-    let mut system = SparseSystem::new(&pattern);
-    let vals = system.values_mut();
-    model.add_tangent(&model.elastic_tangents(), &slots, vals);
+    let mut values = vec![0.0; pattern.nnz()];
+    model.add_tangent(&model.elastic_tangents(), &slots, &mut values);
     let diagonal: Vec<usize> = (0..n).map(|i| pattern.slot(i, i)).collect();
-    let shift = FLOOR_SHIFT * diagonal.iter().map(|&s| vals[s]).sum::<f64>() / n.max(1) as f64;
+    let shift = FLOOR_SHIFT * diagonal.iter().map(|&s| values[s]).sum::<f64>() / n.max(1) as f64;
     for &s in &diagonal {
-        vals[s] += shift;
+        values[s] += shift;
     }
-    system.factor_llt()?;
-    let mut rhs = vec![1.0; n];
-    for _ in 0..steps {
-        system.solve(&mut rhs);
-    }
+    // The stiffness is block diagonal (one block per body): the best the machine can do
+    // factorizes the blocks apart, on rayon's threads, as the solver does.
+    pattern
+        .diagonal_blocks()
+        .into_par_iter()
+        .map(|range| {
+            let (block, entries) = pattern.block(&range);
+            let mut system = SparseSystem::new(&block);
+            system.values_mut().copy_from_slice(&values[entries]);
+            system.factor_llt()?;
+            let mut rhs = vec![1.0; range.len()];
+            for _ in 0..steps {
+                system.solve(&mut rhs);
+            }
+            Ok(())
+        })
+        .collect::<Result<()>>()?;
     Ok(t0.elapsed().as_secs_f64())
 }
 
