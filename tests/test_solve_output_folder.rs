@@ -303,3 +303,62 @@ fn scene_list_names_every_built_in_scene() {
         "{err}"
     );
 }
+
+/// A live run's staging folder is locked: another run into the same folder (here one that
+/// fails on its input) leaves it alone and prints no note, whatever the process ids say.
+#[test]
+fn a_live_runs_staging_folder_is_left_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let mut child = Command::new(BIN)
+        .args([
+            "solve", "--scene", "rates", "--level", "4", "--steps", "400",
+        ])
+        .args(["--out", out.to_str().unwrap()])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let staging = dir.path().join(format!(".out.staging-{}", child.id()));
+    let t = std::time::Instant::now();
+    while !staging.join("solution_0001.vtu").exists() {
+        assert!(t.elapsed().as_secs() < 300, "no step file after 300 s");
+        assert!(child.try_wait().unwrap().is_none(), "the run ended first");
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    let o = solve("rates", &["--set", "h_upper=0"], &out);
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    let alive = child.try_wait().unwrap().is_none();
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(alive, "the long run was still running during the check");
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(!err.contains("note: removed"), "{err}");
+    assert!(
+        staging.exists(),
+        "the live run's staging folder is still there"
+    );
+}
+
+/// `--out .` names no folder of its own and is refused before anything is computed; a
+/// failed run removes the folders it created above `--out`.
+#[test]
+fn out_must_name_a_folder_and_failed_runs_leave_no_parents() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = Command::new(BIN)
+        .args(["solve", "--scene", "patch", "--out", "."])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("names no folder of its own"), "{err}");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    let deep = dir.path().join("missing").join("deeper").join("out");
+    let o = solve("rates", &["--set", "h_upper=0"], &deep);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        !dir.path().join("missing").exists(),
+        "created parents removed"
+    );
+}

@@ -2,7 +2,10 @@
 //! into a staging sibling `.NAME.staging-PID`, which replaces NAME only once the run has
 //! succeeded. A failed run removes its staging folder; a killed one leaves it, and the next
 //! run into the same folder removes it with a one-line note. The previous folder is never
-//! touched before the swap, so it survives any failure byte for byte.
+//! touched before the swap, so it survives any failure byte for byte. A running run holds an
+//! advisory lock (flock) on its staging folder, which the system releases when the process
+//! ends however it ends: a staging folder is stale exactly when its lock is free, whatever
+//! the process ids say (another PID namespace, another system).
 
 use crate::error::{Error, Result};
 use std::path::{Path, PathBuf};
@@ -46,6 +49,13 @@ const FIX: &str = "pass --out with a writable folder, or make this one writable"
 /// kind. Creates the parent, never `dir`. Also removes staging debris of killed runs (see
 /// [`Staging`]), returning one note per folder removed.
 pub fn check_writable(dir: &Path, kind: Output) -> Result<Vec<String>> {
+    if dir.file_name().is_none() {
+        return Err(Error::input(
+            dir,
+            kind.what(),
+            "names no folder of its own (it is replaced whole); pass --out with a new folder's name, e.g. out",
+        ));
+    }
     let parent = parent(dir);
     std::fs::create_dir_all(&parent).map_err(|e| {
         Error::input(
@@ -66,6 +76,20 @@ pub fn check_writable(dir: &Path, kind: Output) -> Result<Vec<String>> {
             .map_err(|e| Error::io(dir, e))?
             .next()
             .is_none();
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::MetadataExt;
+            let (here, above) = (std::fs::metadata(dir), std::fs::metadata(&parent));
+            if let (Ok(here), Ok(above)) = (here, above)
+                && here.dev() != above.dev()
+            {
+                return Err(Error::input(
+                    dir,
+                    kind.what(),
+                    "is a mount point, which cannot be replaced; pass --out with a folder inside it",
+                ));
+            }
+        }
         if !empty && !dir.join(kind.signature()).exists() {
             return Err(Error::input(
                 dir,
@@ -95,12 +119,22 @@ pub struct Staging {
     target: PathBuf,
     path: PathBuf,
     committed: bool,
+    /// The open staging folder, locked while this run lives (see the module).
+    _lock: Option<std::fs::File>,
+    /// The first folder above the target this run created, removed again (when empty)
+    /// if the run fails.
+    created: Option<PathBuf>,
 }
 
 impl Staging {
     /// Check `dir` as [`check_writable`] does and create its staging folder; the notes say
     /// which stale staging folders were removed.
     pub fn begin(dir: &Path, kind: Output) -> Result<(Staging, Vec<String>)> {
+        let created = parent(dir)
+            .ancestors()
+            .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
+            .last()
+            .map(Path::to_path_buf);
         let notes = check_writable(dir, kind)?;
         let path = sibling(dir, "staging", std::process::id());
         let _ = std::fs::remove_dir_all(&path);
@@ -111,10 +145,13 @@ impl Staging {
                 format!("cannot write here ({e}); {FIX}"),
             )
         })?;
+        let lock = std::fs::File::open(&path).ok().filter(try_lock);
         let staging = Staging {
             target: dir.to_path_buf(),
             path,
             committed: false,
+            _lock: lock,
+            created,
         };
         Ok((staging, notes))
     }
@@ -129,10 +166,15 @@ impl Staging {
     pub fn commit(mut self) -> Result<()> {
         let old = sibling(&self.target, "old", std::process::id());
         if self.target.exists() {
-            if !exchange(&self.path, &self.target) {
+            let exchanged =
+                exchange(&self.path, &self.target).map_err(|e| Error::io(&self.target, e))?;
+            if !exchanged {
                 std::fs::rename(&self.target, &old).map_err(|e| Error::io(&self.target, e))?;
-                std::fs::rename(&self.path, &self.target)
-                    .map_err(|e| Error::io(&self.target, e))?;
+                if let Err(e) = std::fs::rename(&self.path, &self.target) {
+                    // Put the previous output back: the target is never left missing.
+                    let _ = std::fs::rename(&old, &self.target);
+                    return Err(Error::io(&self.target, e));
+                }
                 self.committed = true;
                 let _ = std::fs::remove_dir_all(&old);
                 return Ok(());
@@ -151,6 +193,14 @@ impl Drop for Staging {
     fn drop(&mut self) {
         if !self.committed {
             let _ = std::fs::remove_dir_all(&self.path);
+            // The folders this run created above the target, if they are still empty.
+            if let Some(top) = &self.created {
+                for folder in parent(&self.target).ancestors() {
+                    if std::fs::remove_dir(folder).is_err() || folder == top {
+                        break;
+                    }
+                }
+            }
         }
     }
 }
@@ -204,8 +254,12 @@ fn remove_stale(dir: &Path) -> Vec<String> {
             let rest = file.strip_prefix(&format!(".{name}."))?;
             let (role, pid) = rest.rsplit_once('-')?;
             let pid: u32 = pid.parse().ok()?;
-            (matches!(role, "staging" | "old") && !alive(pid))
-                .then(|| (role.to_string(), pid, e.path()))
+            let stale = match role {
+                "staging" => !held(&e.path()),
+                "old" => !alive(pid),
+                _ => false,
+            };
+            stale.then(|| (role.to_string(), pid, e.path()))
         })
         .collect();
     found.sort();
@@ -228,22 +282,45 @@ fn remove_stale(dir: &Path) -> Vec<String> {
     notes
 }
 
-/// Whether process `pid` runs (Linux: /proc; elsewhere every other process counts as gone,
-/// so its debris is removed).
+/// Whether process `pid` runs (Linux: /proc; elsewhere every other process counts as gone).
+/// Only for the previous output a run set aside while swapping without an atomic exchange.
 fn alive(pid: u32) -> bool {
     pid == std::process::id() || Path::new(&format!("/proc/{pid}")).exists()
 }
 
-/// Exchange two paths atomically (Linux renameat2 RENAME_EXCHANGE); false where the system
-/// or the file system cannot.
+/// Whether a live run holds the lock of the staging folder `path` (a folder that cannot be
+/// opened counts as held: it is left alone).
+fn held(path: &Path) -> bool {
+    match std::fs::File::open(path) {
+        Ok(file) => !try_lock(&file),
+        Err(_) => true,
+    }
+}
+
+/// Take an exclusive advisory lock on `file` without waiting (released when the file is
+/// closed, or the process ends).
+#[cfg(unix)]
+fn try_lock(file: &std::fs::File) -> bool {
+    use std::os::unix::io::AsRawFd;
+    // SAFETY: flock on a file descriptor this File owns.
+    unsafe { libc::flock(file.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) == 0 }
+}
+
+#[cfg(not(unix))]
+fn try_lock(_: &std::fs::File) -> bool {
+    true
+}
+
+/// Exchange two paths atomically (Linux renameat2 RENAME_EXCHANGE): Ok(false) where the
+/// system or the file system has no such call, the error of any other failure.
 #[cfg(target_os = "linux")]
-fn exchange(a: &Path, b: &Path) -> bool {
+fn exchange(a: &Path, b: &Path) -> std::io::Result<bool> {
     use std::os::unix::ffi::OsStrExt;
     let (Ok(a), Ok(b)) = (
         std::ffi::CString::new(a.as_os_str().as_bytes()),
         std::ffi::CString::new(b.as_os_str().as_bytes()),
     ) else {
-        return false;
+        return Ok(false);
     };
     // SAFETY: both are valid NUL-terminated paths; renameat2 only reads them.
     let rc = unsafe {
@@ -255,10 +332,17 @@ fn exchange(a: &Path, b: &Path) -> bool {
             libc::RENAME_EXCHANGE,
         )
     };
-    rc == 0
+    if rc == 0 {
+        return Ok(true);
+    }
+    let e = std::io::Error::last_os_error();
+    match e.raw_os_error() {
+        Some(libc::EINVAL) | Some(libc::ENOSYS) | Some(libc::EOPNOTSUPP) => Ok(false),
+        _ => Err(e),
+    }
 }
 
 #[cfg(not(target_os = "linux"))]
-fn exchange(_: &Path, _: &Path) -> bool {
-    false
+fn exchange(_: &Path, _: &Path) -> std::io::Result<bool> {
+    Ok(false)
 }
