@@ -470,6 +470,9 @@ struct SpeedLine {
     dofs: usize,
     ratio_to_floor: f64,
     family: String,
+    /// Threads of the solver and the floor (absent in reports before threads were used).
+    #[serde(default)]
+    threads: Option<usize>,
 }
 
 /// One row of reports/stability/stability.csv (the columns read here).
@@ -505,6 +508,10 @@ fn speed_and_stability(reports: &Path, s: &mut String) -> Result<()> {
         })
         .collect();
     let top = speed.iter().map(|r| r.dofs).max().unwrap_or(0);
+    let threads = match speed.first().and_then(|r| r.threads) {
+        Some(t) => format!(" ({t} threads, the solver and the floor alike)"),
+        None => String::new(),
+    };
     let _ = writeln!(
         s,
         "### [`paper`](reports/paper/README.md): the paper's three tests regenerated\n\n- Every figure of its section 5 and the numbers behind its words (no rates: one mesh per test).\n"
@@ -513,7 +520,7 @@ fn speed_and_stability(reports: &Path, s: &mut String) -> Result<()> {
         s,
         "### [`speed`](reports/speed/README.md): cost against the floor (one Cholesky of the stiffness)
 
-- newton's (set-up + time loop) / floor from 1e4 to {top} dofs: {}.
+- newton's (set-up + time loop) / floor from 1e4 to {top} dofs{threads}: {}.
 ",
         ranges.join(", ")
     );

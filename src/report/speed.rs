@@ -43,10 +43,16 @@ struct SpeedCsv {
     peak_rss_gib: Option<f64>,
     /// viscoplastic (`rates`) or elastic (`rates-elastic`).
     family: &'static str,
+    /// Threads of the solver and the floor.
+    threads: usize,
+    /// The same run's set-up + time loop on one thread (largest level; s).
+    one_thread_s: Option<f64>,
+    /// The floor on one thread (largest level; s).
+    one_thread_floor_s: Option<f64>,
 }
 
 impl SpeedCsv {
-    fn new(r: &SpeedRun) -> Self {
+    fn new(r: &SpeedRun, threads: usize) -> Self {
         let run = &r.run;
         let t = &run.timings;
         SpeedCsv {
@@ -70,6 +76,9 @@ impl SpeedCsv {
             error: r.error,
             peak_rss_gib: run.peak_rss_gib,
             family: r.family.label,
+            threads,
+            one_thread_s: r.one_thread.map(|o| o.0),
+            one_thread_floor_s: r.one_thread.map(|o| o.1),
         }
     }
 }
@@ -129,7 +138,11 @@ const COMBOS: [(Method, SolverKind, usize); 4] = [
 /// Write the report of `study speed`.
 pub fn write_speed(res: &SpeedResult, dir: &Path) -> Result<()> {
     write_folder(dir, |d| {
-        let rows: Vec<SpeedCsv> = res.rows.iter().map(SpeedCsv::new).collect();
+        let rows: Vec<SpeedCsv> = res
+            .rows
+            .iter()
+            .map(|r| SpeedCsv::new(r, res.threads))
+            .collect();
         write(d, "speed.csv", &csv_bytes(&rows)?)?;
         work_precision(res, d)?;
         time_vs_dofs(res, d)?;
@@ -242,6 +255,38 @@ fn readme(res: &SpeedResult) -> String {
                     floor_of(last)
                 );
             }
+        }
+    }
+    let _ = writeln!(
+        s,
+        "\nThreads: {} (rayon's pool; `RAYON_NUM_THREADS` sets it), the same for the solver and the floor. The stiffness is block diagonal, one block per body (they meet only through the contact rows): both sides factorize the blocks apart and side by side, the floor each with faer's AMD ordering, newton each with AMD on the block's interior and its contact-interface unknowns last; their substitutions run side by side too.\n",
+        res.threads
+    );
+    let one: Vec<&SpeedRun> = res.rows.iter().filter(|r| r.one_thread.is_some()).collect();
+    if !one.is_empty() {
+        let _ = writeln!(
+            s,
+            "| family | cone | dofs | newton, 1 thread (s) | newton, {n} threads (s) | speed-up | floor, 1 thread (s) | floor, {n} threads (s) | speed-up | newton / floor, 1 thread | newton / floor, {n} threads |\n|---|---|---|---|---|---|---|---|---|---|---|",
+            n = res.threads
+        );
+        for r in one {
+            let (one_s, one_floor) = r.one_thread.expect("filtered");
+            let all_s = r.run.time_loop_s + r.run.timings.setup_s;
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {:.1} | {:.1} | {:.2} | {:.1} | {:.1} | {:.2} | {:.2} | {:.2} |",
+                r.family.label,
+                r.run.method,
+                r.run.dofs,
+                one_s,
+                all_s,
+                one_s / all_s,
+                one_floor,
+                floor_of(r),
+                one_floor / floor_of(r),
+                one_s / one_floor,
+                ratio(r)
+            );
         }
     }
     let _ = writeln!(

@@ -25,6 +25,9 @@ pub struct SpeedRun {
     pub error: Option<f64>,
     /// The mesh family: scene and gmsh sizes.
     pub family: &'static Family,
+    /// At the largest level, with more than one thread: the same run and floor on one
+    /// thread, (set-up + time loop, floor) in s.
+    pub one_thread: Option<(f64, f64)>,
 }
 
 /// A family of meshes: a scene and its level-0 sizes, refined level by level.
@@ -62,6 +65,9 @@ pub struct SpeedResult {
     pub reference_dofs: usize,
     /// Total wall time (s).
     pub wall_s: f64,
+    /// Threads of rayon's pool (RAYON_NUM_THREADS, or the machine's cores), used alike by
+    /// the solver and the floor.
+    pub threads: usize,
 }
 
 /// Levels at which newton is timed (level 7: 2,196,480 dofs).
@@ -132,6 +138,7 @@ fn sizes(family: &Family, matching: bool) -> Vec<(String, f64)> {
 /// matching-mesh reference.
 pub fn run() -> Result<SpeedResult> {
     let t0 = std::time::Instant::now();
+    let threads = rayon::current_num_threads();
     // Timings first, on a quiet heap (the reference is solved afterwards); the solutions
     // of the levels that get an error are kept until the reference exists.
     let mut rows = Vec::new();
@@ -153,11 +160,28 @@ pub fn run() -> Result<SpeedResult> {
                         _ => 1,
                     };
                     let (sol, floor_s, peak) = timed_runs(&case, kind, repeats)?;
+                    let largest = level == *NEWTON_LEVELS.iter().max().unwrap();
+                    let one_thread = match threads > 1 && largest && kind == SolverKind::Newton {
+                        true => {
+                            let pool = rayon::ThreadPoolBuilder::new()
+                                .num_threads(1)
+                                .build()
+                                .map_err(|e| {
+                                    crate::Error::NotConverged(format!("thread pool: {e}"))
+                                })?;
+                            release_free_heap();
+                            let (one, floor_one, _) =
+                                pool.install(|| timed_runs(&case, kind, 1))?;
+                            Some((one.wall_s + one.timings.setup_s, floor_one))
+                        }
+                        false => None,
+                    };
                     rows.push(SpeedRun {
                         run: RunSummary::new(&case, kind, &sol, Some(floor_s), peak),
                         repeats,
                         error: None,
                         family,
+                        one_thread,
                     });
                     // Errors only where the reference is at least 3 levels finer.
                     if viscoplastic && level + 3 <= REFERENCE_LEVEL {
@@ -182,5 +206,6 @@ pub fn run() -> Result<SpeedResult> {
         rows,
         reference_dofs: rcase.problem.model.n_free,
         wall_s: t0.elapsed().as_secs_f64(),
+        threads,
     })
 }
