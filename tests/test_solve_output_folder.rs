@@ -62,6 +62,32 @@ fn debris(dir: &Path) -> Vec<PathBuf> {
         .collect()
 }
 
+/// Start `solve --scene rates --level 4 --steps STEPS --out OUT` and wait until its first
+/// step file exists in its staging folder; the child and the staging folder.
+fn start_and_wait_for_a_step(out: &Path, steps: &str) -> (std::process::Child, PathBuf) {
+    let mut child = Command::new(BIN)
+        .args([
+            "solve", "--scene", "rates", "--level", "4", "--steps", steps,
+        ])
+        .args(["--out", out.to_str().unwrap()])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let name = out.file_name().unwrap().to_string_lossy();
+    let staging = out
+        .parent()
+        .unwrap()
+        .join(format!(".{name}.staging-{}", child.id()));
+    let t = std::time::Instant::now();
+    while !staging.join("solution_0001.vtu").exists() {
+        assert!(t.elapsed().as_secs() < 300, "no step file after 300 s");
+        assert!(child.try_wait().unwrap().is_none(), "the run ended first");
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    (child, staging)
+}
+
 /// A `solve` killed with SIGKILL right after its first step file appears leaves the previous
 /// output byte for byte; the next run removes the killed run's staging folder with a note.
 #[test]
@@ -76,21 +102,7 @@ fn a_killed_solve_leaves_the_previous_folder_byte_for_byte() {
         "3 steps, solution.vtu, pvd, 2 CSVs"
     );
 
-    let mut child = Command::new(BIN)
-        .args(["solve", "--scene", "rates", "--level", "4", "--steps", "40"])
-        .args(["--out", out.to_str().unwrap()])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let staging = dir.path().join(format!(".out.staging-{}", child.id()));
-    let first = staging.join("solution_0001.vtu");
-    let t = std::time::Instant::now();
-    while !first.exists() {
-        assert!(t.elapsed().as_secs() < 300, "no step file after 300 s");
-        assert!(child.try_wait().unwrap().is_none(), "the run ended first");
-        std::thread::sleep(std::time::Duration::from_millis(2));
-    }
+    let (mut child, staging) = start_and_wait_for_a_step(&out, "40");
     child.kill().unwrap();
     let status = child.wait().unwrap();
     assert_eq!(status.signal(), Some(9), "killed mid-run: {status:?}");
@@ -310,22 +322,7 @@ fn scene_list_names_every_built_in_scene() {
 fn a_live_runs_staging_folder_is_left_alone() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    let mut child = Command::new(BIN)
-        .args([
-            "solve", "--scene", "rates", "--level", "4", "--steps", "400",
-        ])
-        .args(["--out", out.to_str().unwrap()])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let staging = dir.path().join(format!(".out.staging-{}", child.id()));
-    let t = std::time::Instant::now();
-    while !staging.join("solution_0001.vtu").exists() {
-        assert!(t.elapsed().as_secs() < 300, "no step file after 300 s");
-        assert!(child.try_wait().unwrap().is_none(), "the run ended first");
-        std::thread::sleep(std::time::Duration::from_millis(2));
-    }
+    let (mut child, staging) = start_and_wait_for_a_step(&out, "400");
     let o = solve("rates", &["--set", "h_upper=0"], &out);
     let err = String::from_utf8_lossy(&o.stderr).to_string();
     let alive = child.try_wait().unwrap().is_none();
