@@ -710,6 +710,22 @@ impl Model {
     }
 }
 
+/// `values` cut into the disjoint, increasing `ranges` (mutable slices, in order): the
+/// diagonal blocks' parts of a vector or of a pattern's values, for one thread each.
+pub fn split_ranges_mut<'a>(
+    values: &'a mut [f64],
+    ranges: impl IntoIterator<Item = std::ops::Range<usize>>,
+) -> Vec<&'a mut [f64]> {
+    let (mut rest, mut taken, mut parts) = (values, 0, Vec::new());
+    for r in ranges {
+        let (head, tail) = rest.split_at_mut(r.end - taken);
+        parts.push(&mut head[r.start - taken..]);
+        taken = r.end;
+        rest = tail;
+    }
+    parts
+}
+
 /// Triangles from which the constitutive update and the internal force run on rayon's
 /// threads.
 pub const PARALLEL_ELEMENTS: usize = 50_000;

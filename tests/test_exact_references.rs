@@ -33,22 +33,7 @@ fn quick_exact_study_meets_the_thresholds_and_its_quadrature_is_converged() {
     let res = study::run("rates-exact-quick").unwrap();
     assert!(res.reference.is_none(), "no reference solve");
     for r in res.rates.iter().filter(|r| r.quantity == Quantity::Theorem) {
-        println!(
-            "{}: rate {:.3} +- {:.3} over {:?}",
-            r.method,
-            r.rate(),
-            r.stderr(),
-            r.assessment.used
-        );
-        assert_eq!(r.assessment.used, vec![0, 1, 2]);
-        assert_eq!(
-            r.pass,
-            Some(true),
-            "{} rate {} below {:?}",
-            r.method,
-            r.rate(),
-            r.threshold
-        );
+        common::assert_rate_passes(r, &[0, 1, 2]);
     }
     // The same study with twice the Gauss points per direction (64 instead of 16 points per
     // triangle): every error equal to the digits the report prints.

@@ -26,7 +26,7 @@
 //! apart, with the interface solve in between.
 
 use crate::error::{Error, Result};
-use crate::fe::Pattern;
+use crate::fe::{Pattern, split_ranges_mut};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::solvers::{PartialPivLu, SolveCore};
@@ -492,16 +492,6 @@ impl InterfaceFactorization {
         })
     }
 
-    /// The diagonal blocks' sizes (equations), in order.
-    pub fn block_sizes(&self) -> Vec<usize> {
-        self.blocks.iter().map(|b| b.n).collect()
-    }
-
-    /// Entries of the factor L (all blocks).
-    pub fn factor_entries(&self) -> usize {
-        self.blocks.iter().map(|b| b.symbolic.len_val()).sum()
-    }
-
     /// Factorize the symmetric positive (semi)definite stiffness whose lower triangle is
     /// `values` (pattern order; overwritten: scaled and shifted). `shift` is sigma, the
     /// stiffness scale (force/length) added on the interface diagonal. The blocks are
@@ -521,15 +511,7 @@ impl InterfaceFactorization {
         single_precision_solves: bool,
     ) -> Result<()> {
         let t = Instant::now();
-        let mut slices: Vec<&mut [f64]> = Vec::with_capacity(self.blocks.len());
-        let mut rest = values;
-        let mut taken = 0;
-        for block in &self.blocks {
-            let (head, tail) = rest.split_at_mut(block.entries.end - taken);
-            slices.push(&mut head[block.entries.start - taken..]);
-            taken = block.entries.end;
-            rest = tail;
-        }
+        let slices = split_ranges_mut(values, self.blocks.iter().map(|b| b.entries.clone()));
         let schurs: Vec<Mat<f64>> = self
             .blocks
             .par_iter_mut()

@@ -5,7 +5,7 @@
 //! [`super::interface`].
 
 use crate::error::{Error, Result};
-use crate::fe::Pattern;
+use crate::fe::{Pattern, split_ranges_mut};
 use faer::Side;
 use faer::sparse::linalg::solvers::{Llt, Lu, SymbolicLlt, SymbolicLu};
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
@@ -157,18 +157,11 @@ impl SparseSystem {
         };
         if self.blocks.len() > 1 && x.len() >= PARALLEL_EQUATIONS {
             // The blocks on rayon's threads: the same sums in the same order as one thread.
-            let mut parts: Vec<(std::ops::Range<usize>, &mut [f64])> = Vec::new();
-            let mut rest = y;
-            let mut taken = 0;
-            for b in &self.blocks {
-                let (head, tail) = rest.split_at_mut(b.end - taken);
-                parts.push((b.clone(), head));
-                taken = b.end;
-                rest = tail;
-            }
-            parts
-                .into_par_iter()
-                .for_each(|(columns, y_block)| product(columns, y_block));
+            let parts = split_ranges_mut(y, self.blocks.iter().cloned());
+            self.blocks
+                .par_iter()
+                .zip(parts)
+                .for_each(|(columns, y_block)| product(columns.clone(), y_block));
         } else {
             product(0..x.len(), y);
         }

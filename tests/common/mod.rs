@@ -38,3 +38,24 @@ pub fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
         .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
         / amax(a)
 }
+
+/// Print a fitted rate and assert that it was fitted over exactly `levels` and passed its
+/// threshold.
+pub fn assert_rate_passes(r: &contact_rates::study::RateRow, levels: &[usize]) {
+    println!(
+        "{}: rate {:.3} +- {:.3} over {:?}",
+        r.method,
+        r.rate(),
+        r.stderr(),
+        r.assessment.used
+    );
+    assert_eq!(r.assessment.used, levels);
+    assert_eq!(
+        r.pass,
+        Some(true),
+        "{} rate {} below {:?}",
+        r.method,
+        r.rate(),
+        r.threshold
+    );
+}
