@@ -152,6 +152,39 @@ fn ten_steps_then_four_leave_only_the_second_runs_files() {
     assert!(debris(&out).is_empty());
 }
 
+/// One thread (`RAYON_NUM_THREADS=1`: the steps are written on the solve's thread) and
+/// two (a writer thread beside the solve, the bodies' factorizations side by side) write
+/// the same folder byte for byte but summary.csv's timings; the console says where the
+/// files were written.
+#[test]
+fn one_thread_and_two_write_the_same_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut folders = Vec::new();
+    for threads in ["1", "2"] {
+        let out = dir.path().join(format!("out{threads}"));
+        let args = [
+            "solve", "--scene", "rates", "--level", "2", "--steps", "3", "--out",
+        ];
+        let mut all = args.to_vec();
+        all.push(out.to_str().unwrap());
+        let o = common::run(&all, &[("RAYON_NUM_THREADS", threads)]);
+        ok(&o);
+        let console =
+            String::from_utf8_lossy(&o.stdout).to_string() + &String::from_utf8_lossy(&o.stderr);
+        let place = if threads == "1" {
+            "on the solve's thread (RAYON_NUM_THREADS=1)"
+        } else {
+            "on a second thread"
+        };
+        assert!(console.contains(place), "{console}");
+        let mut files = snapshot(&out);
+        files.remove("summary.csv");
+        folders.push(files);
+    }
+    assert_eq!(folders[0].len(), 6);
+    assert!(folders[0] == folders[1], "the two folders differ");
+}
+
 /// A run refused after its staging folder exists (a size that is not positive is found
 /// while the case is built) leaves no folder where there was none, and the previous folder
 /// unchanged where there was one; no debris either way.

@@ -44,7 +44,8 @@ struct SummaryCsv<'a> {
     solver_setup_s: f64,
     floor_s: Option<f64>,
     ratio_to_floor: Option<f64>,
-    /// Building, compressing and writing the step files, on a second thread (s).
+    /// Building, compressing and writing the step files, on a second thread unless the
+    /// run has one (s).
     output_s: f64,
     /// Of that, the time the solve waited for it (s), part of `wall_s`.
     output_wait_s: f64,
@@ -118,33 +119,62 @@ impl<'a> Series<'a> {
 
     /// Run `solve`, giving it the observer that hands each due step to a writer thread (at
     /// most one step waits; the solve blocks when the writer falls behind). The writer
-    /// compresses on one core, the solve goes on on the other. An error of either stops
-    /// both and is returned (the writer's first).
+    /// compresses on one core, the solve goes on on the other. With one thread
+    /// (`RAYON_NUM_THREADS=1`, rayon's convention for the thread count, which the whole run
+    /// honours) the steps are written in turn on the solve's own thread. An error of either
+    /// stops both and is returned (the writer's first).
     pub fn write_during<T>(
         &mut self,
         solve: impl FnOnce(&mut dyn FnMut(usize, usize, &State) -> Result<()>) -> Result<T>,
     ) -> Result<T> {
         let (dir, model) = (self.dir, &self.problem.model);
+        // Build, compress and write one step file (and solution.vtu for the last); its bytes.
+        let write_step = |vtu: &mut Option<io::vtu::StateFile>, step: StepFile| -> Result<u64> {
+            let (name, last, state, nodes) = step;
+            let file = vtu
+                .get_or_insert_with(|| io::vtu::StateFile::new(model))
+                .file(&state, &nodes);
+            write(dir, &name, &file)?;
+            if last {
+                // The last step again, as a second name of the same file (a copy where the
+                // file system has no hard links).
+                let (step, last) = (dir.join(&name), dir.join("solution.vtu"));
+                if std::fs::hard_link(&step, &last).is_err() {
+                    write(dir, "solution.vtu", &file)?;
+                }
+            }
+            Ok(file.len() as u64)
+        };
+        if rayon::current_num_threads() == 1 {
+            let (mut vtu, mut bytes, mut seconds) = (None, 0u64, 0.0);
+            let solved = solve(&mut |n, steps, state| {
+                if n % self.every != 0 && n != steps {
+                    return Ok(());
+                }
+                let nodes = contact_nodes(self.problem, state);
+                self.record(state.time, &nodes, format!("solution_{n:04}.vtu"));
+                let t0 = std::time::Instant::now();
+                let name = self.written.last().unwrap().1.clone();
+                bytes += write_step(&mut vtu, (name, n == steps, state.clone(), nodes))?;
+                seconds += t0.elapsed().as_secs_f64();
+                Ok(())
+            })?;
+            self.output = Written {
+                files: self.written.len(),
+                bytes,
+                seconds,
+                waited_s: seconds,
+            };
+            return Ok(solved);
+        }
         std::thread::scope(|scope| {
             let (send, receive) = std::sync::mpsc::sync_channel::<StepFile>(1);
             let writer = scope.spawn(move || -> Result<(u64, f64)> {
                 let (mut bytes, mut seconds) = (0u64, 0.0);
                 let mut vtu: Option<io::vtu::StateFile> = None;
-                for (name, last, state, nodes) in receive {
+                for step in receive {
                     let t0 = std::time::Instant::now();
-                    let file = vtu
-                        .get_or_insert_with(|| io::vtu::StateFile::new(model))
-                        .file(&state, &nodes);
-                    write(dir, &name, &file)?;
-                    bytes += file.len() as u64;
-                    if last {
-                        // The last step again, as a second name of the same file (a copy
-                        // where the file system has no hard links).
-                        let (step, last) = (dir.join(&name), dir.join("solution.vtu"));
-                        if std::fs::hard_link(&step, &last).is_err() {
-                            write(dir, "solution.vtu", &file)?;
-                        }
-                    }
+                    bytes += write_step(&mut vtu, step)?;
                     seconds += t0.elapsed().as_secs_f64();
                 }
                 Ok((bytes, seconds))
@@ -291,10 +321,15 @@ pub fn console(run: &RunSummary, wall_s: f64, written: &Written, dir: &Path) -> 
     );
     let _ = writeln!(
         s,
-        "wrote {} step files ({:.1} MB, binary zlib VTU) in {:.3} s on a second thread, {:.3} s of it waited for; {} and {}",
+        "wrote {} step files ({:.1} MB, binary zlib VTU) in {:.3} s {}, {:.3} s of it waited for; {} and {}",
         written.files,
         written.bytes as f64 / 1e6,
         written.seconds,
+        if rayon::current_num_threads() == 1 {
+            "on the solve's thread (RAYON_NUM_THREADS=1)"
+        } else {
+            "on a second thread"
+        },
         written.waited_s,
         dir.join("solution.pvd").display(),
         dir.join("summary.csv").display()
