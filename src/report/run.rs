@@ -148,15 +148,11 @@ impl<'a> Series<'a> {
         if rayon::current_num_threads() == 1 {
             let (mut vtu, mut bytes, mut seconds) = (None, 0u64, 0.0);
             let solved = solve(&mut |n, steps, state| {
-                if n % self.every != 0 && n != steps {
-                    return Ok(());
+                if let Some(step) = self.due(n, steps, state) {
+                    let t0 = std::time::Instant::now();
+                    bytes += write_step(&mut vtu, step)?;
+                    seconds += t0.elapsed().as_secs_f64();
                 }
-                let nodes = contact_nodes(self.problem, state);
-                self.record(state.time, &nodes, format!("solution_{n:04}.vtu"));
-                let t0 = std::time::Instant::now();
-                let name = self.written.last().unwrap().1.clone();
-                bytes += write_step(&mut vtu, (name, n == steps, state.clone(), nodes))?;
-                seconds += t0.elapsed().as_secs_f64();
                 Ok(())
             })?;
             self.output = Written {
@@ -181,18 +177,11 @@ impl<'a> Series<'a> {
             });
             let mut waited_s = 0.0;
             let solved = solve(&mut |n, steps, state| {
-                if n % self.every != 0 && n != steps {
+                let Some(step) = self.due(n, steps, state) else {
                     return Ok(());
-                }
-                let nodes = contact_nodes(self.problem, state);
-                self.record(state.time, &nodes, format!("solution_{n:04}.vtu"));
+                };
                 let t0 = std::time::Instant::now();
-                let sent = send.send((
-                    self.written.last().unwrap().1.clone(),
-                    n == steps,
-                    state.clone(),
-                    nodes,
-                ));
+                let sent = send.send(step);
                 waited_s += t0.elapsed().as_secs_f64();
                 // A closed channel means the writer failed: its error is returned below.
                 sent.map_err(|_| {
@@ -212,6 +201,18 @@ impl<'a> Series<'a> {
             };
             solved
         })
+    }
+
+    /// Step `n` of `steps` as a file to write, recorded, when it is due (every `every`-th
+    /// and the last).
+    fn due(&mut self, n: usize, steps: usize, state: &State) -> Option<StepFile> {
+        if n % self.every != 0 && n != steps {
+            return None;
+        }
+        let nodes = contact_nodes(self.problem, state);
+        let name = format!("solution_{n:04}.vtu");
+        self.record(state.time, &nodes, name.clone());
+        Some((name, n == steps, state.clone(), nodes))
     }
 
     /// Record a written step: its time and file, and its contact rows.
