@@ -206,7 +206,7 @@ impl<'a> Series<'a> {
     /// Step `n` of `steps` as a file to write, recorded, when it is due (every `every`-th
     /// and the last).
     fn due(&mut self, n: usize, steps: usize, state: &State) -> Option<StepFile> {
-        if n % self.every != 0 && n != steps {
+        if !n.is_multiple_of(self.every) && n != steps {
             return None;
         }
         let nodes = contact_nodes(self.problem, state);
