@@ -21,10 +21,14 @@ const BIN: &str = env!("CARGO_BIN_EXE_contact-rates");
 
 /// `contact-rates solve --scene SCENE ARGS... --out OUT`.
 fn solve(scene: &str, args: &[&str], out: &Path) -> Output {
+    solve_with_env(scene, args, out, &[])
+}
+
+fn solve_with_env(scene: &str, args: &[&str], out: &Path, envs: &[(&str, &str)]) -> Output {
     let mut all = vec!["solve", "--scene", scene];
     all.extend_from_slice(args);
     all.extend(["--out", out.to_str().unwrap()]);
-    common::run(&all, &[])
+    common::run(&all, envs)
 }
 
 fn ok(o: &Output) {
@@ -162,12 +166,8 @@ fn one_thread_and_two_write_the_same_files() {
     let mut folders = Vec::new();
     for threads in ["1", "2"] {
         let out = dir.path().join(format!("out{threads}"));
-        let args = [
-            "solve", "--scene", "rates", "--level", "2", "--steps", "3", "--out",
-        ];
-        let mut all = args.to_vec();
-        all.push(out.to_str().unwrap());
-        let o = common::run(&all, &[("RAYON_NUM_THREADS", threads)]);
+        let args = ["--level", "2", "--steps", "3"];
+        let o = solve_with_env("rates", &args, &out, &[("RAYON_NUM_THREADS", threads)]);
         ok(&o);
         let console =
             String::from_utf8_lossy(&o.stdout).to_string() + &String::from_utf8_lossy(&o.stderr);

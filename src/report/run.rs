@@ -93,11 +93,13 @@ pub struct Written {
     pub files: usize,
     /// Their size (bytes).
     pub bytes: u64,
-    /// Building, compressing and writing them, on the writer thread (s).
+    /// Building, compressing and writing them (s).
     pub seconds: f64,
     /// Of that, the time the solve waited for the writer (s): the part of the run's wall
     /// time the output costs.
     pub waited_s: f64,
+    /// Written on the solve's own thread (a run of one thread) rather than a writer thread.
+    pub on_solve_thread: bool,
 }
 
 /// A step for the writer thread: the file name, whether it is the last step, the state and
@@ -160,6 +162,7 @@ impl<'a> Series<'a> {
                 bytes,
                 seconds,
                 waited_s: seconds,
+                on_solve_thread: true,
             };
             return Ok(solved);
         }
@@ -198,6 +201,7 @@ impl<'a> Series<'a> {
                 bytes,
                 seconds,
                 waited_s,
+                on_solve_thread: false,
             };
             solved
         })
@@ -326,7 +330,7 @@ pub fn console(run: &RunSummary, wall_s: f64, written: &Written, dir: &Path) -> 
         written.files,
         written.bytes as f64 / 1e6,
         written.seconds,
-        if rayon::current_num_threads() == 1 {
+        if written.on_solve_thread {
             "on the solve's thread (RAYON_NUM_THREADS=1)"
         } else {
             "on a second thread"
