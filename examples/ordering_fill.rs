@@ -11,7 +11,8 @@
 //! seconds of one numeric LDL^T
 //! (sequential, bodies one after the other). Timings are single runs: read them with the
 //! flops beside them.
-use contact_rates::{case::Case, contact::Method, fe::Pattern, scene::Scene, solve::Problem};
+use contact_rates::solve::{Problem, interface::interface_last_order, newton::FLOOR_SHIFT};
+use contact_rates::{case::Case, contact::Method, fe::Pattern, scene::Scene};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::perm::PermRef;
@@ -154,10 +155,7 @@ fn order(block: &Pattern, interface: &[bool], ordering: Ordering) -> Vec<usize> 
                 .flat_map(|v| first[v]..first[v + 1])
                 .collect()
         }
-        Ordering::AmdInterfaceLast => {
-            let (p, a) = subgraph(block, &interior);
-            then_interface(amd_order(p, a))
-        }
+        Ordering::AmdInterfaceLast => interface_last_order(block, interface).unwrap(),
         Ordering::MetisInterfaceLast => {
             let (p, a) = subgraph(block, &interior);
             then_interface(metis_order(p, a))
@@ -247,7 +245,7 @@ fn main() {
         // The floor's shift: a body held only by contact stays factorizable.
         let mean = (0..n).map(|i| values[pattern.slot(i, i)]).sum::<f64>() / n as f64;
         for i in 0..n {
-            values[pattern.slot(i, i)] += 1e-8 * mean;
+            values[pattern.slot(i, i)] += FLOOR_SHIFT * mean;
         }
         let mut on_interface = vec![false; n];
         for row in &p.rows {

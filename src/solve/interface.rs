@@ -179,6 +179,49 @@ impl ActiveSet {
 const PIVOT_EPSILON: f64 = 1e-12;
 const PIVOT_REPLACEMENT: f64 = 1e-6;
 
+/// The elimination order of one body's block (pattern with both triangles): faer's AMD of
+/// the equations not on the interface, then the equations on it (`on_interface`, per
+/// equation of the block) in equation order. The default solver's ordering; public for
+/// `examples/ordering_fill.rs`, which measures it against others.
+pub fn interface_last_order(block: &Pattern, on_interface: &[bool]) -> Result<Vec<usize>> {
+    let n = block.n;
+    let (col_ptr, row_idx) = (&block.col_ptr, &block.row_idx);
+    let interface = (0..n).filter(|&e| on_interface[e]);
+    let interior: Vec<usize> = (0..n).filter(|&e| !on_interface[e]).collect();
+    let mut interior_index = vec![usize::MAX; n];
+    for (k, &e) in interior.iter().enumerate() {
+        interior_index[e] = k;
+    }
+    let (mut interior_ptr, mut interior_rows) = (vec![0usize], Vec::new());
+    for &e in &interior {
+        interior_rows.extend(
+            row_idx[col_ptr[e]..col_ptr[e + 1]]
+                .iter()
+                .map(|&r| interior_index[r])
+                .filter(|&r| r != usize::MAX),
+        );
+        interior_ptr.push(interior_rows.len());
+    }
+    let ni = interior.len();
+    let interior_pattern =
+        SymbolicSparseColMat::new_checked(ni, ni, interior_ptr, None, interior_rows);
+    let (mut fwd, mut inv) = (vec![0usize; ni], vec![0usize; ni]);
+    let mut buffer = MemBuffer::try_new(amd::order_scratch::<usize>(
+        ni,
+        interior_pattern.row_idx().len(),
+    ))
+    .map_err(|_| Error::NotConverged("out of memory in the ordering".into()))?;
+    amd::order(
+        &mut fwd,
+        &mut inv,
+        interior_pattern.as_ref(),
+        Default::default(),
+        MemStack::new(&mut buffer),
+    )
+    .map_err(|e| Error::NotConverged(format!("ordering failed: {e:?}")))?;
+    Ok(fwd.iter().map(|&k| interior[k]).chain(interface).collect())
+}
+
 impl Block {
     /// The block of equations `range` of `pattern`, with its equations on the interface
     /// (`on_interface`, global) last: AMD of the interior, then the interface.
@@ -189,47 +232,12 @@ impl Block {
     ) -> Result<Self> {
         let (first, n) = (range.start, range.len());
         let (block, entries) = pattern.block(&range);
+        let local_interface = &on_interface[range.clone()];
+        let order = interface_last_order(&block, local_interface)?;
+        let interface: Vec<usize> = (0..n).filter(|&e| local_interface[e]).collect();
         let Pattern {
             col_ptr, row_idx, ..
         } = block;
-        let interface: Vec<usize> = (0..n).filter(|&e| on_interface[first + e]).collect();
-        let interior: Vec<usize> = (0..n).filter(|&e| !on_interface[first + e]).collect();
-        let mut interior_index = vec![usize::MAX; n];
-        for (k, &e) in interior.iter().enumerate() {
-            interior_index[e] = k;
-        }
-        let (mut interior_ptr, mut interior_rows) = (vec![0usize], Vec::new());
-        for &e in &interior {
-            interior_rows.extend(
-                row_idx[col_ptr[e]..col_ptr[e + 1]]
-                    .iter()
-                    .map(|&r| interior_index[r])
-                    .filter(|&r| r != usize::MAX),
-            );
-            interior_ptr.push(interior_rows.len());
-        }
-        let ni = interior.len();
-        let interior_pattern =
-            SymbolicSparseColMat::new_checked(ni, ni, interior_ptr, None, interior_rows);
-        let (mut fwd, mut inv) = (vec![0usize; ni], vec![0usize; ni]);
-        let mut buffer = MemBuffer::try_new(amd::order_scratch::<usize>(
-            ni,
-            interior_pattern.row_idx().len(),
-        ))
-        .map_err(|_| Error::NotConverged("out of memory in the ordering".into()))?;
-        amd::order(
-            &mut fwd,
-            &mut inv,
-            interior_pattern.as_ref(),
-            Default::default(),
-            MemStack::new(&mut buffer),
-        )
-        .map_err(|e| Error::NotConverged(format!("ordering failed: {e:?}")))?;
-        let order: Vec<usize> = fwd
-            .iter()
-            .map(|&k| interior[k])
-            .chain(interface.iter().copied())
-            .collect();
         let mut position = vec![0usize; n];
         for (p, &e) in order.iter().enumerate() {
             position[e] = p;
