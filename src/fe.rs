@@ -54,6 +54,13 @@ impl Element {
         }
         e
     }
+    /// Element stiffness `|T| B^T D S B` of the tangent `d` (`d sigma / d eps` in tensor
+    /// components; S halves B's engineering shear), over [`Element::dofs`] (force/length).
+    pub fn stiffness(&self, d: &Matrix3<f64>) -> SMatrix<f64, 6, 6> {
+        let s = Matrix3::from_diagonal(&SVector::<f64, 3>::new(1.0, 1.0, 0.5));
+        let b = self.b_matrix();
+        b.transpose() * (d * s) * b * self.area
+    }
     /// Global dof indices of the element (x, y per node).
     pub fn dofs(&self) -> [usize; 6] {
         let n = self.nodes;
@@ -613,14 +620,8 @@ impl Model {
         source: Option<&[Stress]>,
         tangent: bool,
     ) -> (Vec<Stress>, Vec<Matrix3<f64>>) {
-        let update = |(i, e): (usize, &Element)| {
-            let m = &self.materials[e.body];
-            let de = e.strain(u) - e.strain(u_prev);
-            let mut trial = sigma_prev[i] + m.elastic.apply(&de);
-            if let Some(source) = source {
-                trial += k * source[i];
-            }
-            let (s, d) = m.update(&trial, k);
+        let update = |(i, _): (usize, &Element)| {
+            let (s, d) = self.update_element(i, u, u_prev, sigma_prev, k, source);
             (s, if tangent { d } else { Matrix3::zeros() })
         };
         // On rayon's threads from PARALLEL_ELEMENTS triangles on (each triangle alone: the
@@ -642,6 +643,27 @@ impl Model {
             tan.clear();
         }
         (sig, tan)
+    }
+
+    /// The constitutive update of element `i` alone (see [`Model::update_stresses`]): its
+    /// stress and consistent tangent `d sigma / d eps` (tensor components).
+    pub fn update_element(
+        &self,
+        i: usize,
+        u: &[f64],
+        u_prev: &[f64],
+        sigma_prev: &[Stress],
+        k: f64,
+        source: Option<&[Stress]>,
+    ) -> (Stress, Matrix3<f64>) {
+        let e = &self.elements[i];
+        let m = &self.materials[e.body];
+        let de = e.strain(u) - e.strain(u_prev);
+        let mut trial = sigma_prev[i] + m.elastic.apply(&de);
+        if let Some(source) = source {
+            trial += k * source[i];
+        }
+        m.update(&trial, k)
     }
 
     /// Internal force `sum_T |T| B^T sigma_T` over global dofs. From
@@ -733,9 +755,7 @@ pub const PARALLEL_ELEMENTS: usize = 50_000;
 /// Add `|T| B^T D S B` of one element into `values` through its slot map (S halves the
 /// engineering shear).
 fn scatter_tangent(e: &Element, d: &Matrix3<f64>, slots: &[usize; 36], values: &mut [f64]) {
-    let s = Matrix3::from_diagonal(&SVector::<f64, 3>::new(1.0, 1.0, 0.5));
-    let b = e.b_matrix();
-    let ke = b.transpose() * (d * s) * b * e.area;
+    let ke = e.stiffness(d);
     for i in 0..6 {
         for j in 0..6 {
             let slot = slots[6 * i + j];

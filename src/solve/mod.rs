@@ -2,6 +2,7 @@
 //! solve the same equations: [`newton`] (default), the paper's fixed point with the
 //! penalty-duality iteration, and a Clarabel QP cross-check (both in [`fixed_point`]).
 
+pub mod elimination;
 pub mod fixed_point;
 pub mod interface;
 pub mod linear;

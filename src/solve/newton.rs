@@ -9,6 +9,7 @@
 //! factored one). For elastic bodies K_s = K_t: GMRES stops after one iteration and the
 //! whole run factorizes the stiffness once, like the floor.
 
+use super::elimination::{Elimination, Increment};
 use super::interface::{ActiveSet, InterfaceFactorization};
 use super::linear::{SparseSystem, gmres};
 use super::{Problem, Settings, State, StepReport, StepSolver, inf_norm};
@@ -58,6 +59,8 @@ pub struct Newton<'a> {
     fresh_iterations: usize,
     /// Contact rows the active-set prediction changed (summed over rounds and iterations).
     predicted_changes: usize,
+    /// Local re-equilibration of the triangles where a step leaves the linear model.
+    elimination: Elimination,
 }
 
 /// The factorization GMRES is preconditioned with.
@@ -260,6 +263,7 @@ impl<'a> Newton<'a> {
             symmetric_values: Vec::new(),
             fresh_iterations: 0,
             predicted_changes: 0,
+            elimination: Elimination::new(&p.model),
             trace: std::env::var_os("CONTACT_RATES_TRACE").is_some(),
         })
     }
@@ -625,6 +629,70 @@ impl Newton<'_> {
         .max(1e-12)
     }
 
+    /// Nonlinear elimination of a line-search trial `(ut, lt)` (evaluated in `ev`) from
+    /// the iterate `u` (evaluated in `current`): the nodes of the triangles where the step
+    /// left the return map's linear model ([`Elimination::failed_triangles`]) are
+    /// re-equilibrated with the rest of the mesh held, the gaps of the active contact rows
+    /// through them kept, until their residual is a tenth of the iterate's largest. Returns
+    /// the evaluation of the trial so moved (`ev` itself when no triangle failed).
+    fn eliminate(
+        &self,
+        data: &StepData,
+        u: &[f64],
+        current: &Evaluation,
+        ut: &mut [f64],
+        lt: &mut [f64],
+        ev: Evaluation,
+    ) -> Evaluation {
+        let model = &self.p.model;
+        let failed = timed(&self.clock.constitutive, || {
+            Elimination::failed_triangles(
+                model,
+                u,
+                &current.sigma,
+                &current.tangents,
+                ut,
+                &ev.sigma,
+            )
+        });
+        if failed.is_empty() {
+            return ev;
+        }
+        let c = self.c_scale;
+        let active: Vec<bool> = (0..lt.len())
+            .map(|i| lt[i] + c * ev.gaps[i] >= 0.0)
+            .collect();
+        // The contact forces of the trial's multipliers are held, as a load.
+        let mut load = vec![0.0; data.f_ext.len()];
+        contact::add_transpose(&self.p.rows, lt, &mut load);
+        for (l, f) in load.iter_mut().zip(&data.f_ext) {
+            *l = f - *l;
+        }
+        let increment = Increment {
+            u_prev: &data.prev.u,
+            sigma_prev: &data.prev.sigma,
+            k: data.k,
+            source: data.source.as_deref(),
+            f_ext: &load,
+            rows: &self.p.rows,
+            active: &active,
+        };
+        let tol = 0.1 * inf_norm(&current.residual);
+        let relaxed = timed(&self.clock.constitutive, || {
+            self.elimination
+                .relax(model, &increment, &failed, ut, lt, tol)
+        });
+        if self.trace {
+            eprintln!(
+                "    eliminated {} triangles, {} unknowns, {} local iterations",
+                failed.len(),
+                relaxed.unknowns,
+                relaxed.iterations
+            );
+        }
+        self.evaluate(data, ut, lt)
+    }
+
     /// Backtracking along `step` on the merit |r|^2 + |min(lambda, -c g)|^2 (Armijo against
     /// `reference`, the current iterate's merit): full steps near the solution, shorter
     /// ones when a large step flips many triangles between elastic and viscoplastic (stiff
@@ -640,6 +708,7 @@ impl Newton<'_> {
         data: &StepData,
         u: &[f64],
         lambda: &[f64],
+        current: &Evaluation,
         step: &[f64],
         reference: f64,
     ) -> (Vec<f64>, Vec<f64>, Evaluation, f64) {
@@ -659,8 +728,9 @@ impl Newton<'_> {
         let mut alpha = 1.0;
         let mut best: Option<(f64, (Vec<f64>, Vec<f64>), Evaluation, f64)> = None;
         for _ in 0..12 {
-            let (ut, lt) = trial(alpha);
+            let (mut ut, mut lt) = trial(alpha);
             let ev = self.evaluate(data, &ut, &lt);
+            let ev = self.eliminate(data, u, current, &mut ut, &mut lt, ev);
             let merit = self.merit(&ev, &lt);
             let done = merit <= (1.0 - 1e-4 * alpha) * reference;
             if self.trace {
@@ -774,7 +844,8 @@ impl StepSolver for Newton<'_> {
             }
             factorizations += factorized as usize;
             let alpha;
-            (u, lambda, evaluation, alpha) = self.line_search(&data, &u, &lambda, &step, reference);
+            (u, lambda, evaluation, alpha) =
+                self.line_search(&data, &u, &lambda, &evaluation, &step, reference);
             if self.trace {
                 // A triangle is plastic where its tangent is not the elastic one.
                 let plastic = |tangents: &[Matrix3<f64>]| -> Vec<bool> {
