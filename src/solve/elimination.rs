@@ -16,6 +16,7 @@ use crate::contact::Row;
 use crate::fe::{FIXED, Model};
 use crate::material::{Stress, von_mises};
 use nalgebra::{DMatrix, DVector, Matrix3};
+use rayon::prelude::*;
 
 /// Error of a triangle's linear model, in units of its yield stress, above which its nodes
 /// are re-equilibrated. Measured (see the module comment): 1.4-2.4 where the step fails
@@ -89,10 +90,12 @@ impl Elimination {
         trial: &[f64],
         sigma_trial: &[Stress],
     ) -> Vec<usize> {
+        // Every triangle alone: the same list on any number of threads.
         model
             .elements
-            .iter()
+            .par_iter()
             .enumerate()
+            .with_min_len(4096)
             .filter(|(i, e)| {
                 let Some(vp) = model.materials[e.body].viscoplastic else {
                     return false;

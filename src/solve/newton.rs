@@ -701,8 +701,9 @@ impl Newton<'_> {
     /// [`Newton::predicted_step`]; with stiff viscosity (k E / lambda = 1e3, `rates` level
     /// 1) a non-monotone search (memory 3) let the merit oscillate for 43 iterations of
     /// one step where the monotone one takes 12, and `rates` and `rates-elastic` take the
-    /// same iterations either way (levels 1, 3, 5, measured). Returns the best trial with
-    /// its evaluation (the next iteration's residual).
+    /// same iterations either way (levels 1, 3, 5, measured). Each trial is first moved by
+    /// [`Newton::eliminate`] where the step left the return map's linear model. Returns the
+    /// best trial with its evaluation (the next iteration's residual).
     fn line_search(
         &self,
         data: &StepData,
