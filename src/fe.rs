@@ -54,6 +54,10 @@ impl Element {
         }
         e
     }
+    /// Element internal force `|T| B^T sigma` over [`Element::dofs`] (force).
+    pub fn internal_force(&self, sigma: &Stress) -> SVector<f64, 6> {
+        self.b_matrix().transpose() * sigma * self.area
+    }
     /// Element stiffness `|T| B^T D S B` of the tangent `d` (`d sigma / d eps` in tensor
     /// components; S halves B's engineering shear), over [`Element::dofs`] (force/length).
     pub fn stiffness(&self, d: &Matrix3<f64>) -> SMatrix<f64, 6, 6> {
@@ -676,7 +680,7 @@ impl Model {
                 if e.body != body {
                     continue;
                 }
-                let fe = e.b_matrix().transpose() * s * e.area;
+                let fe = e.internal_force(s);
                 for (k, d) in e.dofs().iter().enumerate() {
                     f[*d - dof_offset] += fe[k];
                 }

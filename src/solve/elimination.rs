@@ -45,12 +45,11 @@ pub struct Increment<'a> {
     pub active: &'a [bool],
 }
 
-/// The mesh's adjacency for the local solves, built once per problem.
+/// The mesh's adjacency for the local solves, built once per problem (the constrained
+/// dofs, which they never move, are read from [`Model::equation`]).
 pub struct Elimination {
     /// Triangles around each node.
     node_elements: Vec<Vec<usize>>,
-    /// Dofs the local solves never move: the constrained ones.
-    held: Vec<bool>,
 }
 
 /// What one [`Elimination::relax`] did.
@@ -71,12 +70,7 @@ impl Elimination {
                 node_elements[a].push(i);
             }
         }
-        let held: Vec<bool> = model.equation.iter().map(|&eq| eq == FIXED).collect();
-
-        Elimination {
-            node_elements,
-            held,
-        }
+        Elimination { node_elements }
     }
 
     /// The viscoplastic triangles whose linear model fails on the step from `u` (stresses
@@ -90,6 +84,10 @@ impl Elimination {
         trial: &[f64],
         sigma_trial: &[Stress],
     ) -> Vec<usize> {
+        // Elastic bodies pay nothing: their linear model is exact.
+        if model.materials.iter().all(|m| m.viscoplastic.is_none()) {
+            return Vec::new();
+        }
         // Every triangle alone: the same list on any number of threads.
         model
             .elements
@@ -125,7 +123,7 @@ impl Elimination {
         let mut dofs: Vec<usize> = triangles
             .iter()
             .flat_map(|&i| model.elements[i].dofs())
-            .filter(|&d| !self.held[d])
+            .filter(|&d| model.equation[d] != FIXED)
             .collect();
         dofs.sort_unstable();
         dofs.dedup();
@@ -139,7 +137,7 @@ impl Elimination {
                     .any(|(d, _)| dofs.binary_search(d).is_ok())
             })
             .flat_map(|i| step.rows[i].entries.iter().map(|&(d, _)| d))
-            .filter(|&d| !self.held[d])
+            .filter(|&d| model.equation[d] != FIXED)
             .collect();
         dofs.append(&mut joined);
         dofs.sort_unstable();
@@ -155,14 +153,13 @@ impl Elimination {
         patch.sort_unstable();
         patch.dedup();
         let local = |d: usize| dofs.binary_search(&d).ok();
-        let residual = |u: &[f64], jacobian: Option<&mut DMatrix<f64>>| -> DVector<f64> {
+        let residual = |u: &[f64], mut jacobian: Option<&mut DMatrix<f64>>| -> DVector<f64> {
             let mut r = DVector::from_iterator(dofs.len(), dofs.iter().map(|&d| -step.f_ext[d]));
-            let mut jacobian = jacobian;
             for &i in &patch {
                 let e = &model.elements[i];
                 let (s, d) =
                     model.update_element(i, u, step.u_prev, step.sigma_prev, step.k, step.source);
-                let fe = e.b_matrix().transpose() * s * e.area;
+                let fe = e.internal_force(&s);
                 let ke = jacobian.as_ref().map(|_| e.stiffness(&d));
                 let ed = e.dofs();
                 for (a, &da) in ed.iter().enumerate() {
