@@ -631,7 +631,8 @@ impl Newton<'_> {
 
     /// Nonlinear elimination of a line-search trial `(ut, lt)` (evaluated in `ev`) from
     /// the iterate `u` (evaluated in `current`): the nodes of the triangles where the step
-    /// left the return map's linear model ([`Elimination::failed_triangles`]) are
+    /// left the return map's linear model ([`Elimination::failed_triangles`]), and of two
+    /// rings of triangles around them ([`Elimination::region`]), are
     /// re-equilibrated with the rest of the mesh held, the gaps of the active contact rows
     /// through them kept, until their residual is a tenth of the iterate's largest. Returns
     /// the evaluation of the trial so moved (`ev` itself when no triangle failed).
@@ -658,6 +659,7 @@ impl Newton<'_> {
         if failed.is_empty() {
             return ev;
         }
+        let region = self.elimination.region(model, &failed);
         let c = self.c_scale;
         let active: Vec<bool> = (0..lt.len())
             .map(|i| lt[i] + c * ev.gaps[i] >= 0.0)
@@ -680,11 +682,12 @@ impl Newton<'_> {
         let tol = 0.1 * inf_norm(&current.residual);
         let relaxed = timed(&self.clock.constitutive, || {
             self.elimination
-                .relax(model, &increment, &failed, ut, lt, tol)
+                .relax(model, &increment, &region, ut, lt, tol)
         });
         if self.trace {
             eprintln!(
-                "    eliminated {} triangles, {} unknowns, {} local iterations",
+                "    eliminated {} triangles ({} failed), {} unknowns, {} local iterations",
+                region.len(),
                 failed.len(),
                 relaxed.unknowns,
                 relaxed.iterations
