@@ -20,8 +20,9 @@
 //! to 1/32 for 20 iterations of one step (26 in all), with the model errors of the
 //! neighbours only 0.01-0.05 sigma_Y but the residual already 1e-2 of the force scale.
 
+use super::linear::SparseSystem;
 use crate::contact::Row;
-use crate::fe::{FIXED, Model};
+use crate::fe::{FIXED, Model, Pattern};
 use crate::material::{Stress, von_mises};
 use nalgebra::{DMatrix, DVector, Matrix3};
 use rayon::prelude::*;
@@ -38,8 +39,60 @@ pub const MODEL_ERROR: f64 = 0.2;
 /// cases): no ring 15-26, one ring 8-9, two rings 6-8, three rings 5-8.
 pub const RINGS: usize = 2;
 
-/// Most Newton iterations of one local solve (each a dense solve on a few unknowns).
+/// Most Newton iterations of one local solve.
 const LOCAL_ITERATIONS: usize = 50;
+
+/// Local systems up to this size are solved dense (at most 261 unknowns in the stiff cases
+/// of `study stability`), larger ones by a sparse LU: where a whole body yields in one
+/// step (`study patch`, nts), hundreds of triangles fail at once and with their rings the
+/// region reached 992 unknowns at level 3 and about 4,000 at level 4, where dense LU made
+/// the study's level-4 run take 278 s instead of 0.4 s.
+const DENSE_UNKNOWNS: usize = 400;
+
+/// The local KKT matrix `[J C^T; C 0]`, dense or sparse by its size.
+enum LocalMatrix {
+    Dense(DMatrix<f64>),
+    Sparse(Box<(SparseSystem, Pattern)>),
+}
+
+impl LocalMatrix {
+    /// A zero matrix of size `n` whose entries can be the pairs in `entries`.
+    fn new(n: usize, entries: impl Fn() -> Vec<(usize, usize)>) -> Self {
+        if n <= DENSE_UNKNOWNS {
+            LocalMatrix::Dense(DMatrix::zeros(n, n))
+        } else {
+            let pattern = Pattern::from_entries(n, entries());
+            LocalMatrix::Sparse(Box::new((SparseSystem::new(&pattern), pattern)))
+        }
+    }
+    fn add(&mut self, row: usize, col: usize, v: f64) {
+        match self {
+            LocalMatrix::Dense(m) => m[(row, col)] += v,
+            LocalMatrix::Sparse(b) => {
+                let slot = b.1.slot(row, col);
+                b.0.values_mut()[slot] += v;
+            }
+        }
+    }
+    fn clear(&mut self) {
+        match self {
+            LocalMatrix::Dense(m) => m.fill(0.0),
+            LocalMatrix::Sparse(b) => b.0.values_mut().fill(0.0),
+        }
+    }
+    /// The solution of `A x = rhs`, None when A is singular.
+    fn solve(&mut self, rhs: DVector<f64>) -> Option<DVector<f64>> {
+        match self {
+            LocalMatrix::Dense(m) => m.clone().lu().solve(&rhs),
+            LocalMatrix::Sparse(b) => {
+                b.0.factor_lu().ok()?;
+                let mut x = rhs;
+                b.0.solve(x.as_mut_slice());
+                x.iter().all(|v| v.is_finite()).then_some(x)
+            }
+        }
+    }
+}
 
 /// What the local solves of one time step share with the global residual.
 pub struct Increment<'a> {
@@ -189,7 +242,7 @@ impl Elimination {
         patch.sort_unstable();
         patch.dedup();
         let local = |d: usize| dofs.binary_search(&d).ok();
-        let residual = |u: &[f64], mut jacobian: Option<&mut DMatrix<f64>>| -> DVector<f64> {
+        let residual = |u: &[f64], mut jacobian: Option<&mut LocalMatrix>| -> DVector<f64> {
             let mut r = DVector::from_iterator(dofs.len(), dofs.iter().map(|&d| -step.f_ext[d]));
             for &i in &patch {
                 let e = &model.elements[i];
@@ -204,7 +257,7 @@ impl Elimination {
                     if let (Some(j), Some(ke)) = (jacobian.as_deref_mut(), ke.as_ref()) {
                         for (b, &db) in ed.iter().enumerate() {
                             if let Some(lb) = local(db) {
-                                j[(la, lb)] += ke[(a, b)];
+                                j.add(la, lb, ke[(a, b)]);
                             }
                         }
                     }
@@ -236,20 +289,33 @@ impl Elimination {
             r
         };
         let mut iterations = 0;
-        let mut jacobian = DMatrix::zeros(nl, nl);
-        let mut r = with_contact(residual(u, Some(&mut jacobian)), &multipliers);
+        // The KKT matrix: the Jacobian's block (accumulated by `residual`) and the rows'.
+        let mut kkt = LocalMatrix::new(nl + nc, || {
+            let mut entries: Vec<(usize, usize)> = (0..nl + nc).map(|i| (i, i)).collect();
+            for &i in &patch {
+                let ed: Vec<usize> = model.elements[i]
+                    .dofs()
+                    .iter()
+                    .filter_map(|&d| local(d))
+                    .collect();
+                entries.extend(ed.iter().flat_map(|&a| ed.iter().map(move |&b| (a, b))));
+            }
+            for (j, (_, c)) in constrained.iter().enumerate() {
+                entries.extend(c.iter().flat_map(|&(l, _)| [(l, nl + j), (nl + j, l)]));
+            }
+            entries
+        });
+        let mut r = with_contact(residual(u, Some(&mut kkt)), &multipliers);
         while r.amax() > tol && iterations < LOCAL_ITERATIONS {
-            let mut kkt = DMatrix::zeros(nl + nc, nl + nc);
-            kkt.view_mut((0, 0), (nl, nl)).copy_from(&jacobian);
             for (j, (_, c)) in constrained.iter().enumerate() {
                 for &(l, v) in c {
-                    kkt[(l, nl + j)] = v;
-                    kkt[(nl + j, l)] = v;
+                    kkt.add(l, nl + j, v);
+                    kkt.add(nl + j, l, v);
                 }
             }
             let mut rhs = DVector::zeros(nl + nc);
             rhs.rows_mut(0, nl).copy_from(&(-&r));
-            let Some(dx) = kkt.lu().solve(&rhs) else {
+            let Some(dx) = kkt.solve(rhs) else {
                 break;
             };
             let start: Vec<f64> = dofs.iter().map(|&d| u[d]).collect();
@@ -279,8 +345,8 @@ impl Elimination {
                 multipliers = start_multipliers;
                 break;
             }
-            jacobian.fill(0.0);
-            r = with_contact(residual(u, Some(&mut jacobian)), &multipliers);
+            kkt.clear();
+            r = with_contact(residual(u, Some(&mut kkt)), &multipliers);
         }
         for ((i, _), m) in constrained.iter().zip(&multipliers) {
             lambda[*i] += m;
