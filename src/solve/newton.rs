@@ -643,8 +643,8 @@ impl Newton<'_> {
         current: &Evaluation,
         ut: &mut [f64],
         lt: &mut [f64],
-        ev: Evaluation,
-    ) -> Evaluation {
+        ev: &Evaluation,
+    ) -> Option<Evaluation> {
         let model = &self.p.model;
         let failed = timed(&self.clock.constitutive, || {
             Elimination::failed_triangles(
@@ -657,7 +657,7 @@ impl Newton<'_> {
             )
         });
         if failed.is_empty() {
-            return ev;
+            return None;
         }
         let region = self.elimination.region(model, &failed);
         let c = self.c_scale;
@@ -693,7 +693,7 @@ impl Newton<'_> {
                 relaxed.iterations
             );
         }
-        self.evaluate(data, ut, lt)
+        Some(self.evaluate(data, ut, lt))
     }
 
     /// Backtracking along `step` on the merit |r|^2 + |min(lambda, -c g)|^2 (Armijo against
@@ -715,7 +715,7 @@ impl Newton<'_> {
         current: &Evaluation,
         step: &[f64],
         reference: f64,
-    ) -> (Vec<f64>, Vec<f64>, Evaluation, f64) {
+    ) -> (Vec<f64>, Vec<f64>, Evaluation, f64, bool) {
         let (n, c) = (self.n, self.c_scale);
         let trial = |alpha: f64| -> (Vec<f64>, Vec<f64>) {
             let mut ut = u.to_vec();
@@ -734,8 +734,25 @@ impl Newton<'_> {
         for _ in 0..12 {
             let (mut ut, mut lt) = trial(alpha);
             let ev = self.evaluate(data, &ut, &lt);
-            let ev = self.eliminate(data, u, current, &mut ut, &mut lt, ev);
-            let merit = self.merit(&ev, &lt);
+            // The trial moved by the elimination, unless that raised the merit (a safeguard:
+            // the local solves hold the rest of the mesh and can land on a worse point; the
+            // line search then never judges a trial worse than the plain one).
+            let raw_merit = self.merit(&ev, &lt);
+            let (raw_u, raw_l) = (ut.clone(), lt.clone());
+            let moved = self
+                .eliminate(data, u, current, &mut ut, &mut lt, &ev)
+                .map(|moved| {
+                    let merit = self.merit(&moved, &lt);
+                    (moved, merit)
+                });
+            let (ev, merit) = match moved {
+                Some((moved, merit)) if merit <= raw_merit => (moved, merit),
+                Some(_) => {
+                    (ut, lt) = (raw_u, raw_l);
+                    (ev, raw_merit)
+                }
+                None => (ev, raw_merit),
+            };
             let done = merit <= (1.0 - 1e-4 * alpha) * reference;
             if self.trace {
                 let res = (ev.residual.iter().map(|v| v * v).sum::<f64>()).sqrt();
@@ -752,8 +769,8 @@ impl Newton<'_> {
             }
             alpha *= 0.5;
         }
-        let (_, (u, lambda), ev, alpha) = best.expect("at least one trial");
-        (u, lambda, ev, alpha)
+        let (merit, (u, lambda), ev, alpha) = best.expect("at least one trial");
+        (u, lambda, ev, alpha, merit < reference)
     }
 }
 
@@ -847,9 +864,17 @@ impl StepSolver for Newton<'_> {
                 );
             }
             factorizations += factorized as usize;
-            let alpha;
-            (u, lambda, evaluation, alpha) =
+            let (alpha, decreased);
+            (u, lambda, evaluation, alpha, decreased) =
                 self.line_search(&data, &u, &lambda, &evaluation, &step, reference);
+            // No trial lowered the merit: the step (from an older factorization, through the
+            // interface model's active set) is no descent direction here; the next one is
+            // computed from a fresh factorization of the current tangent. Measured: a
+            // viscoplastic body on an elastic one (lambda = 0.0025, level 1, 4 steps) sat at
+            // merit ratio 1.0000 for 58 iterations without this, and took 10 with it.
+            if !decreased {
+                self.stale = true;
+            }
             if self.trace {
                 // A triangle is plastic where its tangent is not the elastic one.
                 let plastic = |tangents: &[Matrix3<f64>]| -> Vec<bool> {
