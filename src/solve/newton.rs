@@ -635,7 +635,7 @@ impl Newton<'_> {
     /// rings of triangles around them ([`Elimination::region`]), are
     /// re-equilibrated with the rest of the mesh held, the gaps of the active contact rows
     /// through them kept, until their residual is a tenth of the iterate's largest. Returns
-    /// the evaluation of the trial so moved (`ev` itself when no triangle failed).
+    /// the evaluation of the trial so moved (None when no triangle failed: the trial is as it was).
     fn eliminate(
         &self,
         data: &StepData,
@@ -705,8 +705,9 @@ impl Newton<'_> {
     /// 1) a non-monotone search (memory 3) let the merit oscillate for 43 iterations of
     /// one step where the monotone one takes 12, and `rates` and `rates-elastic` take the
     /// same iterations either way (levels 1, 3, 5, measured). Each trial is first moved by
-    /// [`Newton::eliminate`] where the step left the return map's linear model. Returns the
-    /// best trial with its evaluation (the next iteration's residual).
+    /// [`Newton::eliminate`] where the step left the return map's linear model (kept only
+    /// where that lowers the merit). Returns the best trial with its evaluation (the next
+    /// iteration's residual), its step length, and whether its merit is below `reference`.
     fn line_search(
         &self,
         data: &StepData,
