@@ -25,6 +25,7 @@
 //! solves with the whole factor only, and this needs the forward and back substitutions
 //! apart, with the interface solve in between.
 
+use super::pieces;
 use crate::error::{Error, Result};
 use crate::fe::{Pattern, split_ranges_mut};
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -231,9 +232,11 @@ impl Block {
         on_interface: &[bool],
     ) -> Result<Self> {
         let (first, n) = (range.start, range.len());
-        let (block, entries) = pattern.block(&range);
+        let (block, entries) = pieces::time("setup.block", first, || pattern.block(&range));
         let local_interface = &on_interface[range.clone()];
-        let order = interface_last_order(&block, local_interface)?;
+        let order = pieces::time("setup.order", first, || {
+            interface_last_order(&block, local_interface)
+        })?;
         let interface: Vec<usize> = (0..n).filter(|&e| local_interface[e]).collect();
         let Pattern {
             col_ptr, row_idx, ..
@@ -250,15 +253,17 @@ impl Block {
             .collect();
         let block_pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         let perm = PermRef::new_checked(&order, &position, n);
-        let symbolic = factorize_symbolic_cholesky(
-            block_pattern.as_ref(),
-            Side::Lower,
-            SymmetricOrdering::Custom(perm),
-            CholeskySymbolicParams {
-                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-                ..Default::default()
-            },
-        )
+        let symbolic = pieces::time("setup.symbolic", first, || {
+            factorize_symbolic_cholesky(
+                block_pattern.as_ref(),
+                Side::Lower,
+                SymmetricOrdering::Custom(perm),
+                CholeskySymbolicParams {
+                    supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                    ..Default::default()
+                },
+            )
+        })
         .map_err(|e| Error::NotConverged(format!("symbolic LDLT failed: {e:?}")))?;
         Ok(Block {
             first,
@@ -284,6 +289,7 @@ impl Block {
     /// return its Schur complement onto its interface (see
     /// [`InterfaceFactorization::factor`]).
     fn factor(&mut self, values: &mut [f64], shift: f64, single: bool) -> Result<Mat<f64>> {
+        let t = Instant::now();
         for &e in &self.interface {
             values[self.diagonal[e]] += shift;
         }
@@ -303,6 +309,8 @@ impl Block {
                 values[start + s] *= scaling[i] * scaling[j];
             }
         }
+        pieces::record("factor.scale", self.first, t.elapsed().as_secs_f64());
+        let t = Instant::now();
         let mut l_values = self.numeric.take().map(|f| f.values).unwrap_or_default();
         l_values.resize(self.symbolic.len_val(), 0.0);
         let mut buffer = MemBuffer::try_new(
@@ -311,6 +319,8 @@ impl Block {
         )
         .map_err(|_| Error::NotConverged("out of memory in the LDLT".into()))?;
         let signs = vec![1i8; self.n];
+        pieces::record("factor.allocate", self.first, t.elapsed().as_secs_f64());
+        let t = Instant::now();
         self.symbolic
             .factorize_numeric_ldlt(
                 &mut l_values,
@@ -326,6 +336,8 @@ impl Block {
                 Default::default(),
             )
             .map_err(|e| Error::NotConverged(format!("LDLT failed: {e:?}")))?;
+        pieces::record("factor.numeric", self.first, t.elapsed().as_secs_f64());
+        let t = Instant::now();
         let (l_interface, d_interface) = self.trailing_block(&l_values);
         // S = W_I^{-1} L D L^T W_I^{-1} - sigma I.
         let b = self.interface.len();
@@ -344,6 +356,8 @@ impl Block {
             let s = 0.5 * (ldl[(i, j)] + ldl[(j, i)]) / (w[i] * w[j]);
             if i == j { s - shift } else { s }
         });
+        pieces::record("factor.schur", self.first, t.elapsed().as_secs_f64());
+        let t = Instant::now();
         let mut inverse_diagonal = vec![0.0; self.n];
         for (start, width, pattern, values) in self.supernodes(&l_values) {
             let rows = width + pattern.len();
@@ -351,7 +365,14 @@ impl Block {
                 inverse_diagonal[start + j] = 1.0 / values[j * rows + j];
             }
         }
-        let single = single.then(|| l_values.iter().map(|&v| v as f32).collect());
+        pieces::record(
+            "factor.inverse_diagonal",
+            self.first,
+            t.elapsed().as_secs_f64(),
+        );
+        let single = pieces::time("factor.single", self.first, || {
+            single.then(|| l_values.iter().map(|&v| v as f32).collect())
+        });
         self.numeric = Some(Numeric {
             single,
             inverse_diagonal,
@@ -538,6 +559,7 @@ impl InterfaceFactorization {
             offset += s.nrows();
         }
         self.schur = Some(schur);
+        pieces::record("factor.total", 0, t.elapsed().as_secs_f64());
         self.factorizations += 1;
         self.factor_s
             .set(self.factor_s.get() + t.elapsed().as_secs_f64());
@@ -559,6 +581,7 @@ impl InterfaceFactorization {
         }
         self.factor_s
             .set(self.factor_s.get() + t.elapsed().as_secs_f64());
+        pieces::record("active_set.lu", 0, t.elapsed().as_secs_f64());
         Ok(ActiveSet {
             active: active.to_vec(),
             rows,
@@ -594,10 +617,13 @@ impl InterfaceFactorization {
     pub fn solve(&self, set: &ActiveSet, c: f64, v: &mut [f64]) {
         let n = self.n;
         let (f, g) = v.split_at_mut(n);
-        let condensed = self.condense(f);
-        let (x_interface, y) = self.interface_solve(set, c, &condensed.load, g);
+        let condensed = pieces::time("solve.forward", 0, || self.condense(f));
+        let (x_interface, y) = pieces::time("solve.interface", 0, || {
+            self.interface_solve(set, c, &condensed.load, g)
+        });
         g.copy_from_slice(&y);
-        f.copy_from_slice(&self.expand(condensed, &x_interface));
+        let x = pieces::time("solve.back", 0, || self.expand(condensed, &x_interface));
+        f.copy_from_slice(&x);
     }
 
     /// Forward substitution of the load `f` (n): what the interface sees of it (the
