@@ -25,7 +25,7 @@
 //! solves with the whole factor only, and this needs the forward and back substitutions
 //! apart, with the interface solve in between.
 
-use super::pieces;
+use super::{ordering, pieces};
 use crate::error::{Error, Result};
 use crate::fe::{Pattern, split_ranges_mut};
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -33,7 +33,6 @@ use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::solvers::{PartialPivLu, SolveCore};
 use faer::perm::PermRef;
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::supernodal::{SupernodalLdltRef, SymbolicSupernodalCholesky};
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
@@ -180,52 +179,11 @@ impl ActiveSet {
 const PIVOT_EPSILON: f64 = 1e-12;
 const PIVOT_REPLACEMENT: f64 = 1e-6;
 
-/// The elimination order of one body's block (pattern with both triangles): faer's AMD of
-/// the equations not on the interface, then the equations on it (`on_interface`, per
-/// equation of the block) in equation order. The default solver's ordering; public for
-/// `examples/ordering_fill.rs`, which measures it against others.
-pub fn interface_last_order(block: &Pattern, on_interface: &[bool]) -> Result<Vec<usize>> {
-    let n = block.n;
-    let (col_ptr, row_idx) = (&block.col_ptr, &block.row_idx);
-    let interface = (0..n).filter(|&e| on_interface[e]);
-    let interior: Vec<usize> = (0..n).filter(|&e| !on_interface[e]).collect();
-    let mut interior_index = vec![usize::MAX; n];
-    for (k, &e) in interior.iter().enumerate() {
-        interior_index[e] = k;
-    }
-    let (mut interior_ptr, mut interior_rows) = (vec![0usize], Vec::new());
-    for &e in &interior {
-        interior_rows.extend(
-            row_idx[col_ptr[e]..col_ptr[e + 1]]
-                .iter()
-                .map(|&r| interior_index[r])
-                .filter(|&r| r != usize::MAX),
-        );
-        interior_ptr.push(interior_rows.len());
-    }
-    let ni = interior.len();
-    let interior_pattern =
-        SymbolicSparseColMat::new_checked(ni, ni, interior_ptr, None, interior_rows);
-    let (mut fwd, mut inv) = (vec![0usize; ni], vec![0usize; ni]);
-    let mut buffer = MemBuffer::try_new(amd::order_scratch::<usize>(
-        ni,
-        interior_pattern.row_idx().len(),
-    ))
-    .map_err(|_| Error::NotConverged("out of memory in the ordering".into()))?;
-    amd::order(
-        &mut fwd,
-        &mut inv,
-        interior_pattern.as_ref(),
-        Default::default(),
-        MemStack::new(&mut buffer),
-    )
-    .map_err(|e| Error::NotConverged(format!("ordering failed: {e:?}")))?;
-    Ok(fwd.iter().map(|&k| interior[k]).chain(interface).collect())
-}
-
 impl Block {
     /// The block of equations `range` of `pattern`, with its equations on the interface
-    /// (`on_interface`, global) last: AMD of the interior, then the interface.
+    /// (`on_interface`, global) last: the interior in the order of [`ordering::order`]
+    /// (METIS's nested dissection of the nodes, or AMD for a small block), then the
+    /// interface.
     fn new(
         pattern: &Pattern,
         range: std::ops::Range<usize>,
@@ -235,7 +193,7 @@ impl Block {
         let (block, entries) = pieces::time("setup.block", first, || pattern.block(&range));
         let local_interface = &on_interface[range.clone()];
         let order = pieces::time("setup.order", first, || {
-            interface_last_order(&block, local_interface)
+            ordering::order(&block, local_interface, None, first)
         })?;
         let interface: Vec<usize> = (0..n).filter(|&e| local_interface[e]).collect();
         let Pattern {
@@ -483,11 +441,9 @@ impl InterfaceFactorization {
                 on_interface[eq] = true;
             }
         }
-        let blocks: Vec<Block> = pattern
-            .diagonal_blocks()
-            .into_par_iter()
-            .map(|range| Block::new(pattern, range, &on_interface))
-            .collect::<Result<_>>()?;
+        let blocks: Vec<Block> = ordering::largest_first(pattern.diagonal_blocks(), |range| {
+            Block::new(pattern, range, &on_interface)
+        })?;
         let interface: Vec<usize> = blocks
             .iter()
             .flat_map(|b| b.interface.iter().map(move |&e| b.first + e))

@@ -6,6 +6,7 @@ pub mod fixed_point;
 pub mod interface;
 pub mod linear;
 pub mod newton;
+pub mod ordering;
 pub mod pieces;
 
 use crate::contact::{self, Interface, Method, Row};

@@ -10,16 +10,15 @@
 //! whole run factorizes the stiffness once, like the floor.
 
 use super::interface::{ActiveSet, InterfaceFactorization};
-use super::linear::{SparseSystem, gmres};
-use super::pieces;
+use super::linear::{OrderedCholesky, SparseSystem, gmres};
 use super::{Problem, Settings, State, StepReport, StepSolver, inf_norm};
 use super::{Timings, timed};
+use super::{ordering, pieces};
 use crate::contact;
 use crate::error::{Error, Result};
 use crate::fe::{FIXED, Pattern};
 use crate::material::Stress;
 use nalgebra::Matrix3;
-use rayon::prelude::*;
 use std::cell::Cell;
 
 /// Newton solver state (pattern, slots, factorization) for one problem.
@@ -200,29 +199,22 @@ pub fn floor_time(p: &Problem, steps: usize) -> Result<f64> {
     });
     // The stiffness is block diagonal (one block per body): the best the machine can do
     // factorizes the blocks apart, on rayon's threads, as the solver does.
-    pattern
-        .diagonal_blocks()
-        .into_par_iter()
-        .map(|range| {
-            let first = range.start;
-            let mut system = pieces::time("floor.block", first, || {
-                let (block, entries) = pattern.block(&range);
-                let mut system = SparseSystem::new(&block);
-                system.values_mut().copy_from_slice(&values[entries]);
-                system
-            });
-            pieces::time("floor.factor", first, || system.factor_llt())?;
-            pieces::record("floor.symbolic", first, system.symbolic_s);
-            pieces::record("floor.numeric", first, system.factor_s);
-            let mut rhs = vec![1.0; range.len()];
-            pieces::time("floor.solves", first, || {
-                for _ in 0..steps {
-                    system.solve(&mut rhs);
-                }
-            });
-            Ok(())
-        })
-        .collect::<Result<()>>()?;
+    ordering::largest_first(pattern.diagonal_blocks(), |range| {
+        let first = range.start;
+        let (block, entries) = pieces::time("floor.block", first, || pattern.block(&range));
+        let order = ordering::order(&block, &vec![false; block.n], None, first)?;
+        let mut system = OrderedCholesky::new(&block, &order)?;
+        system.factor(&values[entries])?;
+        pieces::record("floor.symbolic", first, system.symbolic_s);
+        pieces::record("floor.numeric", first, system.factor_s);
+        let mut rhs = vec![1.0; range.len()];
+        pieces::time("floor.solves", first, || {
+            for _ in 0..steps {
+                system.solve(&mut rhs);
+            }
+        });
+        Ok(())
+    })?;
     pieces::record("floor.total", 0, t0.elapsed().as_secs_f64());
     Ok(t0.elapsed().as_secs_f64())
 }
