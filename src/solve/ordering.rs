@@ -5,10 +5,14 @@
 //! nodes (a node's unknowns collapsed into one vertex), optionally with some equations (the
 //! contact interface) last.
 //!
-//! Measured with `examples/ordering_fill.rs` on the meshes of `study speed` (see the README):
-//! from about 1e4 dofs nested dissection needs fewer flops than AMD (3.0x fewer at 2.2e6
-//! dofs) and the numeric factorization is correspondingly faster; below, AMD is as good and
-//! orders faster. [`Method::for_size`] chooses.
+//! Measured with `examples/ordering_fill.rs` on the meshes of `study speed` (one numeric
+//! LDL^T, sequential, both bodies, interface last): nested dissection needs fewer flops
+//! than AMD from 1e4 dofs on (3.9e9 against 2.1e9 at 1.4e5 dofs, 4.5e10 against 1.8e10 at
+//! 5.5e5, 4.2e11 against 1.5e11 at 2.2e6), but METIS orders 4-5x slower than AMD: at 5.5e5
+//! dofs (bodies of 1.8e5 and 3.7e5 equations) it spends 1.0-1.5 s more ordering than it
+//! saves in the numeric factorization (2.0 s against 1.4-1.7 s), at 2.2e6 dofs (7.2e5 and
+//! 1.5e6) it saves about 9 s of numeric work (16.1 s against 7.3 s) for 4 s more ordering.
+//! [`Method::for_size`] chooses by the block's size ([`METIS_FROM`]).
 
 use super::pieces;
 use crate::error::{Error, Result};
@@ -32,11 +36,17 @@ pub enum Method {
 
 /// Blocks with at least this many equations (ordered ones, the interface excluded) are
 /// ordered by METIS, smaller ones by AMD (see the module).
-pub const METIS_FROM: usize = 20_000;
+pub const METIS_FROM: usize = 500_000;
 
 /// METIS's random seed (its default, stated: the orderings, hence the factors and the
 /// solutions, are the same from run to run).
 const METIS_SEED: metis_sys::idx_t = 4321;
+
+/// Refinement iterations of METIS's separators (its default: 10); with coarsening by
+/// random matching (default: sorted heavy-edge). Measured at 2.2e6 dofs: 5.9 s instead of
+/// 7.2 s to order both bodies, for 1.30e11 flops instead of 1.29e11 (1.49e11 instead of
+/// 1.44e11 with the interface last); at 5.5e5 dofs 1.4 s instead of 1.85 s.
+const METIS_NITER: metis_sys::idx_t = 1;
 
 /// METIS keeps its random generator's state in globals (GKlib's Mersenne twister, not
 /// thread-local): two orderings at once on two threads would draw from one sequence in
@@ -185,6 +195,9 @@ fn metis_order(block: &Pattern, vertices: &[usize]) -> Result<Vec<usize>> {
         let status = unsafe {
             metis_sys::METIS_SetDefaultOptions(options.as_mut_ptr());
             options[metis_sys::moptions_et_METIS_OPTION_SEED as usize] = METIS_SEED;
+            options[metis_sys::moptions_et_METIS_OPTION_NITER as usize] = METIS_NITER;
+            options[metis_sys::moptions_et_METIS_OPTION_CTYPE as usize] =
+                metis_sys::mctype_et_METIS_CTYPE_RM as metis_sys::idx_t;
             metis_sys::METIS_NodeND(
                 &mut n,
                 xadj.as_mut_ptr(),
