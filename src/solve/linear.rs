@@ -1,6 +1,6 @@
 //! Sparse linear algebra on a fixed pattern: the values are refilled in place, the symbolic
 //! analysis is done once, and numeric factorizations are timed: faer's sparse Cholesky
-//! (AMD ordering; the floor) and sparse LU (the Newton matrix itself, the fallback of
+//! (AMD ordering, or a given one: [`OrderedCholesky`], the floor's) and sparse LU (the Newton matrix itself, the fallback of
 //! stiff tangents), products, and GMRES. The default solver's factorization is in
 //! [`super::interface`].
 
