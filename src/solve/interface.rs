@@ -25,6 +25,7 @@
 //! solves with the whole factor only, and this needs the forward and back substitutions
 //! apart, with the interface solve in between.
 
+use super::{ordering, pieces};
 use crate::error::{Error, Result};
 use crate::fe::{Pattern, split_ranges_mut};
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -32,7 +33,6 @@ use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::solvers::{PartialPivLu, SolveCore};
 use faer::perm::PermRef;
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::supernodal::{SupernodalLdltRef, SymbolicSupernodalCholesky};
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
@@ -97,18 +97,44 @@ struct Block {
 
 /// The numeric part of a block: values of the factor and the interface's dense blocks.
 struct Numeric {
-    /// Values of the supernodal L (unit diagonal) with D on its diagonal.
+    /// Values of the supernodal L (unit diagonal) with D on its diagonal; with `single`,
+    /// rounded to f32 in place: the first half of the buffer's bytes holds them (see
+    /// [`Numeric::single_values`]).
     values: Vec<f64>,
     /// 1 / D, in elimination order.
     inverse_diagonal: Vec<f64>,
-    /// The values of L rounded to single precision, for the solves (see
+    /// Whether `values` holds L rounded to single precision, for the solves (see
     /// [`InterfaceFactorization::factor`]).
-    single: Option<Vec<f32>>,
+    single: bool,
     /// Symmetric scaling W (local equation order): W (K + sigma P^T P) W was factorized.
     scaling: Vec<f64>,
     /// The trailing block of L (unit lower triangular) and of D.
     l_interface: Mat<f64>,
     d_interface: Vec<f64>,
+}
+
+/// Round `values` to f32 in place: afterwards the first `values.len()` f32 of the buffer
+/// (its first half) are the rounded values (read them with [`Numeric::single_values`]).
+fn round_in_place(values: &mut [f64]) {
+    let wide = values.as_mut_ptr();
+    let narrow = wide as *mut f32;
+    for i in 0..values.len() {
+        // SAFETY: f32 i occupies bytes 4i..4i+4, within f64 i's bytes 8i..8i+8 for i = 0
+        // (read before the write) and before them for i > 0: no f64 not yet read is
+        // overwritten; both pointers are in the buffer and aligned (f64's alignment is a
+        // multiple of f32's).
+        unsafe { narrow.add(i).write(wide.add(i).read() as f32) };
+    }
+}
+
+impl Numeric {
+    /// L rounded to f32 (see [`round_in_place`]); only when `single`.
+    fn single_values(&self) -> &[f32] {
+        debug_assert!(self.single);
+        // SAFETY: the buffer holds values.len() f64, twice the bytes of as many f32, the
+        // first half written by round_in_place; f32 has no invalid bit pattern.
+        unsafe { std::slice::from_raw_parts(self.values.as_ptr() as *const f32, self.values.len()) }
+    }
 }
 
 /// A stored value of the factor: f64, or f32 for the solves of a preconditioner.
@@ -179,61 +205,22 @@ impl ActiveSet {
 const PIVOT_EPSILON: f64 = 1e-12;
 const PIVOT_REPLACEMENT: f64 = 1e-6;
 
-/// The elimination order of one body's block (pattern with both triangles): faer's AMD of
-/// the equations not on the interface, then the equations on it (`on_interface`, per
-/// equation of the block) in equation order. The default solver's ordering; public for
-/// `examples/ordering_fill.rs`, which measures it against others.
-pub fn interface_last_order(block: &Pattern, on_interface: &[bool]) -> Result<Vec<usize>> {
-    let n = block.n;
-    let (col_ptr, row_idx) = (&block.col_ptr, &block.row_idx);
-    let interface = (0..n).filter(|&e| on_interface[e]);
-    let interior: Vec<usize> = (0..n).filter(|&e| !on_interface[e]).collect();
-    let mut interior_index = vec![usize::MAX; n];
-    for (k, &e) in interior.iter().enumerate() {
-        interior_index[e] = k;
-    }
-    let (mut interior_ptr, mut interior_rows) = (vec![0usize], Vec::new());
-    for &e in &interior {
-        interior_rows.extend(
-            row_idx[col_ptr[e]..col_ptr[e + 1]]
-                .iter()
-                .map(|&r| interior_index[r])
-                .filter(|&r| r != usize::MAX),
-        );
-        interior_ptr.push(interior_rows.len());
-    }
-    let ni = interior.len();
-    let interior_pattern =
-        SymbolicSparseColMat::new_checked(ni, ni, interior_ptr, None, interior_rows);
-    let (mut fwd, mut inv) = (vec![0usize; ni], vec![0usize; ni]);
-    let mut buffer = MemBuffer::try_new(amd::order_scratch::<usize>(
-        ni,
-        interior_pattern.row_idx().len(),
-    ))
-    .map_err(|_| Error::NotConverged("out of memory in the ordering".into()))?;
-    amd::order(
-        &mut fwd,
-        &mut inv,
-        interior_pattern.as_ref(),
-        Default::default(),
-        MemStack::new(&mut buffer),
-    )
-    .map_err(|e| Error::NotConverged(format!("ordering failed: {e:?}")))?;
-    Ok(fwd.iter().map(|&k| interior[k]).chain(interface).collect())
-}
-
 impl Block {
     /// The block of equations `range` of `pattern`, with its equations on the interface
-    /// (`on_interface`, global) last: AMD of the interior, then the interface.
+    /// (`on_interface`, global) last: the interior in the order of [`ordering::order`]
+    /// (METIS's nested dissection of the nodes, or AMD for a small block), then the
+    /// interface.
     fn new(
         pattern: &Pattern,
         range: std::ops::Range<usize>,
         on_interface: &[bool],
     ) -> Result<Self> {
         let (first, n) = (range.start, range.len());
-        let (block, entries) = pattern.block(&range);
+        let (block, entries) = pieces::time("setup.block", first, || pattern.block(&range));
         let local_interface = &on_interface[range.clone()];
-        let order = interface_last_order(&block, local_interface)?;
+        let order = pieces::time("setup.order", first, || {
+            ordering::order(&block, local_interface, None, first)
+        })?;
         let interface: Vec<usize> = (0..n).filter(|&e| local_interface[e]).collect();
         let Pattern {
             col_ptr, row_idx, ..
@@ -250,15 +237,17 @@ impl Block {
             .collect();
         let block_pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         let perm = PermRef::new_checked(&order, &position, n);
-        let symbolic = factorize_symbolic_cholesky(
-            block_pattern.as_ref(),
-            Side::Lower,
-            SymmetricOrdering::Custom(perm),
-            CholeskySymbolicParams {
-                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-                ..Default::default()
-            },
-        )
+        let symbolic = pieces::time("setup.symbolic", first, || {
+            factorize_symbolic_cholesky(
+                block_pattern.as_ref(),
+                Side::Lower,
+                SymmetricOrdering::Custom(perm),
+                CholeskySymbolicParams {
+                    supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                    ..Default::default()
+                },
+            )
+        })
         .map_err(|e| Error::NotConverged(format!("symbolic LDLT failed: {e:?}")))?;
         Ok(Block {
             first,
@@ -284,6 +273,7 @@ impl Block {
     /// return its Schur complement onto its interface (see
     /// [`InterfaceFactorization::factor`]).
     fn factor(&mut self, values: &mut [f64], shift: f64, single: bool) -> Result<Mat<f64>> {
+        let t = Instant::now();
         for &e in &self.interface {
             values[self.diagonal[e]] += shift;
         }
@@ -303,6 +293,8 @@ impl Block {
                 values[start + s] *= scaling[i] * scaling[j];
             }
         }
+        pieces::record("factor.scale", self.first, t.elapsed().as_secs_f64());
+        let t = Instant::now();
         let mut l_values = self.numeric.take().map(|f| f.values).unwrap_or_default();
         l_values.resize(self.symbolic.len_val(), 0.0);
         let mut buffer = MemBuffer::try_new(
@@ -311,6 +303,8 @@ impl Block {
         )
         .map_err(|_| Error::NotConverged("out of memory in the LDLT".into()))?;
         let signs = vec![1i8; self.n];
+        pieces::record("factor.allocate", self.first, t.elapsed().as_secs_f64());
+        let t = Instant::now();
         self.symbolic
             .factorize_numeric_ldlt(
                 &mut l_values,
@@ -326,6 +320,8 @@ impl Block {
                 Default::default(),
             )
             .map_err(|e| Error::NotConverged(format!("LDLT failed: {e:?}")))?;
+        pieces::record("factor.numeric", self.first, t.elapsed().as_secs_f64());
+        let t = Instant::now();
         let (l_interface, d_interface) = self.trailing_block(&l_values);
         // S = W_I^{-1} L D L^T W_I^{-1} - sigma I.
         let b = self.interface.len();
@@ -344,6 +340,8 @@ impl Block {
             let s = 0.5 * (ldl[(i, j)] + ldl[(j, i)]) / (w[i] * w[j]);
             if i == j { s - shift } else { s }
         });
+        pieces::record("factor.schur", self.first, t.elapsed().as_secs_f64());
+        let t = Instant::now();
         let mut inverse_diagonal = vec![0.0; self.n];
         for (start, width, pattern, values) in self.supernodes(&l_values) {
             let rows = width + pattern.len();
@@ -351,7 +349,18 @@ impl Block {
                 inverse_diagonal[start + j] = 1.0 / values[j * rows + j];
             }
         }
-        let single = single.then(|| l_values.iter().map(|&v| v as f32).collect());
+        pieces::record(
+            "factor.inverse_diagonal",
+            self.first,
+            t.elapsed().as_secs_f64(),
+        );
+        if single {
+            // In place: a separate f32 copy would cost its pages' first touch (measured at
+            // 2.2e6 dofs: 1.8-4.6 s for a block's copy on this machine).
+            pieces::time("factor.single", self.first, || {
+                round_in_place(&mut l_values)
+            });
+        }
         self.numeric = Some(Numeric {
             single,
             inverse_diagonal,
@@ -462,11 +471,9 @@ impl InterfaceFactorization {
                 on_interface[eq] = true;
             }
         }
-        let blocks: Vec<Block> = pattern
-            .diagonal_blocks()
-            .into_par_iter()
-            .map(|range| Block::new(pattern, range, &on_interface))
-            .collect::<Result<_>>()?;
+        let blocks: Vec<Block> = ordering::largest_first(pattern.diagonal_blocks(), |range| {
+            Block::new(pattern, range, &on_interface)
+        })?;
         let interface: Vec<usize> = blocks
             .iter()
             .flat_map(|b| b.interface.iter().map(move |&e| b.first + e))
@@ -538,6 +545,7 @@ impl InterfaceFactorization {
             offset += s.nrows();
         }
         self.schur = Some(schur);
+        pieces::record("factor.total", 0, t.elapsed().as_secs_f64());
         self.factorizations += 1;
         self.factor_s
             .set(self.factor_s.get() + t.elapsed().as_secs_f64());
@@ -559,6 +567,7 @@ impl InterfaceFactorization {
         }
         self.factor_s
             .set(self.factor_s.get() + t.elapsed().as_secs_f64());
+        pieces::record("active_set.lu", 0, t.elapsed().as_secs_f64());
         Ok(ActiveSet {
             active: active.to_vec(),
             rows,
@@ -594,10 +603,13 @@ impl InterfaceFactorization {
     pub fn solve(&self, set: &ActiveSet, c: f64, v: &mut [f64]) {
         let n = self.n;
         let (f, g) = v.split_at_mut(n);
-        let condensed = self.condense(f);
-        let (x_interface, y) = self.interface_solve(set, c, &condensed.load, g);
+        let condensed = pieces::time("solve.forward", 0, || self.condense(f));
+        let (x_interface, y) = pieces::time("solve.interface", 0, || {
+            self.interface_solve(set, c, &condensed.load, g)
+        });
         g.copy_from_slice(&y);
-        f.copy_from_slice(&self.expand(condensed, &x_interface));
+        let x = pieces::time("solve.back", 0, || self.expand(condensed, &x_interface));
+        f.copy_from_slice(&x);
     }
 
     /// Forward substitution of the load `f` (n): what the interface sees of it (the
@@ -707,22 +719,22 @@ impl Block {
         })
     }
 
-    /// x <- L^{-1} x, with the single-precision copy of L when there is one.
+    /// x <- L^{-1} x, with L in single precision when it is.
     fn forward(&self, numeric: &Numeric, x: &mut [f64]) {
-        match &numeric.single {
-            Some(values) => self.forward_with(values, x),
-            None => self.forward_with(&numeric.values, x),
+        match numeric.single {
+            true => self.forward_with(numeric.single_values(), x),
+            false => self.forward_with(&numeric.values, x),
         }
     }
 
-    /// x <- L^{-T} D^{-1} x, with the single-precision copy of L when there is one.
+    /// x <- L^{-T} D^{-1} x, with L in single precision when it is.
     fn diagonal_and_back(&self, numeric: &Numeric, x: &mut [f64]) {
         for (xi, d) in x.iter_mut().zip(&numeric.inverse_diagonal) {
             *xi *= d;
         }
-        match &numeric.single {
-            Some(values) => self.back_with(values, x),
-            None => self.back_with(&numeric.values, x),
+        match numeric.single {
+            true => self.back_with(numeric.single_values(), x),
+            false => self.back_with(&numeric.values, x),
         }
     }
 

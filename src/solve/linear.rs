@@ -1,14 +1,20 @@
 //! Sparse linear algebra on a fixed pattern: the values are refilled in place, the symbolic
 //! analysis is done once, and numeric factorizations are timed: faer's sparse Cholesky
-//! (AMD ordering; the floor) and sparse LU (the Newton matrix itself, the fallback of
+//! (AMD ordering, or a given one: [`OrderedCholesky`], the floor's) and sparse LU (the Newton matrix itself, the fallback of
 //! stiff tangents), products, and GMRES. The default solver's factorization is in
 //! [`super::interface`].
 
 use crate::error::{Error, Result};
 use crate::fe::{Pattern, split_ranges_mut};
-use faer::Side;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::perm::PermRef;
+use faer::sparse::SparseColMatRef;
+use faer::sparse::linalg::cholesky::{
+    LltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
+};
 use faer::sparse::linalg::solvers::{Llt, Lu, SymbolicLlt, SymbolicLu};
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use faer::{Conj, Par, Side};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -165,6 +171,94 @@ impl SparseSystem {
         } else {
             product(0..x.len(), y);
         }
+    }
+}
+
+/// A sparse Cholesky factorization L L^T of a symmetric positive definite matrix in a given
+/// elimination order (the floor's: see [`super::floor_time`]): faer's symbolic analysis,
+/// numeric factorization and substitutions, timed apart.
+pub struct OrderedCholesky {
+    pattern: SymbolicSparseColMat<usize>,
+    symbolic: SymbolicCholesky<usize>,
+    values: Vec<f64>,
+    /// Seconds in the numeric factorizations.
+    pub factor_s: f64,
+    /// Seconds in the symbolic analysis (the ordering given).
+    pub symbolic_s: f64,
+}
+
+impl OrderedCholesky {
+    /// The symbolic analysis of `pattern` (both triangles; the lower one is read) in the
+    /// elimination order `order` (the equation eliminated first, second, ...).
+    pub fn new(pattern: &Pattern, order: &[usize]) -> Result<Self> {
+        let t = Instant::now();
+        let n = pattern.n;
+        let pattern = SymbolicSparseColMat::new_checked(
+            n,
+            n,
+            pattern.col_ptr.clone(),
+            None,
+            pattern.row_idx.clone(),
+        );
+        let mut position = vec![0usize; n];
+        for (p, &e) in order.iter().enumerate() {
+            position[e] = p;
+        }
+        let symbolic = factorize_symbolic_cholesky(
+            pattern.as_ref(),
+            Side::Lower,
+            SymmetricOrdering::Custom(PermRef::new_checked(order, &position, n)),
+            Default::default(),
+        )
+        .map_err(|e| Error::NotConverged(format!("symbolic Cholesky failed: {e:?}")))?;
+        Ok(OrderedCholesky {
+            pattern,
+            symbolic,
+            values: Vec::new(),
+            factor_s: 0.0,
+            symbolic_s: t.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// Factorize the matrix whose values (pattern order) are `values`.
+    pub fn factor(&mut self, values: &[f64]) -> Result<()> {
+        let t = Instant::now();
+        self.values.clear();
+        self.values.resize(self.symbolic.len_val(), 0.0);
+        let mut buffer = MemBuffer::try_new(
+            self.symbolic
+                .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
+        )
+        .map_err(|_| Error::NotConverged("out of memory in the Cholesky".into()))?;
+        self.symbolic
+            .factorize_numeric_llt(
+                &mut self.values,
+                SparseColMatRef::new(self.pattern.as_ref(), values),
+                Side::Lower,
+                Default::default(),
+                Par::Seq,
+                MemStack::new(&mut buffer),
+                Default::default(),
+            )
+            .map_err(|e| {
+                Error::NotConverged(format!(
+                    "the matrix is not positive definite ({e:?}): is a body free to move?"
+                ))
+            })?;
+        self.factor_s += t.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// Solve with the factorization, in place.
+    pub fn solve(&self, rhs: &mut [f64]) {
+        let n = rhs.len();
+        let mut buffer = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
+        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
+            Conj::No,
+            faer::MatMut::from_column_major_slice_mut(rhs, n, 1),
+            Par::Seq,
+            MemStack::new(&mut buffer),
+        );
     }
 }
 

@@ -7,6 +7,8 @@ pub mod fixed_point;
 pub mod interface;
 pub mod linear;
 pub mod newton;
+pub mod ordering;
+pub mod pieces;
 
 use crate::contact::{self, Interface, Method, Row};
 use crate::error::{Error, Result};
@@ -212,8 +214,8 @@ impl Solution {
 
 /// The floor a solver is judged by (SPEC section 7), measured on the same mesh and
 /// machine: what the problem cannot avoid, from scratch: the pattern and values of the
-/// elastic stiffness (assembled once), one sparse Cholesky factorization (faer's AMD
-/// ordering, symbolic and numeric) and two triangular solves (one forward-backward pair)
+/// elastic stiffness (assembled once), one sparse Cholesky factorization (ordering by
+/// [`ordering::order`], symbolic and numeric) and two triangular solves (one forward-backward pair)
 /// per time step. Seconds. The stiffness is shifted by [`newton::FLOOR_SHIFT`] times its
 /// mean diagonal, so that a body held only by contact does not make it singular. Compare
 /// it with a solver's set-up plus time loop (`RunSummary::ratio_to_floor`).

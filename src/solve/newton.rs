@@ -11,15 +11,15 @@
 
 use super::elimination::{Elimination, Increment};
 use super::interface::{ActiveSet, InterfaceFactorization};
-use super::linear::{SparseSystem, gmres};
+use super::linear::{OrderedCholesky, SparseSystem, gmres};
 use super::{Problem, Settings, State, StepReport, StepSolver, inf_norm};
 use super::{Timings, timed};
+use super::{ordering, pieces};
 use crate::contact;
 use crate::error::{Error, Result};
 use crate::fe::{FIXED, Pattern};
 use crate::material::Stress;
 use nalgebra::Matrix3;
-use rayon::prelude::*;
 use std::cell::Cell;
 
 /// Newton solver state (pattern, slots, factorization) for one problem.
@@ -188,31 +188,37 @@ pub fn floor_time(p: &Problem, steps: usize) -> Result<f64> {
     let t0 = std::time::Instant::now();
     let model = &p.model;
     let n = model.n_free;
-    let (pattern, slots) = model.stiffness_pattern(&[], n);
-    let mut values = vec![0.0; pattern.nnz()];
-    model.add_tangent(&model.elastic_tangents(), &slots, &mut values);
-    let diagonal: Vec<usize> = (0..n).map(|i| pattern.slot(i, i)).collect();
-    let shift = FLOOR_SHIFT * diagonal.iter().map(|&s| values[s]).sum::<f64>() / n.max(1) as f64;
-    for &s in &diagonal {
-        values[s] += shift;
-    }
+    let (pattern, slots) = pieces::time("floor.pattern", 0, || model.stiffness_pattern(&[], n));
+    let values = pieces::time("floor.values", 0, || {
+        let mut values = vec![0.0; pattern.nnz()];
+        model.add_tangent(&model.elastic_tangents(), &slots, &mut values);
+        let diagonal: Vec<usize> = (0..n).map(|i| pattern.slot(i, i)).collect();
+        let shift =
+            FLOOR_SHIFT * diagonal.iter().map(|&s| values[s]).sum::<f64>() / n.max(1) as f64;
+        for &s in &diagonal {
+            values[s] += shift;
+        }
+        values
+    });
     // The stiffness is block diagonal (one block per body): the best the machine can do
     // factorizes the blocks apart, on rayon's threads, as the solver does.
-    pattern
-        .diagonal_blocks()
-        .into_par_iter()
-        .map(|range| {
-            let (block, entries) = pattern.block(&range);
-            let mut system = SparseSystem::new(&block);
-            system.values_mut().copy_from_slice(&values[entries]);
-            system.factor_llt()?;
-            let mut rhs = vec![1.0; range.len()];
+    ordering::largest_first(pattern.diagonal_blocks(), |range| {
+        let first = range.start;
+        let (block, entries) = pieces::time("floor.block", first, || pattern.block(&range));
+        let order = ordering::order(&block, &vec![false; block.n], None, first)?;
+        let mut system = OrderedCholesky::new(&block, &order)?;
+        system.factor(&values[entries])?;
+        pieces::record("floor.symbolic", first, system.symbolic_s);
+        pieces::record("floor.numeric", first, system.factor_s);
+        let mut rhs = vec![1.0; range.len()];
+        pieces::time("floor.solves", first, || {
             for _ in 0..steps {
                 system.solve(&mut rhs);
             }
-            Ok(())
-        })
-        .collect::<Result<()>>()?;
+        });
+        Ok(())
+    })?;
+    pieces::record("floor.total", 0, t0.elapsed().as_secs_f64());
     Ok(t0.elapsed().as_secs_f64())
 }
 
@@ -221,7 +227,8 @@ impl<'a> Newton<'a> {
     pub fn new(p: &'a Problem, settings: &Settings) -> Result<Self> {
         let t_setup = std::time::Instant::now();
         let n = p.model.n_free;
-        let (pattern, slots) = p.model.stiffness_pattern(&[], n);
+        let (pattern, slots) =
+            pieces::time("setup.pattern", 0, || p.model.stiffness_pattern(&[], n));
         let rows: Vec<Vec<(usize, f64)>> = p
             .rows
             .iter()
@@ -233,17 +240,24 @@ impl<'a> Newton<'a> {
                     .collect()
             })
             .collect();
-        let mut stiffness = SparseSystem::new(&pattern);
-        let vals = stiffness.values_mut();
-        p.model
-            .add_tangent(&p.model.elastic_tangents(), &slots, vals);
-        let elastic_values = vals.to_vec();
+        let (stiffness, elastic_values) = pieces::time("setup.values", 0, || {
+            let mut stiffness = SparseSystem::new(&pattern);
+            let vals = stiffness.values_mut();
+            p.model
+                .add_tangent(&p.model.elastic_tangents(), &slots, vals);
+            let elastic_values = vals.to_vec();
+            (stiffness, elastic_values)
+        });
         // Stiffness scale: the mean diagonal of the elastic stiffness.
         let c_scale = (0..n)
             .map(|i| elastic_values[pattern.slot(i, i)])
             .sum::<f64>()
             / n.max(1) as f64;
-        let factorization = InterfaceFactorization::new(&pattern, &rows)?;
+        let factorization = pieces::time("setup.interface_analysis", 0, || {
+            InterfaceFactorization::new(&pattern, &rows)
+        })?;
+        let setup_s = t_setup.elapsed().as_secs_f64();
+        pieces::record("setup.total", 0, setup_s);
         Ok(Newton {
             p,
             settings: *settings,
@@ -258,7 +272,7 @@ impl<'a> Newton<'a> {
             stale: false,
             c_scale,
             clock: Default::default(),
-            setup_s: t_setup.elapsed().as_secs_f64(),
+            setup_s,
             elastic_values,
             symmetric_values: Vec::new(),
             fresh_iterations: 0,
