@@ -624,29 +624,41 @@ impl Model {
         source: Option<&[Stress]>,
         tangent: bool,
     ) -> (Vec<Stress>, Vec<Matrix3<f64>>) {
-        let update = |(i, _): (usize, &Element)| {
-            let (s, d) = self.update_element(i, u, u_prev, sigma_prev, k, source);
-            (s, if tangent { d } else { Matrix3::zeros() })
-        };
+        let update =
+            |(i, _): (usize, &Element)| self.update_element(i, u, u_prev, sigma_prev, k, source);
         // On rayon's threads from PARALLEL_ELEMENTS triangles on (each triangle alone: the
         // same numbers on any number of threads); below, serial: a rayon version was
         // measured slower on 2 cores at 14k triangles (9-11 ms against 6 ms per 4-step
-        // solve).
-        let (sig, mut tan): (Vec<Stress>, Vec<Matrix3<f64>>) =
-            if self.elements.len() >= PARALLEL_ELEMENTS {
+        // solve). Without `tangent` no tangent is stored (at 2.2e6 triangles they are
+        // 150 MB of fresh pages per update).
+        let parallel = self.elements.len() >= PARALLEL_ELEMENTS;
+        match (tangent, parallel) {
+            (true, true) => self
+                .elements
+                .par_iter()
+                .enumerate()
+                .with_min_len(4096)
+                .map(update)
+                .unzip(),
+            (true, false) => self.elements.iter().enumerate().map(update).unzip(),
+            (false, true) => (
                 self.elements
                     .par_iter()
                     .enumerate()
                     .with_min_len(4096)
-                    .map(update)
-                    .unzip()
-            } else {
-                self.elements.iter().enumerate().map(update).unzip()
-            };
-        if !tangent {
-            tan.clear();
+                    .map(|x| update(x).0)
+                    .collect(),
+                Vec::new(),
+            ),
+            (false, false) => (
+                self.elements
+                    .iter()
+                    .enumerate()
+                    .map(|x| update(x).0)
+                    .collect(),
+                Vec::new(),
+            ),
         }
-        (sig, tan)
     }
 
     /// The constitutive update of element `i` alone (see [`Model::update_stresses`]): its
@@ -706,25 +718,64 @@ impl Model {
         values: &mut [f64],
     ) {
         for ((e, d), sl) in self.elements.iter().zip(tangents).zip(slots) {
-            scatter_tangent(e, d, sl, values);
+            scatter_tangent(e, d, sl, 0, values);
         }
     }
 
     /// Add `|T| B^T (D - E) S B` for the elements whose tangent D differs from the elastic
     /// E of their body (the viscoplastic ones): on top of the assembled elastic stiffness,
     /// this assembles the consistent tangent while elastic triangles cost nothing.
+    /// `split`: [`Model::body_slot_split`] of `slots`, computed once by the caller.
     pub fn add_tangent_change(
         &self,
         tangents: &[Matrix3<f64>],
         slots: &[[usize; 36]],
+        split: Option<usize>,
         values: &mut [f64],
     ) {
-        for ((e, d), sl) in self.elements.iter().zip(tangents).zip(slots) {
-            let elastic = self.materials[e.body].elastic.matrix();
-            if *d != elastic {
-                scatter_tangent(e, &(d - elastic), sl, values);
+        // A body with no viscoplastic part is skipped whole. From PARALLEL_ELEMENTS
+        // triangles on, the two bodies on two threads when their slots are apart (the
+        // stiffness is block diagonal: body 1's values follow body 0's), each in element
+        // order: every slot gets the same sums in the same order as on one thread.
+        let flows = |body: usize| self.materials[body].viscoplastic.is_some();
+        let add = |body: usize, values: &mut [f64], offset: usize| {
+            if !flows(body) {
+                return;
+            }
+            let elastic = self.materials[body].elastic.matrix();
+            for ((e, d), sl) in self.elements.iter().zip(tangents).zip(slots) {
+                if e.body == body && *d != elastic {
+                    scatter_tangent(e, &(d - elastic), sl, offset, values);
+                }
+            }
+        };
+        let split =
+            split.filter(|_| self.elements.len() >= PARALLEL_ELEMENTS && flows(0) && flows(1));
+        match split {
+            Some(split) => {
+                let (first, second) = values.split_at_mut(split);
+                rayon::join(|| add(0, first, 0), || add(1, second, split));
+            }
+            None => {
+                add(0, values, 0);
+                add(1, values, 0);
             }
         }
+    }
+
+    /// The first value slot of body 1 when every slot of body 0's triangles is below it
+    /// and every slot of body 1's at or above it (the stiffness's values split between
+    /// the bodies), else None.
+    pub fn body_slot_split(&self, slots: &[[usize; 36]]) -> Option<usize> {
+        let (mut below, mut above) = (0usize, usize::MAX);
+        for (e, sl) in self.elements.iter().zip(slots) {
+            let used = sl.iter().filter(|&&s| s != FIXED);
+            match e.body {
+                0 => below = below.max(used.max().map_or(0, |&s| s + 1)),
+                _ => above = above.min(used.min().copied().unwrap_or(usize::MAX)),
+            }
+        }
+        (below <= above && above != usize::MAX).then_some(below)
     }
 
     /// Elastic tangents of all elements (E of each body).
@@ -758,13 +809,19 @@ pub const PARALLEL_ELEMENTS: usize = 50_000;
 
 /// Add `|T| B^T D S B` of one element into `values` through its slot map (S halves the
 /// engineering shear).
-fn scatter_tangent(e: &Element, d: &Matrix3<f64>, slots: &[usize; 36], values: &mut [f64]) {
+fn scatter_tangent(
+    e: &Element,
+    d: &Matrix3<f64>,
+    slots: &[usize; 36],
+    offset: usize,
+    values: &mut [f64],
+) {
     let ke = e.stiffness(d);
     for i in 0..6 {
         for j in 0..6 {
             let slot = slots[6 * i + j];
             if slot != FIXED {
-                values[slot] += ke[(i, j)];
+                values[slot - offset] += ke[(i, j)];
             }
         }
     }

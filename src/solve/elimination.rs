@@ -116,8 +116,11 @@ pub struct Increment<'a> {
 /// The mesh's adjacency for the local solves, built once per problem (the constrained
 /// dofs, which they never move, are read from [`Model::equation`]).
 pub struct Elimination {
-    /// Triangles around each node.
-    node_elements: Vec<Vec<usize>>,
+    /// Triangles around each node, built at the first elimination (most solves never
+    /// eliminate: at 2.2e6 dofs the lists cost a million allocations).
+    node_elements: std::cell::OnceCell<Vec<Vec<usize>>>,
+    /// Nodes of the mesh.
+    n_nodes: usize,
 }
 
 /// What one [`Elimination::relax`] did.
@@ -132,13 +135,23 @@ pub struct Relaxed {
 impl Elimination {
     /// Adjacency of `model`.
     pub fn new(model: &Model) -> Self {
-        let mut node_elements = vec![Vec::new(); model.n_nodes];
-        for (i, e) in model.elements.iter().enumerate() {
-            for &a in &e.nodes {
-                node_elements[a].push(i);
-            }
+        Elimination {
+            node_elements: std::cell::OnceCell::new(),
+            n_nodes: model.n_nodes,
         }
-        Elimination { node_elements }
+    }
+
+    /// Triangles around each node of `model` (the model of [`Elimination::new`]).
+    fn node_elements(&self, model: &Model) -> &[Vec<usize>] {
+        self.node_elements.get_or_init(|| {
+            let mut node_elements = vec![Vec::new(); self.n_nodes];
+            for (i, e) in model.elements.iter().enumerate() {
+                for &a in &e.nodes {
+                    node_elements[a].push(i);
+                }
+            }
+            node_elements
+        })
     }
 
     /// The viscoplastic triangles whose linear model fails on the step from `u` (stresses
@@ -176,12 +189,13 @@ impl Elimination {
 
     /// `triangles` and [`RINGS`] rings of viscoplastic triangles around them, sorted.
     pub fn region(&self, model: &Model, triangles: &[usize]) -> Vec<usize> {
+        let node_elements = self.node_elements(model);
         let mut region = triangles.to_vec();
         for _ in 0..RINGS {
             region = region
                 .iter()
                 .flat_map(|&i| model.elements[i].nodes)
-                .flat_map(|a| self.node_elements[a].iter().copied())
+                .flat_map(|a| node_elements[a].iter().copied())
                 .chain(region.iter().copied())
                 .filter(|&i| {
                     model.materials[model.elements[i].body]
@@ -237,7 +251,7 @@ impl Elimination {
         // Every triangle touching them contributes to their residual.
         let mut patch: Vec<usize> = dofs
             .iter()
-            .flat_map(|&d| self.node_elements[d / 2].iter().copied())
+            .flat_map(|&d| self.node_elements(model)[d / 2].iter().copied())
             .collect();
         patch.sort_unstable();
         patch.dedup();

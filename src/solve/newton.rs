@@ -20,6 +20,7 @@ use crate::error::{Error, Result};
 use crate::fe::{FIXED, Pattern};
 use crate::material::Stress;
 use nalgebra::Matrix3;
+use rayon::prelude::*;
 use std::cell::Cell;
 
 /// Newton solver state (pattern, slots, factorization) for one problem.
@@ -53,6 +54,12 @@ pub struct Newton<'a> {
     trace: bool,
     /// The elastic stiffness in pattern order.
     elastic_values: Vec<f64>,
+    /// Whether a body is viscoplastic; if not, every tangent is elastic: the constitutive
+    /// update stores none ([`Evaluation::tangents`] is empty) and the stiffness is never
+    /// reassembled.
+    viscoplastic: bool,
+    /// The first value slot of body 1 in the stiffness ([`Model::body_slot_split`]).
+    body_split: Option<usize>,
     /// Lower triangle of the symmetric stiffness handed to the LDL^T (pattern order).
     symmetric_values: Vec<f64>,
     /// GMRES iterations of the first solve after the last factorization.
@@ -256,6 +263,7 @@ impl<'a> Newton<'a> {
         let factorization = pieces::time("setup.interface_analysis", 0, || {
             InterfaceFactorization::new(&pattern, &rows)
         })?;
+        let body_split = p.model.body_slot_split(&slots);
         let setup_s = t_setup.elapsed().as_secs_f64();
         pieces::record("setup.total", 0, setup_s);
         Ok(Newton {
@@ -274,6 +282,8 @@ impl<'a> Newton<'a> {
             clock: Default::default(),
             setup_s,
             elastic_values,
+            viscoplastic: p.model.materials.iter().any(|m| m.viscoplastic.is_some()),
+            body_split,
             symmetric_values: Vec::new(),
             fresh_iterations: 0,
             predicted_changes: 0,
@@ -310,24 +320,21 @@ impl<'a> Newton<'a> {
         timed(&clock.assembly, || {
             vals.clear();
             vals.extend_from_slice(&self.elastic_values);
-            let symmetric: Vec<Matrix3<f64>> = (self.p.model.elements.iter().zip(tangents))
-                .map(|(e, d)| {
-                    symmetric_tangent(d, &self.p.model.materials[e.body].elastic.matrix())
-                })
+            if self.viscoplastic {
+                let model = &self.p.model;
+                let symmetric: Vec<Matrix3<f64>> = (model
+                    .elements
+                    .par_iter()
+                    .zip(tangents.par_iter()))
+                .with_min_len(4096)
+                .map(|(e, d)| symmetric_tangent(d, &model.materials[e.body].elastic.matrix()))
                 .collect();
-            self.p
-                .model
-                .add_tangent_change(&symmetric, &self.slots, &mut vals);
+                model.add_tangent_change(&symmetric, &self.slots, self.body_split, &mut vals);
+            }
         });
-        let viscoplastic = self
-            .p
-            .model
-            .materials
-            .iter()
-            .any(|m| m.viscoplastic.is_some());
         let result = self
             .factorization
-            .factor(&mut vals, self.c_scale, viscoplastic);
+            .factor(&mut vals, self.c_scale, self.viscoplastic);
         self.symmetric_values = vals;
         result?;
         self.active_set = None;
@@ -418,7 +425,7 @@ impl<'a> Newton<'a> {
 struct Evaluation {
     /// Stresses from the return map.
     sigma: Vec<Stress>,
-    /// Consistent tangents per triangle.
+    /// Consistent tangents per triangle; empty when no body is viscoplastic (all elastic).
     tangents: Vec<Matrix3<f64>>,
     /// Equilibrium residual f_int - F + C^T lambda over the free dofs (force).
     residual: Vec<f64>,
@@ -457,7 +464,7 @@ impl Newton<'_> {
                 &data.prev.sigma,
                 data.k,
                 data.source.as_deref(),
-                true,
+                self.viscoplastic,
             )
         });
         let f_int = timed(&clock.assembly, || model.internal_force(&sigma));
@@ -493,11 +500,17 @@ impl Newton<'_> {
     /// Write the current tangent stiffness into the matrix GMRES multiplies with: the
     /// elastic stiffness (assembled once) plus the viscoplastic triangles' changes.
     fn assemble_tangent(&mut self, tangents: &[Matrix3<f64>]) {
+        if !self.viscoplastic {
+            // Every tangent is elastic: the stiffness holds them since the set-up.
+            return;
+        }
         let clock = std::rc::Rc::clone(&self.clock);
         timed(&clock.assembly, || {
             let vals = self.stiffness.values_mut();
             vals.copy_from_slice(&self.elastic_values);
-            self.p.model.add_tangent_change(tangents, &self.slots, vals);
+            self.p
+                .model
+                .add_tangent_change(tangents, &self.slots, self.body_split, vals);
         });
     }
 
@@ -554,7 +567,15 @@ impl Newton<'_> {
                 let (p, c) = (self.p, self.c_scale);
                 let rows = &self.rows;
                 let kkt = self.kkt.get_or_insert_with(|| KktMatrix::new(p, rows));
-                kkt.factor(p, &ev.tangents, &set, c)?;
+                let elastic;
+                let tangents = match self.viscoplastic {
+                    true => &ev.tangents,
+                    false => {
+                        elastic = p.model.elastic_tangents();
+                        &elastic
+                    }
+                };
+                kkt.factor(p, tangents, &set, c)?;
                 timed(&self.clock.solve, || kkt.system.solve(&mut rhs));
                 self.preconditioner = Preconditioner::KktLu(set.clone());
                 0
