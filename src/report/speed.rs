@@ -49,6 +49,11 @@ struct SpeedCsv {
     one_thread_s: Option<f64>,
     /// The floor on one thread (largest level; s).
     one_thread_floor_s: Option<f64>,
+    /// Fill of the solver's factor of the stiffness: entries of L, both bodies, the
+    /// interface rows included (0 for the paper's solver, which has no such factor).
+    factor_entries: usize,
+    /// Fill of the floor's Cholesky factor: entries of L, both bodies.
+    floor_factor_entries: usize,
 }
 
 impl SpeedCsv {
@@ -79,6 +84,8 @@ impl SpeedCsv {
             threads,
             one_thread_s: r.one_thread.map(|o| o.0),
             one_thread_floor_s: r.one_thread.map(|o| o.1),
+            factor_entries: t.factor_entries,
+            floor_factor_entries: r.floor_entries,
         }
     }
 }
@@ -225,17 +232,18 @@ fn readme(res: &SpeedResult) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "# Study `speed`\n\nWhat each accuracy costs, on two families of the same non-matching meshes (h1/h2 = 1.4142, h_upper = 0.28 at level 0, every level splits each triangle in 4), {} time steps: `rates` (viscoplastic, about half the domain flows) and `rates-elastic` (no yield stress). Each run's cost, the solver's set-up (pattern, symbolic analysis) plus its time loop, is compared with the floor measured on the same mesh: what the problem cannot avoid, from scratch: the elastic stiffness's pattern and values, one sparse Cholesky of it (faer; ordering, symbolic and numeric; shifted by 1e-8 of its mean diagonal so that a body held only by contact does not make it singular), and one solve (two triangular solves) per time step. Runs below {} dofs are timed {} times, below {} dofs {} times, solver and floor alternately, each on a heap handed back to the system as in a fresh process, and the fastest of each is kept (single timings of 0.01-1 s scatter by up to a factor 2 on this shared 2-core machine). Errors (viscoplastic family) are in the theorem norm against a matching-mesh reference at level {} ({} dofs), shown where the reference is at least 3 levels finer. `peak RSS` is the process's peak during the solve (reset before it). Regenerate with `cargo run --release -- study speed` ({:.0} s).\n",
+        "# Study `speed`\n\nWhat each accuracy costs, on two families of the same non-matching meshes (h1/h2 = 1.4142, h_upper = 0.28 at level 0, every level splits each triangle in 4), {} time steps: `rates` (viscoplastic, about half the domain flows) and `rates-elastic` (no yield stress). Each run's cost, the solver's set-up (pattern, symbolic analysis) plus its time loop, is compared with the floor measured on the same mesh: what the problem cannot avoid, from scratch: the elastic stiffness's pattern and values, one sparse Cholesky of it (faer; ordering, symbolic and numeric; shifted by 1e-8 of its mean diagonal so that a body held only by contact does not make it singular), and one solve (two triangular solves) per time step. Runs below {} dofs are timed {} times, below {} dofs {} times, larger ones {} times, solver and floor alternately, each on a heap handed back to the system as in a fresh process, and the fastest of each is kept (single timings of 0.01-1 s scatter by up to a factor 2 on this shared 2-core machine). Errors (viscoplastic family) are in the theorem norm against a matching-mesh reference at level {} ({} dofs), shown where the reference is at least 3 levels finer. `peak RSS` is the process's peak during the solve (reset before it). Regenerate with `cargo run --release -- study speed` ({:.0} s).\n",
         crate::study::speed::STEPS,
         crate::study::speed::REPEATS[0].0,
         crate::study::speed::REPEATS[0].1,
         crate::study::speed::REPEATS[1].0,
         crate::study::speed::REPEATS[1].1,
+        crate::study::speed::REPEATS_ABOVE,
         crate::study::speed::REFERENCE_LEVEL,
         res.reference_dofs,
         res.wall_s
     );
-    s.push_str("| family | cone | newton / floor from 1e4 dofs (smallest - largest) | at the largest run |\n|---|---|---|---|\n");
+    s.push_str("| family | cone | newton / floor from 1e4 dofs (smallest - largest) | at the largest run | fill at the largest run, entries of L: newton / floor |\n|---|---|---|---|---|\n");
     for family in &FAMILIES {
         for m in [Method::Mortar, Method::Nts] {
             let runs: Vec<&SpeedRun> = family_runs(res, family, m, SolverKind::Newton)
@@ -245,21 +253,24 @@ fn readme(res: &SpeedResult) -> String {
             if let Some(last) = runs.last() {
                 let _ = writeln!(
                     s,
-                    "| {} | {m} | {:.2} - {:.2} | {:.2} at {} dofs ({:.1} s, floor {:.1} s) |",
+                    "| {} | {m} | {:.2} - {:.2} | {:.2} at {} dofs ({:.1} s, floor {:.1} s) | {:.3e} / {:.3e} = {:.2} |",
                     family.label,
                     ratios.iter().copied().fold(f64::INFINITY, f64::min),
                     ratios.iter().copied().fold(0.0, f64::max),
                     ratio(last),
                     last.run.dofs,
                     last.run.time_loop_s + last.run.timings.setup_s,
-                    floor_of(last)
+                    floor_of(last),
+                    last.run.timings.factor_entries as f64,
+                    last.floor_entries as f64,
+                    last.run.timings.factor_entries as f64 / last.floor_entries.max(1) as f64
                 );
             }
         }
     }
     let _ = writeln!(
         s,
-        "\nThreads: {} (rayon's pool; `RAYON_NUM_THREADS` sets it), the same for the solver and the floor. The stiffness is block diagonal, one block per body (they meet only through the contact rows): both sides factorize the blocks apart and side by side, in the same ordering (`solve::ordering`: METIS's nested dissection of the nodes for a block of 500,000 equations or more, faer's AMD below), the floor of each whole block, newton of the block's interior with its contact-interface unknowns last; their substitutions run side by side too.\n",
+        "\nThreads: {} (rayon's pool; `RAYON_NUM_THREADS` sets it), the same for the solver and the floor. The stiffness is block diagonal, one block per body (they meet only through the contact rows): both sides factorize the blocks apart and side by side, in the same ordering (`solve::ordering`: METIS's nested dissection of the nodes for a block of 500,000 equations or more, faer's AMD below), the floor of each whole block, newton of the block's interior with its contact-interface unknowns last; their substitutions run side by side too. The fill is the number of entries of the factor L on and below its diagonal (both bodies; newton's includes its interface rows).\n",
         res.threads
     );
     let one: Vec<&SpeedRun> = res.rows.iter().filter(|r| r.one_thread.is_some()).collect();
@@ -311,6 +322,19 @@ fn readme(res: &SpeedResult) -> String {
     s
 }
 
+/// The two fills and their ratio (empty for a solver without a factor of the stiffness).
+fn fill(newton: usize, floor: usize) -> String {
+    match newton {
+        0 => String::new(),
+        _ => format!(
+            "{:.3e} / {:.3e} = {:.3}",
+            newton as f64,
+            floor as f64,
+            newton as f64 / floor.max(1) as f64
+        ),
+    }
+}
+
 fn gib(v: Option<f64>) -> String {
     v.map(|g| format!("{g:.1}")).unwrap_or_default()
 }
@@ -320,13 +344,13 @@ fn table(res: &SpeedResult) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "| family | method | solver | level | dofs | iterations | factorizations | time loop (s) | floor (s) | (set-up + loop) / floor | set-up (s) | factorizations (s) | solves (s) | assembly (s) | constitutive (s) | peak RSS (GiB) | error |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+        "| family | method | solver | level | dofs | iterations | factorizations | time loop (s) | floor (s) | (set-up + loop) / floor | set-up (s) | factorizations (s) | solves (s) | assembly (s) | constitutive (s) | fill, newton / floor (entries of L) | peak RSS (GiB) | error |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for r in &res.rows {
         let (run, t) = (&r.run, &r.run.timings);
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.2} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.2} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {} | {} | {} |",
             r.family.label,
             run.method,
             run.solver,
@@ -342,6 +366,7 @@ fn table(res: &SpeedResult) -> String {
             t.solve_s,
             t.assembly_s,
             t.constitutive_s,
+            fill(t.factor_entries, r.floor_entries),
             gib(run.peak_rss_gib),
             r.error.map(|e| format!("{e:.3e}")).unwrap_or_default()
         );

@@ -459,6 +459,15 @@ impl Block {
 }
 
 impl InterfaceFactorization {
+    /// The fill of the blocks' factors (interface rows included), summed over the blocks
+    /// ([`ordering::supernodal_entries`]).
+    pub fn factor_entries(&self) -> usize {
+        self.blocks
+            .iter()
+            .map(|b| ordering::supernodal_entries(b.supernodal()))
+            .sum()
+    }
+
     /// Order the stiffness with pattern `pattern` (n x n, both triangles) with the interface
     /// of `rows` (contact rows as (equation, coefficient)) last in each of its diagonal
     /// blocks, and analyze the blocks (on rayon's threads).

@@ -188,6 +188,11 @@ pub struct OrderedCholesky {
 }
 
 impl OrderedCholesky {
+    /// The fill of the factor ([`super::ordering::factor_entries`]).
+    pub fn factor_entries(&self) -> usize {
+        super::ordering::factor_entries(&self.symbolic)
+    }
+
     /// The symbolic analysis of `pattern` (both triangles; the lower one is read) in the
     /// elimination order `order` (the equation eliminated first, second, ...).
     pub fn new(pattern: &Pattern, order: &[usize]) -> Result<Self> {

@@ -169,6 +169,10 @@ pub struct Timings {
     /// One-off set-up per mesh: the matrix pattern with its entry-to-slot map and the
     /// symbolic analysis (ordering). Not part of the time loop (`Solution::wall_s`).
     pub setup_s: f64,
+    /// The fill of the stiffness's factor, entries of L ([`ordering::factor_entries`]);
+    /// 0 for a solver without one.
+    #[serde(default)]
+    pub factor_entries: usize,
 }
 
 /// Run `f`, adding its wall time to `cell`.
@@ -220,7 +224,22 @@ impl Solution {
 /// mean diagonal, so that a body held only by contact does not make it singular. Compare
 /// it with a solver's set-up plus time loop (`RunSummary::ratio_to_floor`).
 pub fn floor_time(p: &Problem, steps: usize) -> Result<f64> {
-    newton::floor_time(p, steps)
+    Ok(newton::floor(p, steps)?.seconds)
+}
+
+/// The floor of [`floor_time`] with the fill of its factor.
+#[derive(Debug, Clone, Copy)]
+pub struct Floor {
+    /// Wall time (s).
+    pub seconds: f64,
+    /// Entries of the Cholesky factor L, summed over the bodies' blocks
+    /// ([`ordering::factor_entries`]).
+    pub factor_entries: usize,
+}
+
+/// [`floor_time`] with the fill of the floor's factor.
+pub fn floor(p: &Problem, steps: usize) -> Result<Floor> {
+    newton::floor(p, steps)
 }
 
 /// One solver's per-step interface.

@@ -190,8 +190,8 @@ impl KktMatrix {
 /// changes nothing the floor measures (its cost).
 pub const FLOOR_SHIFT: f64 = 1e-8;
 
-/// See [`super::floor_time`].
-pub fn floor_time(p: &Problem, steps: usize) -> Result<f64> {
+/// See [`super::floor`].
+pub fn floor(p: &Problem, steps: usize) -> Result<super::Floor> {
     let t0 = std::time::Instant::now();
     let model = &p.model;
     let n = model.n_free;
@@ -209,7 +209,7 @@ pub fn floor_time(p: &Problem, steps: usize) -> Result<f64> {
     });
     // The stiffness is block diagonal (one block per body): the best the machine can do
     // factorizes the blocks apart, on rayon's threads, as the solver does.
-    ordering::largest_first(pattern.diagonal_blocks(), |range| {
+    let entries = ordering::largest_first(pattern.diagonal_blocks(), |range| {
         let first = range.start;
         let (block, entries) = pieces::time("floor.block", first, || pattern.block(&range));
         let order = ordering::order(&block, &vec![false; block.n], None, first)?;
@@ -223,10 +223,14 @@ pub fn floor_time(p: &Problem, steps: usize) -> Result<f64> {
                 system.solve(&mut rhs);
             }
         });
-        Ok(())
+        Ok(system.factor_entries())
     })?;
-    pieces::record("floor.total", 0, t0.elapsed().as_secs_f64());
-    Ok(t0.elapsed().as_secs_f64())
+    let seconds = t0.elapsed().as_secs_f64();
+    pieces::record("floor.total", 0, seconds);
+    Ok(super::Floor {
+        seconds,
+        factor_entries: entries.iter().sum(),
+    })
 }
 
 impl<'a> Newton<'a> {
@@ -959,6 +963,7 @@ impl StepSolver for Newton<'_> {
             factorizations: self.factorization.factorizations + kkt_factorizations,
             solves: self.factorization.solves.get() + kkt_solves,
             setup_s: self.setup_s,
+            factor_entries: self.factorization.factor_entries(),
         }
     }
 }
