@@ -221,19 +221,25 @@ fn metis_order(block: &Pattern, vertices: &[usize]) -> Result<Vec<usize>> {
         .collect())
 }
 
-/// The flops (multiply-adds) of a supernodal factorization: a supernode of c columns over
-/// r rows below costs c^3/3 for its diagonal block, c^2 r for its panel and c r^2 for the
-/// update of the rows below.
-pub fn flops(symbolic: &SymbolicSupernodalCholesky<usize>) -> f64 {
+/// (columns, rows below) of each supernode of a supernodal factor.
+fn supernode_shapes(
+    symbolic: &SymbolicSupernodalCholesky<usize>,
+) -> impl Iterator<Item = (usize, usize)> + '_ {
     let (begin, end, row_ptr) = (
         symbolic.supernode_begin(),
         symbolic.supernode_end(),
         symbolic.col_ptr_for_row_idx(),
     );
-    (0..symbolic.n_supernodes())
-        .map(|s| {
-            let c = (end[s] - begin[s]) as f64;
-            let r = (row_ptr[s + 1] - row_ptr[s]) as f64;
+    (0..symbolic.n_supernodes()).map(move |s| (end[s] - begin[s], row_ptr[s + 1] - row_ptr[s]))
+}
+
+/// The flops (multiply-adds) of a supernodal factorization: a supernode of c columns over
+/// r rows below costs c^3/3 for its diagonal block, c^2 r for its panel and c r^2 for the
+/// update of the rows below.
+pub fn flops(symbolic: &SymbolicSupernodalCholesky<usize>) -> f64 {
+    supernode_shapes(symbolic)
+        .map(|(c, r)| {
+            let (c, r) = (c as f64, r as f64);
             c * c * c / 3.0 + c * c * r + c * r * r
         })
         .sum()
@@ -254,16 +260,8 @@ pub fn factor_entries(symbolic: &SymbolicCholesky<usize>) -> usize {
 
 /// [`factor_entries`] of a supernodal factor.
 pub fn supernodal_entries(symbolic: &SymbolicSupernodalCholesky<usize>) -> usize {
-    let (begin, end, row_ptr) = (
-        symbolic.supernode_begin(),
-        symbolic.supernode_end(),
-        symbolic.col_ptr_for_row_idx(),
-    );
-    (0..symbolic.n_supernodes())
-        .map(|s| {
-            let (c, r) = (end[s] - begin[s], row_ptr[s + 1] - row_ptr[s]);
-            c * (c + 1) / 2 + c * r
-        })
+    supernode_shapes(symbolic)
+        .map(|(c, r)| c * (c + 1) / 2 + c * r)
         .sum()
 }
 
