@@ -805,7 +805,7 @@ pub fn split_ranges_mut<'a>(
 
 /// Triangles from which the constitutive update and the internal force run on rayon's
 /// threads.
-pub const PARALLEL_ELEMENTS: usize = 50_000;
+pub const PARALLEL_ELEMENTS: usize = 8_000;
 
 /// Add `|T| B^T D S B` of one element into `values` through its slot map (S halves the
 /// engineering shear).

@@ -68,6 +68,11 @@ impl SparseSystem {
     }
 
     /// Values in pattern order (CSC slots).
+    pub fn values(&self) -> &[f64] {
+        self.mat.val()
+    }
+
+    /// Values in pattern order (CSC slots), to write.
     pub fn values_mut(&mut self) -> &mut [f64] {
         self.mat.val_mut()
     }

@@ -393,16 +393,15 @@ fn run_steps(
                         .product()
                 })
                 .collect();
+            // sum_i w_i field(point i), the terms of each entry in the order of the points.
             let mix = |field: &dyn Fn(&State) -> &[f64]| -> Vec<f64> {
-                (0..field(&prev).len())
-                    .map(|d| {
-                        points
-                            .iter()
-                            .zip(&weights)
-                            .map(|(s, w)| w * field(s)[d])
-                            .sum()
-                    })
-                    .collect()
+                let mut sum: Vec<f64> = field(points[0]).iter().map(|v| weights[0] * v).collect();
+                for (s, w) in points.iter().zip(&weights).skip(1) {
+                    for (total, v) in sum.iter_mut().zip(field(s)) {
+                        *total += w * v;
+                    }
+                }
+                sum
             };
             State {
                 time: t,

@@ -10,7 +10,7 @@
 //! whole run factorizes the stiffness once, like the floor.
 
 use super::elimination::{Elimination, Increment};
-use super::interface::{ActiveSet, InterfaceFactorization};
+use super::interface::{ActiveSet, InterfaceFactorization, Precision};
 use super::linear::{OrderedCholesky, SparseSystem, gmres};
 use super::{Problem, Settings, State, StepReport, StepSolver, inf_norm};
 use super::{Timings, timed};
@@ -52,7 +52,8 @@ pub struct Newton<'a> {
     /// distances, the active set and its flips, the plastic triangles and how many switched,
     /// the line search's step length.
     trace: bool,
-    /// The elastic stiffness in pattern order.
+    /// The elastic stiffness in pattern order (empty with no viscoplastic body: the
+    /// stiffness is never reassembled).
     elastic_values: Vec<f64>,
     /// Whether a body is viscoplastic; if not, every tangent is elastic: the constitutive
     /// update stores none ([`Evaluation::tangents`] is empty) and the stiffness is never
@@ -251,17 +252,23 @@ impl<'a> Newton<'a> {
                     .collect()
             })
             .collect();
+        let viscoplastic = p.model.materials.iter().any(|m| m.viscoplastic.is_some());
         let (stiffness, elastic_values) = pieces::time("setup.values", 0, || {
             let mut stiffness = SparseSystem::new(&pattern);
             let vals = stiffness.values_mut();
             p.model
                 .add_tangent(&p.model.elastic_tangents(), &slots, vals);
-            let elastic_values = vals.to_vec();
+            // The elastic stiffness the tangents are assembled on; an elastic run keeps it
+            // in `stiffness` alone.
+            let elastic_values = match viscoplastic {
+                true => vals.to_vec(),
+                false => Vec::new(),
+            };
             (stiffness, elastic_values)
         });
         // Stiffness scale: the mean diagonal of the elastic stiffness.
         let c_scale = (0..n)
-            .map(|i| elastic_values[pattern.slot(i, i)])
+            .map(|i| stiffness.values()[pattern.slot(i, i)])
             .sum::<f64>()
             / n.max(1) as f64;
         let factorization = pieces::time("setup.interface_analysis", 0, || {
@@ -286,7 +293,7 @@ impl<'a> Newton<'a> {
             clock: Default::default(),
             setup_s,
             elastic_values,
-            viscoplastic: p.model.materials.iter().any(|m| m.viscoplastic.is_some()),
+            viscoplastic,
             body_split,
             symmetric_values: Vec::new(),
             fresh_iterations: 0,
@@ -318,13 +325,17 @@ impl<'a> Newton<'a> {
     }
 
     /// Factorize the symmetric counterpart K_s of the tangent stiffness (see the module).
+    /// With no viscoplastic body K_s is the stiffness itself, factorized as it is.
     fn factor(&mut self, tangents: &[Matrix3<f64>]) -> Result<()> {
-        let clock = std::rc::Rc::clone(&self.clock);
-        let mut vals = std::mem::take(&mut self.symmetric_values);
-        timed(&clock.assembly, || {
-            vals.clear();
-            vals.extend_from_slice(&self.elastic_values);
-            if self.viscoplastic {
+        if !self.viscoplastic {
+            self.factorization
+                .factor(self.stiffness.values(), self.c_scale, Precision::Single)?;
+        } else {
+            let clock = std::rc::Rc::clone(&self.clock);
+            let mut vals = std::mem::take(&mut self.symmetric_values);
+            timed(&clock.assembly, || {
+                vals.clear();
+                vals.extend_from_slice(&self.elastic_values);
                 let model = &self.p.model;
                 let symmetric: Vec<Matrix3<f64>> = (model
                     .elements
@@ -334,13 +345,13 @@ impl<'a> Newton<'a> {
                 .map(|(e, d)| symmetric_tangent(d, &model.materials[e.body].elastic.matrix()))
                 .collect();
                 model.add_tangent_change(&symmetric, &self.slots, self.body_split, &mut vals);
-            }
-        });
-        let result = self
-            .factorization
-            .factor(&mut vals, self.c_scale, self.viscoplastic);
-        self.symmetric_values = vals;
-        result?;
+            });
+            let result = self
+                .factorization
+                .factor(&vals, self.c_scale, Precision::Single);
+            self.symmetric_values = vals;
+            result?;
+        }
         self.active_set = None;
         self.stale = false;
         self.preconditioner = Preconditioner::Interface;
@@ -437,6 +448,9 @@ struct Evaluation {
     gaps: Vec<f64>,
     /// Scale of the forces: the larger of |F| and |f_int| over the free dofs.
     scale: f64,
+    /// Whether every triangle's tangent is elastic (no viscoplastic body, or none of its
+    /// triangles flows): the Newton model is then linear but for the contact rows.
+    linear: bool,
 }
 
 /// What one time step's iterations share.
@@ -483,12 +497,17 @@ impl Newton<'_> {
         let scale = inf_norm(&data.f_free)
             .max(inf_norm(&model.restrict(&f_int)))
             .max(f64::MIN_POSITIVE);
+        let linear = !self.viscoplastic
+            || (model.elements.par_iter().zip(&tangents))
+                .with_min_len(4096)
+                .all(|(e, d)| *d == model.materials[e.body].elastic.matrix());
         Evaluation {
             sigma,
             tangents,
             residual: model.restrict(&r),
             gaps,
             scale,
+            linear,
         }
     }
 
@@ -542,7 +561,7 @@ impl Newton<'_> {
         // than 5 and more than the fresh factorization needed. The rule counts iterations,
         // not seconds, so the results do not depend on the machine's load.
         let budget = 10;
-        let forcing = self.forcing_term(distance);
+        let forcing = self.forcing_term(distance, ev.linear);
         self.assemble_tangent(&ev.tangents);
         let reusable = match &self.preconditioner {
             Preconditioner::Interface => true,
@@ -655,9 +674,17 @@ impl Newton<'_> {
     /// last iteration of a step). While only the active set is searched (residual at
     /// round-off), the semismooth steps terminate finitely and want the solve to tolerance:
     /// a 1e-2 solve there left 4e-9 behind and cost one more iteration in other units.
-    fn forcing_term(&self, distance: &Distance) -> f64 {
+    /// Where every triangle's tangent is elastic (`linear`) the Newton model is exact but
+    /// for the active set, which the interface model settles: the solve to a tenth of the
+    /// tolerance ends the step in one iteration (measured, `rates-elastic` at 137,472 dofs:
+    /// 4 iterations and 7 preconditioner applications for 4 steps, against 8 and 8 with
+    /// the rule above and a single-precision factorization).
+    fn forcing_term(&self, distance: &Distance, linear: bool) -> f64 {
         let res = distance.residual;
         let tol_term = 0.3 * self.settings.tol / res.max(distance.complementarity);
+        if linear {
+            return (0.1 * tol_term).clamp(1e-14, 1e-2);
+        }
         if tol_term > 1e-2 {
             // Within 30x of the tolerance: a loose solve ends it (the quadratic term is far
             // below the tolerance there).
