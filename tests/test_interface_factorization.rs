@@ -6,8 +6,7 @@
 //! from one sparse factorization of the stiffness: residual at round-off (1e-12 of the
 //! right-hand side) in double precision, within 1e-4 in single precision (newton's: f32
 //! rounding times the condition of the stiffness); and an elastic run factorizes once and
-//! ends every time step in one Newton iteration (GMRES takes the single-precision solve to
-//! the tolerance).
+//! ends every time step in at most two Newton iterations.
 //! Geometry: the `rates` scene (its upper block is held vertically only by contact: a
 //! singular stiffness) at level 1, both cones; `rates-elastic` at level 2.
 //! Data: E = 100, nu = 0.3; right-hand sides from a fixed pseudo-random sequence.
@@ -108,8 +107,12 @@ fn interface_solve_is_exact_for_any_active_set() {
     }
 }
 
+/// An elastic step is linear but for the active set, which the interface model settles:
+/// its first Newton iteration leaves the single-precision solve's error (8.5e-6 of the
+/// right-hand side at level 1 in the test above), its second the square of that, below
+/// the tolerance 1e-10. The stiffness never changes: one factorization for the whole run.
 #[test]
-fn an_elastic_run_factorizes_once_and_takes_one_iteration_per_step() {
+fn an_elastic_run_factorizes_once_and_takes_at_most_two_iterations_per_step() {
     for method in [Method::Mortar, Method::Nts] {
         let case = common::case("rates-elastic", 2, method, &[]);
         let sol = solve::solve(&case.problem, &Settings::default(), 4, false).unwrap();
@@ -119,6 +122,6 @@ fn an_elastic_run_factorizes_once_and_takes_one_iteration_per_step() {
             sol.reports.iter().map(|r| r.iterations).collect::<Vec<_>>()
         );
         assert_eq!(sol.timings.factorizations, 1);
-        assert!(sol.reports.iter().all(|r| r.iterations == 1));
+        assert!(sol.reports.iter().all(|r| r.iterations <= 2));
     }
 }

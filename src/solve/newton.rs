@@ -6,8 +6,9 @@
 //! the contact interface's unknowns last, so that a change of the active set costs a dense
 //! solve on the interface and never a sparse refactorization. The sparse matrix is
 //! refactorized only when GMRES needs many iterations (the tangent moved far from the
-//! factored one). For elastic bodies K_s = K_t: GMRES stops after one iteration and the
-//! whole run factorizes the stiffness once, like the floor.
+//! factored one). The factorization is in single precision (see
+//! [`InterfaceFactorization::factor`]): for elastic bodies K_s = K_t, a step ends in one or
+//! two iterations and the whole run factorizes the stiffness once, like the floor.
 
 use super::elimination::{Elimination, Increment};
 use super::interface::{ActiveSet, InterfaceFactorization, Precision};
@@ -448,9 +449,6 @@ struct Evaluation {
     gaps: Vec<f64>,
     /// Scale of the forces: the larger of |F| and |f_int| over the free dofs.
     scale: f64,
-    /// Whether every triangle's tangent is elastic (no viscoplastic body, or none of its
-    /// triangles flows): the Newton model is then linear but for the contact rows.
-    linear: bool,
 }
 
 /// What one time step's iterations share.
@@ -497,17 +495,12 @@ impl Newton<'_> {
         let scale = inf_norm(&data.f_free)
             .max(inf_norm(&model.restrict(&f_int)))
             .max(f64::MIN_POSITIVE);
-        let linear = !self.viscoplastic
-            || (model.elements.par_iter().zip(&tangents))
-                .with_min_len(4096)
-                .all(|(e, d)| *d == model.materials[e.body].elastic.matrix());
         Evaluation {
             sigma,
             tangents,
             residual: model.restrict(&r),
             gaps,
             scale,
-            linear,
         }
     }
 
@@ -561,7 +554,7 @@ impl Newton<'_> {
         // than 5 and more than the fresh factorization needed. The rule counts iterations,
         // not seconds, so the results do not depend on the machine's load.
         let budget = 10;
-        let forcing = self.forcing_term(distance, ev.linear);
+        let forcing = self.forcing_term(distance);
         self.assemble_tangent(&ev.tangents);
         let reusable = match &self.preconditioner {
             Preconditioner::Interface => true,
@@ -674,17 +667,15 @@ impl Newton<'_> {
     /// last iteration of a step). While only the active set is searched (residual at
     /// round-off), the semismooth steps terminate finitely and want the solve to tolerance:
     /// a 1e-2 solve there left 4e-9 behind and cost one more iteration in other units.
-    /// Where every triangle's tangent is elastic (`linear`) the Newton model is exact but
-    /// for the active set, which the interface model settles: the solve to a tenth of the
-    /// tolerance ends the step in one iteration (measured, `rates-elastic` at 137,472 dofs:
-    /// 4 iterations and 7 preconditioner applications for 4 steps, against 8 and 8 with
-    /// the rule above and a single-precision factorization).
-    fn forcing_term(&self, distance: &Distance, linear: bool) -> f64 {
+    /// The same rule holds where the Newton model is exact (elastic bodies): the
+    /// single-precision solve is not, and a second iteration costs less than solving to
+    /// the tolerance in the first (measured, `rates-elastic` at 137,472 dofs, 4 steps: 5
+    /// iterations and 6 preconditioner applications, solves 0.064 s, against 4, 7 and
+    /// 0.088 s when a step whose triangles are all elastic is solved to a tenth of the
+    /// tolerance; `rates`: 11 iterations and 29 applications against 10 and 30).
+    fn forcing_term(&self, distance: &Distance) -> f64 {
         let res = distance.residual;
         let tol_term = 0.3 * self.settings.tol / res.max(distance.complementarity);
-        if linear {
-            return (0.1 * tol_term).clamp(1e-14, 1e-2);
-        }
         if tol_term > 1e-2 {
             // Within 30x of the tolerance: a loose solve ends it (the quadratic term is far
             // below the tolerance there).
