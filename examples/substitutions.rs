@@ -47,11 +47,20 @@ fn main() -> contact_rates::error::Result<()> {
         .map(|i| ((i * 7919) % 1000) as f64 / 500.0 - 1.0)
         .collect();
     let (mut best, mut first, mut spread) = (f64::INFINITY, None::<Vec<f64>>, 0.0f64);
+    let (mut forward, mut back) = (f64::INFINITY, f64::INFINITY);
     for _ in 0..repeats {
         let mut x = b.clone();
         let t = Instant::now();
         factorization.solve(&set, c, &mut x);
         best = best.min(t.elapsed().as_secs_f64());
+        // The two substitutions apart.
+        let t = Instant::now();
+        let condensed = factorization.condense(&b[..n]);
+        forward = forward.min(t.elapsed().as_secs_f64());
+        let (x_interface, _) = factorization.interface_solve(&set, c, &condensed.load, &b[n..]);
+        let t = Instant::now();
+        let _ = factorization.expand(condensed, &x_interface);
+        back = back.min(t.elapsed().as_secs_f64());
         match &first {
             None => first = Some(x),
             Some(f) => {
@@ -64,10 +73,12 @@ fn main() -> contact_rates::error::Result<()> {
     }
     let x = first.expect("one solve");
     println!(
-        "level {level} {method:?} dofs {n} threads {} fill {}: solve {:.3} ms (fastest of {repeats}), |x| {:.6e}, spread {spread:.1e}",
+        "level {level} {method:?} dofs {n} threads {} fill {}: solve {:.3} ms (fastest of {repeats}; forward {:.3}, back {:.3}), |x| {:.6e}, spread {spread:.1e}",
         rayon::current_num_threads(),
         factorization.factor_entries(),
         best * 1e3,
+        forward * 1e3,
+        back * 1e3,
         x.iter().map(|v| v * v).sum::<f64>().sqrt()
     );
     Ok(())
