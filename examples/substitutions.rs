@@ -5,7 +5,6 @@
 //! `cargo run --release --example substitutions -- LEVEL [mortar|nts] [REPEATS]`.
 use contact_rates::case::Case;
 use contact_rates::contact::Method;
-use contact_rates::fe::FIXED;
 use contact_rates::scene::Scene;
 use contact_rates::solve::interface::{InterfaceFactorization, Precision};
 use std::time::Instant;
@@ -30,14 +29,7 @@ fn main() -> contact_rates::error::Result<()> {
     let mut values = vec![0.0; pattern.nnz()];
     model.add_tangent(&model.elastic_tangents(), &slots, &mut values);
     let c = (0..n).map(|i| values[pattern.slot(i, i)]).sum::<f64>() / n as f64;
-    let rows: Vec<Vec<(usize, f64)>> = (case.problem.rows.iter())
-        .map(|r| {
-            (r.entries.iter())
-                .map(|&(d, v)| (model.equation[d], v))
-                .filter(|&(eq, _)| eq != FIXED)
-                .collect()
-        })
-        .collect();
+    let rows = case.problem.free_rows();
     let m = rows.len();
     let mut factorization = InterfaceFactorization::new(&pattern, &rows)?;
     factorization.factor(&values, c, Precision::Single)?;

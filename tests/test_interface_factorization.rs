@@ -13,7 +13,6 @@
 
 mod common;
 use contact_rates::contact::Method;
-use contact_rates::fe::FIXED;
 use contact_rates::solve::interface::{InterfaceFactorization, Precision};
 use contact_rates::solve::linear::SparseSystem;
 use contact_rates::solve::{self, Settings};
@@ -71,14 +70,7 @@ fn interface_solve_is_exact_for_any_active_set() {
         model.add_tangent(&model.elastic_tangents(), &slots, stiffness.values_mut());
         let values = stiffness.values_mut().to_vec();
         let c = (0..n).map(|i| values[pattern.slot(i, i)]).sum::<f64>() / n as f64;
-        let rows: Vec<Vec<(usize, f64)>> = (case.problem.rows.iter())
-            .map(|r| {
-                (r.entries.iter())
-                    .map(|&(d, v)| (model.equation[d], v))
-                    .filter(|&(eq, _)| eq != FIXED)
-                    .collect()
-            })
-            .collect();
+        let rows = case.problem.free_rows();
         let m = rows.len();
         let b = sequence(n + m);
         for (precision, tolerance) in [(Precision::Double, 1e-12), (Precision::Single, 1e-4)] {

@@ -123,6 +123,24 @@ enum FactorValues {
     Single(Vec<f32>),
 }
 
+impl FactorValues {
+    /// The f64 values, if these are.
+    fn double(self) -> Option<Vec<f64>> {
+        match self {
+            FactorValues::Double(l) => Some(l),
+            FactorValues::Single(_) => None,
+        }
+    }
+
+    /// The f32 values, if these are.
+    fn single(self) -> Option<Vec<f32>> {
+        match self {
+            FactorValues::Single(l) => Some(l),
+            FactorValues::Double(_) => None,
+        }
+    }
+}
+
 /// A stored value of the factor: f64, or f32 for a preconditioner.
 trait Value: faer::traits::RealField + Copy {
     fn get(self) -> f64;
@@ -278,23 +296,13 @@ impl Block {
         let previous = self.numeric.take().map(|f| f.values);
         let (l, (l_interface, d_interface, inverse_diagonal)) = match precision {
             Precision::Double => {
-                let mut l = match previous {
-                    Some(FactorValues::Double(l)) => l,
-                    _ => Vec::new(),
-                };
-                let scaled = self.scaled(values, &diagonal, &scaling);
-                pieces::record("factor.scale", self.first, t.elapsed().as_secs_f64());
-                let parts = self.numeric_ldlt(&mut l, &scaled)?;
+                let l = previous.and_then(FactorValues::double).unwrap_or_default();
+                let (l, parts) = self.numeric_from(l, values, &diagonal, &scaling, t)?;
                 (FactorValues::Double(l), parts)
             }
             Precision::Single => {
-                let mut l = match previous {
-                    Some(FactorValues::Single(l)) => l,
-                    _ => Vec::new(),
-                };
-                let scaled = self.scaled(values, &diagonal, &scaling);
-                pieces::record("factor.scale", self.first, t.elapsed().as_secs_f64());
-                let parts = self.numeric_ldlt(&mut l, &scaled)?;
+                let l = previous.and_then(FactorValues::single).unwrap_or_default();
+                let (l, parts) = self.numeric_from(l, values, &diagonal, &scaling, t)?;
                 (FactorValues::Single(l), parts)
             }
         };
@@ -325,6 +333,23 @@ impl Block {
             d_interface,
         });
         Ok(schur)
+    }
+
+    /// The scaled values in the precision of `T` ([`Block::scaled`]) and their LDL^T
+    /// into `l` ([`Block::numeric_ldlt`]); `t` started the scaling's clock.
+    #[allow(clippy::type_complexity)]
+    fn numeric_from<T: Value>(
+        &self,
+        mut l: Vec<T>,
+        values: &[f64],
+        diagonal: &[f64],
+        scaling: &[f64],
+        t: Instant,
+    ) -> Result<(Vec<T>, (Mat<f64>, Vec<f64>, Vec<f64>))> {
+        let scaled = self.scaled(values, diagonal, scaling);
+        pieces::record("factor.scale", self.first, t.elapsed().as_secs_f64());
+        let parts = self.numeric_ldlt(&mut l, &scaled)?;
+        Ok((l, parts))
     }
 
     /// W (K + sigma P^T P) W in the precision of `T` (pattern order): the block's values

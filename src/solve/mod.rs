@@ -119,6 +119,20 @@ impl Problem {
             rows,
         }
     }
+
+    /// The constraint rows over the free unknowns: per row, (equation, coefficient) for
+    /// each entry on a free dof (the rows of the Newton system).
+    pub fn free_rows(&self) -> Vec<Vec<(usize, f64)>> {
+        let equation = &self.model.equation;
+        (self.rows.iter())
+            .map(|r| {
+                (r.entries.iter())
+                    .map(|&(d, v)| (equation[d], v))
+                    .filter(|&(eq, _)| eq != crate::fe::FIXED)
+                    .collect()
+            })
+            .collect()
+    }
 }
 
 /// The discrete state at one time t_n.

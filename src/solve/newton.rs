@@ -242,17 +242,7 @@ impl<'a> Newton<'a> {
         let n = p.model.n_free;
         let (pattern, slots) =
             pieces::time("setup.pattern", 0, || p.model.stiffness_pattern(&[], n));
-        let rows: Vec<Vec<(usize, f64)>> = p
-            .rows
-            .iter()
-            .map(|r| {
-                r.entries
-                    .iter()
-                    .map(|&(d, v)| (p.model.equation[d], v))
-                    .filter(|&(eq, _)| eq != FIXED)
-                    .collect()
-            })
-            .collect();
+        let rows = p.free_rows();
         let viscoplastic = p.model.materials.iter().any(|m| m.viscoplastic.is_some());
         let (stiffness, elastic_values) = pieces::time("setup.values", 0, || {
             let mut stiffness = SparseSystem::new(&pattern);
