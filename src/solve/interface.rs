@@ -280,9 +280,9 @@ impl Block {
         }
     }
 
-    /// Factorize the block whose lower-triangle values are `values` (overwritten) and
-    /// return its Schur complement onto its interface (see
-    /// [`InterfaceFactorization::factor`]).
+    /// Factorize the block whose lower-triangle values are `values` (read only: the
+    /// shifted and scaled values are a copy in `precision`) and return its Schur
+    /// complement onto its interface (see [`InterfaceFactorization::factor`]).
     fn factor(&mut self, values: &[f64], shift: f64, precision: Precision) -> Result<Mat<f64>> {
         let t = Instant::now();
         let mut diagonal: Vec<f64> = self.diagonal.iter().map(|&s| values[s]).collect();
