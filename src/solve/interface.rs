@@ -25,6 +25,7 @@
 //! solves with the whole factor only, and this needs the forward and back substitutions
 //! apart, with the interface solve in between.
 
+use super::substitution::{self, Split, Structure, Value};
 use super::{ordering, pieces};
 use crate::error::{Error, Result};
 use crate::fe::Pattern;
@@ -64,6 +65,8 @@ pub struct InterfaceFactorization {
     row_scale: Vec<f64>,
     /// The diagonal blocks, in equation order.
     blocks: Vec<Block>,
+    /// Each block's elimination tree split into subtrees for the substitutions.
+    splits: Vec<Split>,
     /// S: the Schur complement of the stiffness onto the interface (b x b, force/length),
     /// block diagonal.
     schur: Option<Mat<f64>>,
@@ -88,6 +91,8 @@ struct Block {
     /// Position of each local equation in the block's elimination order.
     position: Vec<usize>,
     symbolic: SymbolicCholesky<usize>,
+    /// First column of each supernode of the factor, and n at the end.
+    begin: Vec<usize>,
     /// Pattern of the block (lower triangle read) and the slots of its diagonal entries,
     /// in local equation order.
     pattern: SymbolicSparseColMat<usize>,
@@ -117,6 +122,12 @@ pub enum Precision {
     Single,
 }
 
+/// The factor values of every block, in their one precision.
+enum Values<'a> {
+    Double(Vec<&'a [f64]>),
+    Single(Vec<&'a [f32]>),
+}
+
 /// The values of a block's factor.
 enum FactorValues {
     Double(Vec<f64>),
@@ -139,44 +150,6 @@ impl FactorValues {
             FactorValues::Double(_) => None,
         }
     }
-}
-
-/// A stored value of the factor: f64, or f32 for a preconditioner.
-trait Value: faer::traits::RealField + Copy {
-    fn get(self) -> f64;
-    fn from_f64(v: f64) -> Self;
-}
-impl Value for f64 {
-    fn get(self) -> f64 {
-        self
-    }
-    fn from_f64(v: f64) -> Self {
-        v
-    }
-}
-impl Value for f32 {
-    fn get(self) -> f64 {
-        self as f64
-    }
-    fn from_f64(v: f64) -> Self {
-        v as f32
-    }
-}
-
-/// sum_k l_k x_k, with four partial sums: one running sum is bound by the latency of the
-/// addition.
-fn dot<T: Value>(l: &[T], x: &[f64]) -> f64 {
-    let mut sums = [0.0; 4];
-    let (l_chunks, x_chunks) = (l.chunks_exact(4), x.chunks_exact(4));
-    let rest: f64 = (l_chunks.remainder().iter().zip(x_chunks.remainder()))
-        .map(|(a, b)| a.get() * b)
-        .sum();
-    for (a, b) in l_chunks.zip(x_chunks) {
-        for k in 0..4 {
-            sums[k] += a[k].get() * b[k];
-        }
-    }
-    sums[0] + sums[1] + sums[2] + sums[3] + rest
 }
 
 /// Whether an LU's pivots are all above 1e-12 of the largest (an empty matrix is regular).
@@ -260,6 +233,14 @@ impl Block {
             )
         })
         .map_err(|e| Error::NotConverged(format!("symbolic LDLT failed: {e:?}")))?;
+        let begin = match symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(s) => {
+                let mut begin = s.supernode_begin().to_vec();
+                begin.push(n);
+                begin
+            }
+            SymbolicCholeskyRaw::Simplicial(_) => unreachable!("supernodal forced above"),
+        };
         Ok(Block {
             first,
             n,
@@ -267,6 +248,7 @@ impl Block {
             interface,
             position,
             symbolic,
+            begin,
             pattern: block_pattern,
             diagonal,
             numeric: None,
@@ -457,17 +439,22 @@ impl Block {
         (l, d)
     }
 
-    /// Forward substitution of the block's load `f` (local equations): the substituted
-    /// vector and what the block's interface sees of the load.
-    fn condense(&self, f: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    /// The block's load `f` (local equations) scaled by W and in elimination order: the
+    /// vector the forward substitution starts from.
+    fn permuted(&self, f: &[f64]) -> Vec<f64> {
         let numeric = self.numeric.as_ref().expect("factor before solve");
-        let (n, b) = (self.n, self.interface.len());
-        let mut y = vec![0.0; n];
+        let mut y = vec![0.0; self.n];
         for (e, &p) in self.position.iter().enumerate() {
             y[p] = numeric.scaling[e] * f[e];
         }
-        self.forward(numeric, &mut y);
-        // The condensed load W_I^{-1} L_II y_I.
+        y
+    }
+
+    /// What the block's interface sees of the load, from its forward substitution `y`: the
+    /// condensed load W_I^{-1} L_II y_I.
+    fn interface_load(&self, y: &[f64]) -> Vec<f64> {
+        let numeric = self.numeric.as_ref().expect("factor before solve");
+        let (n, b) = (self.n, self.interface.len());
         let first = n - b;
         let mut load = vec![0.0; b];
         for j in 0..b {
@@ -481,12 +468,13 @@ impl Block {
         for (i, &e) in self.interface.iter().enumerate() {
             load[i] /= numeric.scaling[e];
         }
-        (y, load)
+        load
     }
 
-    /// The block's displacement (local equations) whose interface values are
-    /// `x_interface`, from its forward substitution `y`.
-    fn expand(&self, mut y: Vec<f64>, x_interface: &[f64]) -> Vec<f64> {
+    /// The vector the back substitution starts from: the forward substitution `y` with the
+    /// trailing values that lead to the interface values `x_interface` (D L_II^T W_I^{-1}
+    /// x_I), all times D^{-1}.
+    fn before_back(&self, mut y: Vec<f64>, x_interface: &[f64]) -> Vec<f64> {
         let numeric = self.numeric.as_ref().expect("factor before solve");
         let (n, b) = (self.n, self.interface.len());
         let first = n - b;
@@ -499,12 +487,31 @@ impl Block {
                 .sum();
             y[first + j] = numeric.d_interface[j] * s;
         }
-        self.diagonal_and_back(numeric, &mut y);
-        let mut x = vec![0.0; n];
+        for (yi, d) in y.iter_mut().zip(&numeric.inverse_diagonal) {
+            *yi *= d;
+        }
+        y
+    }
+
+    /// The block's displacement (local equations) from its back substitution `y`.
+    fn unpermuted(&self, y: &[f64]) -> Vec<f64> {
+        let numeric = self.numeric.as_ref().expect("factor before solve");
+        let mut x = vec![0.0; self.n];
         for (e, &p) in self.position.iter().enumerate() {
             x[e] = numeric.scaling[e] * y[p];
         }
         x
+    }
+
+    /// The factor's supernodal structure.
+    fn structure(&self) -> Structure<'_> {
+        let sym = self.supernodal();
+        Structure {
+            begin: &self.begin,
+            row_ptr: sym.col_ptr_for_row_idx(),
+            rows: sym.row_idx(),
+            val_ptr: sym.col_ptr_for_val(),
+        }
     }
 }
 
@@ -537,6 +544,8 @@ impl InterfaceFactorization {
             .iter()
             .flat_map(|b| b.interface.iter().map(move |&e| b.first + e))
             .collect();
+        let structures: Vec<Structure> = blocks.iter().map(Block::structure).collect();
+        let splits = substitution::split(&structures);
         let mut local = vec![usize::MAX; n];
         for (l, &e) in interface.iter().enumerate() {
             local[e] = l;
@@ -558,6 +567,7 @@ impl InterfaceFactorization {
             rows: interface_rows,
             row_scale,
             blocks,
+            splits,
             schur: None,
             factor_s: Cell::new(0.0),
             symbolic_s: t.elapsed().as_secs_f64(),
@@ -668,21 +678,61 @@ impl InterfaceFactorization {
     }
 
     /// Forward substitution of the load `f` (n): what the interface sees of it (the
-    /// blocks on rayon's threads).
+    /// subtrees, then the blocks' tops, on rayon's threads: see [`substitution`]).
     pub fn condense(&self, f: &[f64]) -> Condensed {
         self.solves.set(self.solves.get() + 1);
-        let parts: Vec<(Vec<f64>, Vec<f64>)> = self
+        let mut y: Vec<Vec<f64>> = self
             .blocks
             .par_iter()
-            .map(|b| b.condense(&f[b.first..b.first + b.n]))
+            .map(|b| b.permuted(&f[b.first..b.first + b.n]))
             .collect();
-        let mut load = Vec::with_capacity(self.interface.len());
-        let mut y = Vec::with_capacity(parts.len());
-        for (yb, lb) in parts {
-            y.push(yb);
-            load.extend(lb);
+        match self.values() {
+            Values::Single(v) => self.forward(&v, &mut y),
+            Values::Double(v) => self.forward(&v, &mut y),
         }
+        let load = (self.blocks.iter().zip(&y))
+            .flat_map(|(b, yb)| b.interface_load(yb))
+            .collect();
         Condensed { y, load }
+    }
+
+    /// The blocks' factor values, all in one precision.
+    fn values(&self) -> Values<'_> {
+        let numeric = || {
+            self.blocks
+                .iter()
+                .map(|b| b.numeric.as_ref().expect("factored"))
+        };
+        match numeric().all(|n| matches!(n.values, FactorValues::Single(_))) {
+            true => Values::Single(
+                numeric()
+                    .map(|n| match &n.values {
+                        FactorValues::Single(l) => &l[..],
+                        FactorValues::Double(_) => unreachable!("checked above"),
+                    })
+                    .collect(),
+            ),
+            false => Values::Double(
+                numeric()
+                    .map(|n| match &n.values {
+                        FactorValues::Double(l) => &l[..],
+                        FactorValues::Single(_) => unreachable!("one precision per factorization"),
+                    })
+                    .collect(),
+            ),
+        }
+    }
+
+    /// y <- L^{-1} y, block by block (`y`: the blocks' vectors in elimination order).
+    fn forward<T: Value>(&self, values: &[&[T]], y: &mut [Vec<f64>]) {
+        let structures: Vec<Structure> = self.blocks.iter().map(Block::structure).collect();
+        substitution::forward_blocks(&self.splits, &structures, values, y);
+    }
+
+    /// y <- L^{-T} y, block by block.
+    fn back<T: Value>(&self, values: &[&[T]], y: &mut [Vec<f64>]) {
+        let structures: Vec<Structure> = self.blocks.iter().map(Block::structure).collect();
+        substitution::back_blocks(&self.splits, &structures, values, y);
     }
 
     /// The interface part of the Newton system of `set` (see the module): the interface
@@ -723,7 +773,7 @@ impl InterfaceFactorization {
 
     /// The displacement (n) whose interface values are `x_interface`, from the forward
     /// substitution `condensed`: per block, the trailing values that lead to x_I, D L_II^T
-    /// W_I^{-1} x_I, then the back substitution (the blocks on rayon's threads).
+    /// W_I^{-1} x_I, then the back substitution (on rayon's threads, as the forward one).
     pub fn expand(&self, condensed: Condensed, x_interface: &[f64]) -> Vec<f64> {
         let mut offsets = Vec::with_capacity(self.blocks.len());
         let mut offset = 0;
@@ -731,12 +781,15 @@ impl InterfaceFactorization {
             offsets.push(offset);
             offset += b.interface.len();
         }
-        let parts: Vec<Vec<f64>> = self
-            .blocks
-            .par_iter()
-            .zip(condensed.y)
-            .zip(offsets)
-            .map(|((b, y), o)| b.expand(y, &x_interface[o..o + b.interface.len()]))
+        let mut y: Vec<Vec<f64>> = (self.blocks.par_iter().zip(condensed.y).zip(offsets))
+            .map(|((b, y), o)| b.before_back(y, &x_interface[o..o + b.interface.len()]))
+            .collect();
+        match self.values() {
+            Values::Single(v) => self.back(&v, &mut y),
+            Values::Double(v) => self.back(&v, &mut y),
+        }
+        let parts: Vec<Vec<f64>> = (self.blocks.par_iter().zip(&y))
+            .map(|(b, yb)| b.unpermuted(yb))
             .collect();
         parts.concat()
     }
@@ -772,70 +825,5 @@ impl Block {
                 &values[val_ptr[s]..val_ptr[s + 1]],
             )
         })
-    }
-
-    /// x <- L^{-1} x.
-    fn forward(&self, numeric: &Numeric, x: &mut [f64]) {
-        match &numeric.values {
-            FactorValues::Single(l) => self.forward_with(l, x),
-            FactorValues::Double(l) => self.forward_with(l, x),
-        }
-    }
-
-    /// x <- L^{-T} D^{-1} x.
-    fn diagonal_and_back(&self, numeric: &Numeric, x: &mut [f64]) {
-        for (xi, d) in x.iter_mut().zip(&numeric.inverse_diagonal) {
-            *xi *= d;
-        }
-        match &numeric.values {
-            FactorValues::Single(l) => self.back_with(l, x),
-            FactorValues::Double(l) => self.back_with(l, x),
-        }
-    }
-
-    /// x <- L^{-1} x (unit lower triangular, supernode after supernode). Plain loops over
-    /// the columns, the off-diagonal rows gathered and scattered once per supernode: a
-    /// solve reads the factor once and is bound by memory.
-    fn forward_with<T: Value>(&self, values: &[T], x: &mut [f64]) {
-        let mut below = Vec::new();
-        for (start, width, pattern, values) in self.supernodes(values) {
-            let rows = width + pattern.len();
-            below.clear();
-            below.resize(pattern.len(), 0.0);
-            for j in 0..width {
-                let xj = x[start + j];
-                if xj == 0.0 {
-                    continue;
-                }
-                let column = &values[j * rows..(j + 1) * rows];
-                for (xi, l) in x[start + j + 1..start + width]
-                    .iter_mut()
-                    .zip(&column[j + 1..width])
-                {
-                    *xi -= l.get() * xj;
-                }
-                for (bk, l) in below.iter_mut().zip(&column[width..]) {
-                    *bk += l.get() * xj;
-                }
-            }
-            for (&i, bk) in pattern.iter().zip(&below) {
-                x[i] -= bk;
-            }
-        }
-    }
-
-    /// x <- L^{-T} x.
-    fn back_with<T: Value>(&self, values: &[T], x: &mut [f64]) {
-        let mut below = Vec::new();
-        for (start, width, pattern, values) in self.supernodes(values).rev() {
-            let rows = width + pattern.len();
-            below.clear();
-            below.extend(pattern.iter().map(|&i| x[i]));
-            for j in (0..width).rev() {
-                let column = &values[j * rows..(j + 1) * rows];
-                x[start + j] -= dot(&column[width..], &below)
-                    + dot(&column[j + 1..width], &x[start + j + 1..start + width]);
-            }
-        }
     }
 }

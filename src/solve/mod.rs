@@ -9,6 +9,7 @@ pub mod linear;
 pub mod newton;
 pub mod ordering;
 pub mod pieces;
+pub mod substitution;
 
 use crate::contact::{self, Interface, Method, Row};
 use crate::error::{Error, Result};

@@ -1,0 +1,455 @@
+//! The forward and back substitutions with a supernodal factor L (unit lower triangular),
+//! and the split of a factor's elimination tree into subtrees that are substituted side by
+//! side on rayon's threads.
+//!
+//! A supernode's columns update only rows of its ancestors in the elimination tree, so two
+//! disjoint subtrees are independent in a forward substitution except for the rows of their
+//! common ancestors, and in a back substitution they only read those rows. A [`Subtree`] is
+//! substituted on a vector of its own (its columns, then the rows outside it that it
+//! updates or reads), and the updates of the outside rows are added afterwards, subtree by
+//! subtree in a fixed order: the sums, hence the results, do not depend on the threads.
+//! The supernodes outside every subtree (the top of the tree: separators and the contact
+//! interface) are substituted after them (forward) or before them (back).
+//!
+//! Why: the two bodies are factorized apart, one block each, and their substitutions ran
+//! side by side, but the blocks differ in size (at 137,472 dofs of `rates`: 45,312 and
+//! 92,160 equations), so the larger one set the time: one preconditioner solve 9.3 ms on
+//! two threads against 13.5 ms on one.
+
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// A stored value of the factor: f64, or f32 for a preconditioner.
+pub trait Value: faer::traits::RealField + Copy + Send + Sync + 'static {
+    /// The value in f64.
+    fn get(self) -> f64;
+    /// The value rounded from f64.
+    fn from_f64(v: f64) -> Self;
+}
+impl Value for f64 {
+    fn get(self) -> f64 {
+        self
+    }
+    fn from_f64(v: f64) -> Self {
+        v
+    }
+}
+impl Value for f32 {
+    fn get(self) -> f64 {
+        self as f64
+    }
+    fn from_f64(v: f64) -> Self {
+        v as f32
+    }
+}
+
+/// sum_k l_k x_k, with four partial sums: one running sum is bound by the latency of the
+/// addition.
+fn dot<T: Value>(l: &[T], x: &[f64]) -> f64 {
+    let mut sums = [0.0; 4];
+    let (l_chunks, x_chunks) = (l.chunks_exact(4), x.chunks_exact(4));
+    let rest: f64 = (l_chunks.remainder().iter().zip(x_chunks.remainder()))
+        .map(|(a, b)| a.get() * b)
+        .sum();
+    for (a, b) in l_chunks.zip(x_chunks) {
+        for k in 0..4 {
+            sums[k] += a[k].get() * b[k];
+        }
+    }
+    sums[0] + sums[1] + sums[2] + sums[3] + rest
+}
+
+/// One supernode as the substitutions see it: (first column, width, off-diagonal row
+/// indices, values: the width columns of the diagonal block and the off-diagonal rows,
+/// column-major).
+pub type Supernode<'a, T> = (usize, usize, &'a [usize], &'a [T]);
+
+/// x <- L^{-1} x over `supernodes` (increasing). Plain loops over the columns, the
+/// off-diagonal rows gathered and scattered once per supernode: a solve reads the factor
+/// once and is bound by memory.
+pub fn forward<'a, T: Value>(supernodes: impl Iterator<Item = Supernode<'a, T>>, x: &mut [f64]) {
+    let mut below = Vec::new();
+    for (start, width, pattern, values) in supernodes {
+        let rows = width + pattern.len();
+        below.clear();
+        below.resize(pattern.len(), 0.0);
+        for j in 0..width {
+            let xj = x[start + j];
+            if xj == 0.0 {
+                continue;
+            }
+            let column = &values[j * rows..(j + 1) * rows];
+            for (xi, l) in x[start + j + 1..start + width]
+                .iter_mut()
+                .zip(&column[j + 1..width])
+            {
+                *xi -= l.get() * xj;
+            }
+            for (bk, l) in below.iter_mut().zip(&column[width..]) {
+                *bk += l.get() * xj;
+            }
+        }
+        for (&i, bk) in pattern.iter().zip(&below) {
+            x[i] -= bk;
+        }
+    }
+}
+
+/// x <- L^{-T} x over `supernodes` (decreasing).
+pub fn back<'a, T: Value>(supernodes: impl Iterator<Item = Supernode<'a, T>>, x: &mut [f64]) {
+    let mut below = Vec::new();
+    for (start, width, pattern, values) in supernodes {
+        let rows = width + pattern.len();
+        below.clear();
+        below.extend(pattern.iter().map(|&i| x[i]));
+        for j in (0..width).rev() {
+            let column = &values[j * rows..(j + 1) * rows];
+            x[start + j] -= dot(&column[width..], &below)
+                + dot(&column[j + 1..width], &x[start + j + 1..start + width]);
+        }
+    }
+}
+
+/// The supernodal structure of a factor: per supernode its first column (and one past
+/// the last: `begin[s + 1]`), its off-diagonal rows (`rows[row_ptr[s]..row_ptr[s + 1]]`)
+/// and its values (`val_ptr[s]..val_ptr[s + 1]`).
+#[derive(Clone, Copy)]
+pub struct Structure<'a> {
+    /// First column of each supernode, and n at the end.
+    pub begin: &'a [usize],
+    /// Start of each supernode's off-diagonal rows in `rows`.
+    pub row_ptr: &'a [usize],
+    /// Off-diagonal rows, increasing per supernode.
+    pub rows: &'a [usize],
+    /// Start of each supernode's values.
+    pub val_ptr: &'a [usize],
+}
+
+impl Structure<'_> {
+    fn n_supernodes(&self) -> usize {
+        self.begin.len() - 1
+    }
+
+    fn pattern(&self, s: usize) -> &[usize] {
+        &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]]
+    }
+
+    /// The values a substitution reads in supernode `s` (its cost).
+    fn weight(&self, s: usize) -> usize {
+        self.val_ptr[s + 1] - self.val_ptr[s]
+    }
+
+    /// The parent of each supernode in the elimination tree (None at a root): the
+    /// supernode of its first off-diagonal row.
+    fn parents(&self) -> Vec<Option<usize>> {
+        let mut of_column = vec![0; *self.begin.last().unwrap_or(&0)];
+        for s in 0..self.n_supernodes() {
+            of_column[self.begin[s]..self.begin[s + 1]].fill(s);
+        }
+        (0..self.n_supernodes())
+            .map(|s| self.pattern(s).first().map(|&i| of_column[i]))
+            .collect()
+    }
+}
+
+/// A subtree of one block's elimination tree (closed under descendants), with its own
+/// numbering: its columns 0..k, then the rows outside it that its supernodes touch.
+pub struct Subtree {
+    /// Its supernodes, increasing.
+    supernodes: Vec<usize>,
+    /// Its columns (increasing): local 0..k.
+    columns: Vec<usize>,
+    /// Rows outside the subtree its supernodes touch (increasing): local k.. .
+    outside: Vec<usize>,
+    /// Per supernode (in `supernodes`' order): local first column.
+    start: Vec<usize>,
+    /// Per supernode: start of its local off-diagonal rows in `rows` (and the end).
+    row_ptr: Vec<usize>,
+    /// Off-diagonal rows in local numbering.
+    rows: Vec<usize>,
+    /// Values of the subtree (weight of [`Structure::weight`]).
+    weight: usize,
+}
+
+impl Subtree {
+    /// The subtree below `root` (its descendants: `children` lists them).
+    fn new(structure: &Structure, children: &[Vec<usize>], root: usize) -> Self {
+        let mut supernodes = vec![root];
+        let mut next = 0;
+        while next < supernodes.len() {
+            supernodes.extend_from_slice(&children[supernodes[next]]);
+            next += 1;
+        }
+        supernodes.sort_unstable();
+        let mut columns = Vec::new();
+        let mut start = Vec::with_capacity(supernodes.len());
+        for &s in &supernodes {
+            start.push(columns.len());
+            columns.extend(structure.begin[s]..structure.begin[s + 1]);
+        }
+        let inside = |i: usize| columns.binary_search(&i);
+        let mut outside: Vec<usize> = supernodes
+            .iter()
+            .flat_map(|&s| structure.pattern(s).iter().copied())
+            .filter(|&i| inside(i).is_err())
+            .collect();
+        outside.sort_unstable();
+        outside.dedup();
+        let k = columns.len();
+        let mut row_ptr = vec![0];
+        let mut rows = Vec::new();
+        for &s in &supernodes {
+            rows.extend(structure.pattern(s).iter().map(|&i| match inside(i) {
+                Ok(local) => local,
+                Err(_) => k + outside.binary_search(&i).expect("collected above"),
+            }));
+            row_ptr.push(rows.len());
+        }
+        let weight = supernodes.iter().map(|&s| structure.weight(s)).sum();
+        Subtree {
+            supernodes,
+            columns,
+            outside,
+            start,
+            row_ptr,
+            rows,
+            weight,
+        }
+    }
+
+    /// The subtree's supernodes in local numbering, increasing.
+    fn local<'a, T: Value>(
+        &'a self,
+        structure: &'a Structure,
+        values: &'a [T],
+    ) -> impl DoubleEndedIterator<Item = Supernode<'a, T>> + 'a {
+        self.supernodes.iter().enumerate().map(move |(k, &s)| {
+            (
+                self.start[k],
+                structure.begin[s + 1] - structure.begin[s],
+                &self.rows[self.row_ptr[k]..self.row_ptr[k + 1]],
+                &values[structure.val_ptr[s]..structure.val_ptr[s + 1]],
+            )
+        })
+    }
+}
+
+/// One block's elimination tree split: subtrees, and the top (every other supernode,
+/// increasing: closed under ancestors).
+pub struct Split {
+    /// Disjoint subtrees.
+    pub subtrees: Vec<Subtree>,
+    /// Supernodes in no subtree, increasing.
+    top: Vec<usize>,
+}
+
+/// Subtrees below this many values are not split further (their halves would cost less
+/// than the scheduling).
+const SMALLEST_SPLIT: usize = 20_000;
+
+/// Subtrees are split until none holds more than this fraction of all the blocks' work:
+/// four or more pieces for two threads, scheduled as they come free.
+const LARGEST_SHARE: f64 = 0.2;
+
+/// The tops may hold at most this fraction of the blocks' work.
+const TOP_SHARE: f64 = 0.15;
+
+/// Split the elimination trees of the blocks `structures` into subtrees: starting from
+/// the roots, the heaviest subtree is replaced by its children (its root joins its
+/// block's top) while it holds more than [`LARGEST_SHARE`] of the work, the tops hold
+/// less than [`TOP_SHARE`] and it is worth splitting ([`SMALLEST_SPLIT`]). The split
+/// depends on the structures only, never on the threads at hand.
+pub fn split(structures: &[Structure]) -> Vec<Split> {
+    let children: Vec<Vec<Vec<usize>>> = structures
+        .iter()
+        .map(|st| {
+            let mut children = vec![Vec::new(); st.n_supernodes()];
+            for (s, parent) in st.parents().into_iter().enumerate() {
+                if let Some(p) = parent {
+                    children[p].push(s);
+                }
+            }
+            children
+        })
+        .collect();
+    // Subtree weights, children before parents (a child's index is below its parent's).
+    let weights: Vec<Vec<usize>> = structures
+        .iter()
+        .zip(&children)
+        .map(|(st, ch)| {
+            let mut w: Vec<usize> = (0..st.n_supernodes()).map(|s| st.weight(s)).collect();
+            for s in 0..w.len() {
+                w[s] += ch[s].iter().map(|&c| w[c]).sum::<usize>();
+            }
+            w
+        })
+        .collect();
+    let total: usize = structures
+        .iter()
+        .map(|st| (0..st.n_supernodes()).map(|s| st.weight(s)).sum::<usize>())
+        .sum();
+    // Candidates (block, root), the heaviest last.
+    let weight = |&(b, s): &(usize, usize)| weights[b][s];
+    let mut candidates: Vec<(usize, usize)> = Vec::new();
+    for (b, st) in structures.iter().enumerate() {
+        let parents = st.parents();
+        candidates.extend(
+            (0..st.n_supernodes())
+                .filter(|&s| parents[s].is_none())
+                .map(|s| (b, s)),
+        );
+    }
+    let mut tops: Vec<Vec<usize>> = vec![Vec::new(); structures.len()];
+    let mut top_work = 0;
+    loop {
+        candidates.sort_by_key(|c| (weight(c), std::cmp::Reverse(*c)));
+        let Some(&(b, s)) = candidates.last() else {
+            break;
+        };
+        let own = structures[b].weight(s);
+        if (weight(&(b, s)) as f64) <= LARGEST_SHARE * total as f64
+            || weight(&(b, s)) < SMALLEST_SPLIT
+            || (top_work + own) as f64 > TOP_SHARE * total as f64
+        {
+            break;
+        }
+        candidates.pop();
+        tops[b].push(s);
+        top_work += own;
+        candidates.extend(children[b][s].iter().map(|&c| (b, c)));
+    }
+    // Per block, the subtrees heaviest first: the order they are scheduled in.
+    candidates.reverse();
+    tops.into_iter()
+        .enumerate()
+        .map(|(b, mut top)| {
+            top.sort_unstable();
+            let subtrees = (candidates.iter())
+                .filter(|c| c.0 == b)
+                .map(|&(_, root)| Subtree::new(&structures[b], &children[b], root))
+                .collect();
+            Split { subtrees, top }
+        })
+        .collect()
+}
+
+/// A lock that a panic elsewhere does not poison for the substitutions (they only read
+/// and write numbers).
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// x <- L^{-1} x for every block (`x`: the blocks' vectors, elimination order). The
+/// subtrees of all blocks are tasks on rayon's threads, the blocks with the most work
+/// first; the task that finishes a block's last subtree adds their updates of the outside
+/// rows (subtree by subtree, in a fixed order) and substitutes the block's top, while the
+/// other threads go on with the next subtrees.
+pub fn forward_blocks<T: Value>(
+    splits: &[Split],
+    structures: &[Structure],
+    values: &[&[T]],
+    x: &mut [Vec<f64>],
+) {
+    let blocks: Vec<Mutex<&mut Vec<f64>>> = x.iter_mut().map(Mutex::new).collect();
+    let parts: Vec<Vec<Mutex<Vec<f64>>>> = (splits.iter())
+        .map(|s| s.subtrees.iter().map(|_| Mutex::new(Vec::new())).collect())
+        .collect();
+    let remaining: Vec<AtomicUsize> = (splits.iter())
+        .map(|s| AtomicUsize::new(s.subtrees.len()))
+        .collect();
+    let top = |b: usize| {
+        let mut xb = lock(&blocks[b]);
+        for (subtree, part) in splits[b].subtrees.iter().zip(&parts[b]) {
+            let z = std::mem::take(&mut *lock(part));
+            let k = subtree.columns.len();
+            for (&i, &v) in subtree.columns.iter().zip(&z[..k]) {
+                xb[i] = v;
+            }
+            for (&i, &v) in subtree.outside.iter().zip(&z[k..]) {
+                xb[i] += v;
+            }
+        }
+        let (split, st, v) = (&splits[b], &structures[b], values[b]);
+        forward(split.top.iter().map(|&s| global(st, v, s)), &mut xb);
+    };
+    rayon::scope_fifo(|scope| {
+        for b in by_work(splits) {
+            if splits[b].subtrees.is_empty() {
+                scope.spawn_fifo(move |_| top(b));
+            }
+            for (t, subtree) in splits[b].subtrees.iter().enumerate() {
+                let (top, blocks, parts, remaining) = (&top, &blocks, &parts, &remaining);
+                scope.spawn_fifo(move |_| {
+                    let mut z: Vec<f64> = {
+                        let xb = lock(&blocks[b]);
+                        subtree.columns.iter().map(|&i| xb[i]).collect()
+                    };
+                    z.resize(subtree.columns.len() + subtree.outside.len(), 0.0);
+                    forward(subtree.local(&structures[b], values[b]), &mut z);
+                    *lock(&parts[b][t]) = z;
+                    if remaining[b].fetch_sub(1, Ordering::AcqRel) == 1 {
+                        top(b);
+                    }
+                });
+            }
+        }
+    });
+}
+
+/// x <- L^{-T} x for every block: each block's top, then its subtrees, as tasks on
+/// rayon's threads (the blocks with the most work first).
+pub fn back_blocks<T: Value>(
+    splits: &[Split],
+    structures: &[Structure],
+    values: &[&[T]],
+    x: &mut [Vec<f64>],
+) {
+    let blocks: Vec<Mutex<&mut Vec<f64>>> = x.iter_mut().map(Mutex::new).collect();
+    let subtree = |b: usize, subtree: &Subtree| {
+        let mut z: Vec<f64> = {
+            let xb = lock(&blocks[b]);
+            (subtree.columns.iter())
+                .chain(&subtree.outside)
+                .map(|&i| xb[i])
+                .collect()
+        };
+        back(subtree.local(&structures[b], values[b]).rev(), &mut z);
+        let mut xb = lock(&blocks[b]);
+        for (&i, &v) in subtree.columns.iter().zip(&z) {
+            xb[i] = v;
+        }
+    };
+    rayon::scope_fifo(|scope| {
+        for b in by_work(splits) {
+            let (subtree, blocks) = (&subtree, &blocks);
+            scope.spawn_fifo(move |scope| {
+                {
+                    let (split, st, v) = (&splits[b], &structures[b], values[b]);
+                    let mut xb = lock(&blocks[b]);
+                    back(split.top.iter().rev().map(|&s| global(st, v, s)), &mut xb);
+                }
+                for t in &splits[b].subtrees {
+                    scope.spawn_fifo(move |_| subtree(b, t));
+                }
+            });
+        }
+    });
+}
+
+/// The blocks, the most work first.
+fn by_work(splits: &[Split]) -> Vec<usize> {
+    let work = |s: &Split| s.subtrees.iter().map(|t| t.weight).sum::<usize>();
+    let mut order: Vec<usize> = (0..splits.len()).collect();
+    order.sort_by_key(|&b| (std::cmp::Reverse(work(&splits[b])), b));
+    order
+}
+
+/// Supernode `s` in the block's own numbering.
+fn global<'a, T: Value>(structure: &'a Structure, values: &'a [T], s: usize) -> Supernode<'a, T> {
+    (
+        structure.begin[s],
+        structure.begin[s + 1] - structure.begin[s],
+        structure.pattern(s),
+        &values[structure.val_ptr[s]..structure.val_ptr[s + 1]],
+    )
+}
