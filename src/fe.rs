@@ -716,19 +716,21 @@ impl Model {
         values: &mut [f64],
     ) {
         for ((e, d), sl) in self.elements.iter().zip(tangents).zip(slots) {
-            scatter_tangent(e, d, sl, 0, values);
+            scatter_tangent(e, d, sl, 0, Orientation::AsIs, values);
         }
     }
 
     /// Add `|T| B^T (D - E) S B` for the elements whose tangent D differs from the elastic
     /// E of their body (the viscoplastic ones): on top of the assembled elastic stiffness,
     /// this assembles the consistent tangent while elastic triangles cost nothing.
-    /// `split`: [`Model::body_slot_split`] of `slots`, computed once by the caller.
+    /// `split`: [`Model::body_slot_split`] of `slots`, computed once by the caller;
+    /// `orientation`: whether `values` hold the matrix or its transpose.
     pub fn add_tangent_change(
         &self,
         tangents: &[Matrix3<f64>],
         slots: &[[usize; 36]],
         split: Option<usize>,
+        orientation: Orientation,
         values: &mut [f64],
     ) {
         // A body with no viscoplastic part is skipped whole. From PARALLEL_ELEMENTS
@@ -743,7 +745,7 @@ impl Model {
             let elastic = self.materials[body].elastic.matrix();
             for ((e, d), sl) in self.elements.iter().zip(tangents).zip(slots) {
                 if e.body == body && *d != elastic {
-                    scatter_tangent(e, &(d - elastic), sl, offset, values);
+                    scatter_tangent(e, &(d - elastic), sl, offset, orientation, values);
                 }
             }
         };
@@ -807,6 +809,17 @@ pub fn split_ranges_mut<'a>(
 /// `rates` 0.032 s against 0.021-0.024 s, of `rates-elastic` 0.0046 s against 0.0032-0.0036 s.
 pub const PARALLEL_ELEMENTS: usize = 8_000;
 
+/// How assembled values are laid out in a pattern's slots: the matrix itself (entry (i, j)
+/// in the slot of row i, column j), or its transpose (in the slot of row j, column i: the
+/// matrix by rows, as a row-wise product wants it; see `SparseSystem::transpose_matvec`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Orientation {
+    /// Entry (i, j) in slot (i, j).
+    AsIs,
+    /// Entry (i, j) in slot (j, i).
+    Transposed,
+}
+
 /// Add `|T| B^T D S B` of one element into `values` through its slot map (S halves the
 /// engineering shear).
 fn scatter_tangent(
@@ -814,12 +827,16 @@ fn scatter_tangent(
     d: &Matrix3<f64>,
     slots: &[usize; 36],
     offset: usize,
+    orientation: Orientation,
     values: &mut [f64],
 ) {
     let ke = e.stiffness(d);
     for i in 0..6 {
         for j in 0..6 {
-            let slot = slots[6 * i + j];
+            let slot = match orientation {
+                Orientation::AsIs => slots[6 * i + j],
+                Orientation::Transposed => slots[6 * j + i],
+            };
             if slot != FIXED {
                 values[slot - offset] += ke[(i, j)];
             }

@@ -129,14 +129,20 @@ fn a_solve_gives_the_same_bits_on_one_thread_and_on_two() {
         pool.install(|| {
             let mut factorization = InterfaceFactorization::new(&pattern, &rows).unwrap();
             factorization.factor(&values, c, Precision::Single).unwrap();
-            let set = factorization.active_set(&vec![true; rows.len()], c).unwrap();
+            let set = factorization
+                .active_set(&vec![true; rows.len()], c)
+                .unwrap();
             let mut x = b.clone();
             factorization.solve(&set, c, &mut x);
             x
         })
     };
     let (one, two) = (solve_on(1), solve_on(2));
-    let differing = one.iter().zip(&two).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
+    let differing = one
+        .iter()
+        .zip(&two)
+        .filter(|(a, b)| a.to_bits() != b.to_bits())
+        .count();
     assert_eq!(differing, 0, "{differing} of {} values differ", one.len());
 }
 

@@ -545,7 +545,7 @@ impl InterfaceFactorization {
             .flat_map(|b| b.interface.iter().map(move |&e| b.first + e))
             .collect();
         let structures: Vec<Structure> = blocks.iter().map(Block::structure).collect();
-        let splits = substitution::split(&structures);
+        let splits = pieces::time("setup.split", 0, || substitution::split(&structures));
         let mut local = vec![usize::MAX; n];
         for (l, &e) in interface.iter().enumerate() {
             local[e] = l;

@@ -18,7 +18,7 @@ use super::{Timings, timed};
 use super::{ordering, pieces};
 use crate::contact;
 use crate::error::{Error, Result};
-use crate::fe::{FIXED, Pattern};
+use crate::fe::{FIXED, Orientation, Pattern};
 use crate::material::Stress;
 use nalgebra::Matrix3;
 use rayon::prelude::*;
@@ -31,7 +31,9 @@ pub struct Newton<'a> {
     n: usize,
     /// Slots of each triangle's 6 x 6 entries in the stiffness pattern.
     slots: Vec<[usize; 36]>,
-    /// The current tangent stiffness K_t (for GMRES's products).
+    /// The current tangent stiffness, stored transposed (K_t^T: the elastic part is
+    /// symmetric, the viscoplastic triangles' changes are assembled transposed), for
+    /// GMRES's products by rows.
     stiffness: SparseSystem,
     /// The contact rows over the free unknowns: (equation, coefficient).
     rows: Vec<Vec<(usize, f64)>>,
@@ -299,7 +301,8 @@ impl<'a> Newton<'a> {
         let (n, c) = (self.n, self.c_scale);
         let (xu, xl) = x.split_at(n);
         let (yu, yl) = y.split_at_mut(n);
-        self.stiffness.matvec(xu, yu);
+        // The stiffness holds K_t^T (see `assemble_tangent`): its transpose product is K_t x.
+        self.stiffness.transpose_matvec(xu, yu);
         for (i, row) in self.rows.iter().enumerate() {
             let xi = c * xl[i];
             if xi != 0.0 {
@@ -335,7 +338,13 @@ impl<'a> Newton<'a> {
                 .with_min_len(4096)
                 .map(|(e, d)| symmetric_tangent(d, &model.materials[e.body].elastic.matrix()))
                 .collect();
-                model.add_tangent_change(&symmetric, &self.slots, self.body_split, &mut vals);
+                model.add_tangent_change(
+                    &symmetric,
+                    &self.slots,
+                    self.body_split,
+                    Orientation::AsIs,
+                    &mut vals,
+                );
             });
             let result = self
                 .factorization
@@ -504,7 +513,8 @@ impl Newton<'_> {
     }
 
     /// Write the current tangent stiffness into the matrix GMRES multiplies with: the
-    /// elastic stiffness (assembled once) plus the viscoplastic triangles' changes.
+    /// elastic stiffness (assembled once) plus the viscoplastic triangles' changes, as
+    /// K_t^T (the consistent tangent is not symmetric; the products read it by rows).
     fn assemble_tangent(&mut self, tangents: &[Matrix3<f64>]) {
         if !self.viscoplastic {
             // Every tangent is elastic: the stiffness holds them since the set-up.
@@ -514,9 +524,13 @@ impl Newton<'_> {
         timed(&clock.assembly, || {
             let vals = self.stiffness.values_mut();
             vals.copy_from_slice(&self.elastic_values);
-            self.p
-                .model
-                .add_tangent_change(tangents, &self.slots, self.body_split, vals);
+            self.p.model.add_tangent_change(
+                tangents,
+                &self.slots,
+                self.body_split,
+                Orientation::Transposed,
+                vals,
+            );
         });
     }
 

@@ -62,12 +62,32 @@ fn dot<T: Value>(l: &[T], x: &[f64]) -> f64 {
 /// One supernode as the substitutions see it: (first column, width, off-diagonal row
 /// indices, values: the width columns of the diagonal block and the off-diagonal rows,
 /// column-major).
-pub type Supernode<'a, T> = (usize, usize, &'a [usize], &'a [T]);
+pub type Supernode<'a, T, I> = (usize, usize, &'a [I], &'a [T]);
+
+/// A row index as stored: usize in faer's structure, u32 in a [`Subtree`]'s own (half the
+/// bytes of a copy made once per mesh).
+pub trait Row: Copy + Send + Sync + 'static {
+    /// The index.
+    fn at(self) -> usize;
+}
+impl Row for usize {
+    fn at(self) -> usize {
+        self
+    }
+}
+impl Row for u32 {
+    fn at(self) -> usize {
+        self as usize
+    }
+}
 
 /// x <- L^{-1} x over `supernodes` (increasing). Plain loops over the columns, the
 /// off-diagonal rows gathered and scattered once per supernode: a solve reads the factor
 /// once and is bound by memory.
-pub fn forward<'a, T: Value>(supernodes: impl Iterator<Item = Supernode<'a, T>>, x: &mut [f64]) {
+pub fn forward<'a, T: Value, I: Row>(
+    supernodes: impl Iterator<Item = Supernode<'a, T, I>>,
+    x: &mut [f64],
+) {
     let mut below = Vec::new();
     for (start, width, pattern, values) in supernodes {
         let rows = width + pattern.len();
@@ -90,18 +110,21 @@ pub fn forward<'a, T: Value>(supernodes: impl Iterator<Item = Supernode<'a, T>>,
             }
         }
         for (&i, bk) in pattern.iter().zip(&below) {
-            x[i] -= bk;
+            x[i.at()] -= bk;
         }
     }
 }
 
 /// x <- L^{-T} x over `supernodes` (decreasing).
-pub fn back<'a, T: Value>(supernodes: impl Iterator<Item = Supernode<'a, T>>, x: &mut [f64]) {
+pub fn back<'a, T: Value, I: Row>(
+    supernodes: impl Iterator<Item = Supernode<'a, T, I>>,
+    x: &mut [f64],
+) {
     let mut below = Vec::new();
     for (start, width, pattern, values) in supernodes {
         let rows = width + pattern.len();
         below.clear();
-        below.extend(pattern.iter().map(|&i| x[i]));
+        below.extend(pattern.iter().map(|&i| x[i.at()]));
         for j in (0..width).rev() {
             let column = &values[j * rows..(j + 1) * rows];
             x[start + j] -= dot(&column[width..], &below)
@@ -139,16 +162,27 @@ impl Structure<'_> {
         self.val_ptr[s + 1] - self.val_ptr[s]
     }
 
-    /// The parent of each supernode in the elimination tree (None at a root): the
-    /// supernode of its first off-diagonal row.
-    fn parents(&self) -> Vec<Option<usize>> {
+    /// The supernode of each column.
+    fn of_column(&self) -> Vec<usize> {
         let mut of_column = vec![0; *self.begin.last().unwrap_or(&0)];
         for s in 0..self.n_supernodes() {
             of_column[self.begin[s]..self.begin[s + 1]].fill(s);
         }
-        (0..self.n_supernodes())
-            .map(|s| self.pattern(s).first().map(|&i| of_column[i]))
-            .collect()
+        of_column
+    }
+
+    /// The children of each supernode in the elimination tree (a supernode's parent is
+    /// the supernode of its first off-diagonal row), and the roots.
+    fn tree(&self, of_column: &[usize]) -> (Vec<Vec<usize>>, Vec<usize>) {
+        let mut children = vec![Vec::new(); self.n_supernodes()];
+        let mut roots = Vec::new();
+        for s in 0..self.n_supernodes() {
+            match self.pattern(s).first() {
+                Some(&i) => children[of_column[i]].push(s),
+                None => roots.push(s),
+            }
+        }
+        (children, roots)
     }
 }
 
@@ -166,14 +200,23 @@ pub struct Subtree {
     /// Per supernode: start of its local off-diagonal rows in `rows` (and the end).
     row_ptr: Vec<usize>,
     /// Off-diagonal rows in local numbering.
-    rows: Vec<usize>,
+    rows: Vec<u32>,
     /// Values of the subtree (weight of [`Structure::weight`]).
     weight: usize,
 }
 
 impl Subtree {
-    /// The subtree below `root` (its descendants: `children` lists them).
-    fn new(structure: &Structure, children: &[Vec<usize>], root: usize) -> Self {
+    /// The subtree below `root` (its descendants: `children` lists them). `of_column`:
+    /// [`Structure::of_column`]; `inside` (per supernode, all false) and `local` (per
+    /// column) are scratch.
+    fn new(
+        structure: &Structure,
+        children: &[Vec<usize>],
+        root: usize,
+        of_column: &[usize],
+        inside: &mut [bool],
+        local: &mut [usize],
+    ) -> Self {
         let mut supernodes = vec![root];
         let mut next = 0;
         while next < supernodes.len() {
@@ -184,28 +227,34 @@ impl Subtree {
         let mut columns = Vec::new();
         let mut start = Vec::with_capacity(supernodes.len());
         for &s in &supernodes {
+            inside[s] = true;
             start.push(columns.len());
-            columns.extend(structure.begin[s]..structure.begin[s + 1]);
+            for c in structure.begin[s]..structure.begin[s + 1] {
+                local[c] = columns.len();
+                columns.push(c);
+            }
         }
-        let inside = |i: usize| columns.binary_search(&i);
         let mut outside: Vec<usize> = supernodes
             .iter()
             .flat_map(|&s| structure.pattern(s).iter().copied())
-            .filter(|&i| inside(i).is_err())
+            .filter(|&i| !inside[of_column[i]])
             .collect();
         outside.sort_unstable();
         outside.dedup();
         let k = columns.len();
+        for (j, &i) in outside.iter().enumerate() {
+            local[i] = k + j;
+        }
         let mut row_ptr = vec![0];
         let mut rows = Vec::new();
         for &s in &supernodes {
-            rows.extend(structure.pattern(s).iter().map(|&i| match inside(i) {
-                Ok(local) => local,
-                Err(_) => k + outside.binary_search(&i).expect("collected above"),
-            }));
+            rows.extend(structure.pattern(s).iter().map(|&i| local[i] as u32));
             row_ptr.push(rows.len());
         }
         let weight = supernodes.iter().map(|&s| structure.weight(s)).sum();
+        for &s in &supernodes {
+            inside[s] = false;
+        }
         Subtree {
             supernodes,
             columns,
@@ -222,7 +271,7 @@ impl Subtree {
         &'a self,
         structure: &'a Structure,
         values: &'a [T],
-    ) -> impl DoubleEndedIterator<Item = Supernode<'a, T>> + 'a {
+    ) -> impl DoubleEndedIterator<Item = Supernode<'a, T, u32>> + 'a {
         self.supernodes.iter().enumerate().map(move |(k, &s)| {
             (
                 self.start[k],
@@ -260,18 +309,11 @@ const TOP_SHARE: f64 = 0.15;
 /// less than [`TOP_SHARE`] and it is worth splitting ([`SMALLEST_SPLIT`]). The split
 /// depends on the structures only, never on the threads at hand.
 pub fn split(structures: &[Structure]) -> Vec<Split> {
-    let children: Vec<Vec<Vec<usize>>> = structures
-        .iter()
-        .map(|st| {
-            let mut children = vec![Vec::new(); st.n_supernodes()];
-            for (s, parent) in st.parents().into_iter().enumerate() {
-                if let Some(p) = parent {
-                    children[p].push(s);
-                }
-            }
-            children
-        })
-        .collect();
+    let of_column: Vec<Vec<usize>> = structures.iter().map(Structure::of_column).collect();
+    let (children, roots): (Vec<Vec<Vec<usize>>>, Vec<Vec<usize>>) = (structures.iter())
+        .zip(&of_column)
+        .map(|(st, of)| st.tree(of))
+        .unzip();
     // Subtree weights, children before parents (a child's index is below its parent's).
     let weights: Vec<Vec<usize>> = structures
         .iter()
@@ -290,15 +332,9 @@ pub fn split(structures: &[Structure]) -> Vec<Split> {
         .sum();
     // Candidates (block, root), the heaviest last.
     let weight = |&(b, s): &(usize, usize)| weights[b][s];
-    let mut candidates: Vec<(usize, usize)> = Vec::new();
-    for (b, st) in structures.iter().enumerate() {
-        let parents = st.parents();
-        candidates.extend(
-            (0..st.n_supernodes())
-                .filter(|&s| parents[s].is_none())
-                .map(|s| (b, s)),
-        );
-    }
+    let mut candidates: Vec<(usize, usize)> = (roots.iter().enumerate())
+        .flat_map(|(b, r)| r.iter().map(move |&s| (b, s)))
+        .collect();
     let mut tops: Vec<Vec<usize>> = vec![Vec::new(); structures.len()];
     let mut top_work = 0;
     loop {
@@ -324,9 +360,21 @@ pub fn split(structures: &[Structure]) -> Vec<Split> {
         .enumerate()
         .map(|(b, mut top)| {
             top.sort_unstable();
+            let st = &structures[b];
+            let mut inside = vec![false; st.n_supernodes()];
+            let mut local = vec![0; of_column[b].len()];
             let subtrees = (candidates.iter())
                 .filter(|c| c.0 == b)
-                .map(|&(_, root)| Subtree::new(&structures[b], &children[b], root))
+                .map(|&(_, root)| {
+                    Subtree::new(
+                        st,
+                        &children[b],
+                        root,
+                        &of_column[b],
+                        &mut inside,
+                        &mut local,
+                    )
+                })
                 .collect();
             Split { subtrees, top }
         })
@@ -445,7 +493,11 @@ fn by_work(splits: &[Split]) -> Vec<usize> {
 }
 
 /// Supernode `s` in the block's own numbering.
-fn global<'a, T: Value>(structure: &'a Structure, values: &'a [T], s: usize) -> Supernode<'a, T> {
+fn global<'a, T: Value>(
+    structure: &'a Structure,
+    values: &'a [T],
+    s: usize,
+) -> Supernode<'a, T, usize> {
     (
         structure.begin[s],
         structure.begin[s + 1] - structure.begin[s],
