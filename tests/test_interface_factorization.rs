@@ -59,20 +59,35 @@ fn relative_residual(
     worst / b.iter().fold(0.0f64, |a, v| a.max(v.abs()))
 }
 
+/// The elastic stiffness of `case` (pattern, matrix, its values), its mean diagonal c
+/// (force/length) and the contact rows over the free unknowns.
+fn elastic_system(
+    case: &contact_rates::case::Case,
+) -> (
+    SparseSystem,
+    Vec<f64>,
+    f64,
+    Vec<Vec<(usize, f64)>>,
+    contact_rates::fe::Pattern,
+) {
+    let model = &case.problem.model;
+    let n = model.n_free;
+    let (pattern, slots) = model.stiffness_pattern(&[], n);
+    let mut stiffness = SparseSystem::new(&pattern);
+    model.add_tangent(&model.elastic_tangents(), &slots, stiffness.values_mut());
+    let values = stiffness.values_mut().to_vec();
+    let c = (0..n).map(|i| values[pattern.slot(i, i)]).sum::<f64>() / n as f64;
+    (stiffness, values, c, case.problem.free_rows(), pattern)
+}
+
 /// Level 1 factorizes each body whole; level 4 (34,432 dofs) splits the larger body's
 /// elimination tree into subtrees substituted side by side ([`contact_rates::solve::substitution`]).
 #[test]
 fn interface_solve_is_exact_for_any_active_set() {
     for (level, method) in [(1, Method::Mortar), (1, Method::Nts), (4, Method::Mortar)] {
         let case = common::case("rates", level, method, &[]);
-        let model = &case.problem.model;
-        let n = model.n_free;
-        let (pattern, slots) = model.stiffness_pattern(&[], n);
-        let mut stiffness = SparseSystem::new(&pattern);
-        model.add_tangent(&model.elastic_tangents(), &slots, stiffness.values_mut());
-        let values = stiffness.values_mut().to_vec();
-        let c = (0..n).map(|i| values[pattern.slot(i, i)]).sum::<f64>() / n as f64;
-        let rows = case.problem.free_rows();
+        let n = case.problem.model.n_free;
+        let (stiffness, values, c, rows, pattern) = elastic_system(&case);
         let m = rows.len();
         let b = sequence(n + m);
         // Single precision's error grows with the condition of the stiffness (h^-2): its
@@ -112,14 +127,8 @@ fn interface_solve_is_exact_for_any_active_set() {
 #[test]
 fn a_solve_gives_the_same_bits_on_one_thread_and_on_two() {
     let case = common::case("rates", 4, Method::Mortar, &[]);
-    let model = &case.problem.model;
-    let n = model.n_free;
-    let (pattern, slots) = model.stiffness_pattern(&[], n);
-    let mut stiffness = SparseSystem::new(&pattern);
-    model.add_tangent(&model.elastic_tangents(), &slots, stiffness.values_mut());
-    let values = stiffness.values_mut().to_vec();
-    let c = (0..n).map(|i| values[pattern.slot(i, i)]).sum::<f64>() / n as f64;
-    let rows = case.problem.free_rows();
+    let n = case.problem.model.n_free;
+    let (_, values, c, rows, pattern) = elastic_system(&case);
     let b = sequence(n + rows.len());
     let solve_on = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
