@@ -31,9 +31,11 @@ pub struct Newton<'a> {
     n: usize,
     /// Slots of each triangle's 6 x 6 entries in the stiffness pattern.
     slots: Vec<[usize; 36]>,
-    /// The current tangent stiffness, stored transposed (K_t^T: the elastic part is
-    /// symmetric, the viscoplastic triangles' changes are assembled transposed), for
-    /// GMRES's products by rows.
+    /// The current tangent stiffness, stored transposed (K_t^T: the viscoplastic
+    /// triangles' changes are assembled transposed; the elastic part as it is, being
+    /// symmetric up to round-off: its element matrices B^T (D S) B |T| differ from their
+    /// transposes in the last bit, so the products are K_t x to 2.5e-16 relative, not to the
+    /// bit), for GMRES's products by rows.
     stiffness: SparseSystem,
     /// The contact rows over the free unknowns: (equation, coefficient).
     rows: Vec<Vec<(usize, f64)>>,
@@ -301,7 +303,8 @@ impl<'a> Newton<'a> {
         let (n, c) = (self.n, self.c_scale);
         let (xu, xl) = x.split_at(n);
         let (yu, yl) = y.split_at_mut(n);
-        // The stiffness holds K_t^T (see `assemble_tangent`): its transpose product is K_t x.
+        // The stiffness holds K_t^T (see `assemble_tangent`): its transpose product is K_t x
+        // (to round-off in the elastic part: see the field).
         self.stiffness.transpose_matvec(xu, yu);
         for (i, row) in self.rows.iter().enumerate() {
             let xi = c * xl[i];
