@@ -150,6 +150,22 @@ impl FactorValues {
             FactorValues::Double(_) => None,
         }
     }
+
+    /// The f64 values, if these are, borrowed.
+    fn as_double(&self) -> Option<&[f64]> {
+        match self {
+            FactorValues::Double(l) => Some(l),
+            FactorValues::Single(_) => None,
+        }
+    }
+
+    /// The f32 values, if these are, borrowed.
+    fn as_single(&self) -> Option<&[f32]> {
+        match self {
+            FactorValues::Single(l) => Some(l),
+            FactorValues::Double(_) => None,
+        }
+    }
 }
 
 /// Whether an LU's pivots are all above 1e-12 of the largest (an empty matrix is regular).
@@ -390,7 +406,9 @@ impl Block {
         let (l_interface, d_interface) = self.trailing_block(l);
         let t = Instant::now();
         let mut inverse_diagonal = vec![0.0; self.n];
-        for (start, width, pattern, values) in self.supernodes(l) {
+        let structure = self.structure();
+        for s in 0..structure.n_supernodes() {
+            let (start, width, pattern, values) = structure.supernode(l, s);
             let rows = width + pattern.len();
             for j in 0..width {
                 inverse_diagonal[start + j] = 1.0 / values[j * rows + j].get();
@@ -701,23 +719,13 @@ impl InterfaceFactorization {
         let numeric = || {
             self.blocks
                 .iter()
-                .map(|b| b.numeric.as_ref().expect("factored"))
+                .map(|b| &b.numeric.as_ref().expect("factored").values)
         };
-        match numeric().all(|n| matches!(n.values, FactorValues::Single(_))) {
-            true => Values::Single(
+        match numeric().map(FactorValues::as_single).collect() {
+            Some(single) => Values::Single(single),
+            None => Values::Double(
                 numeric()
-                    .map(|n| match &n.values {
-                        FactorValues::Single(l) => &l[..],
-                        FactorValues::Double(_) => unreachable!("checked above"),
-                    })
-                    .collect(),
-            ),
-            false => Values::Double(
-                numeric()
-                    .map(|n| match &n.values {
-                        FactorValues::Double(l) => &l[..],
-                        FactorValues::Single(_) => unreachable!("one precision per factorization"),
-                    })
+                    .map(|v| v.as_double().expect("one precision per factorization"))
                     .collect(),
             ),
         }
@@ -800,30 +808,5 @@ impl InterfaceFactorization {
             .iter()
             .map(|&(l, _, v)| v * x_interface[l])
             .sum()
-    }
-}
-
-impl Block {
-    /// The supernodes as (first column, width, off-diagonal row indices, values: the
-    /// columns of the width x width diagonal block and the off-diagonal rows, column-major).
-    fn supernodes<'v, T>(
-        &'v self,
-        values: &'v [T],
-    ) -> impl DoubleEndedIterator<Item = (usize, usize, &'v [usize], &'v [T])> + 'v {
-        let sym = self.supernodal();
-        let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
-        let (row_ptr, rows, val_ptr) = (
-            sym.col_ptr_for_row_idx(),
-            sym.row_idx(),
-            sym.col_ptr_for_val(),
-        );
-        (0..sym.n_supernodes()).map(move |s| {
-            (
-                begin[s],
-                end[s] - begin[s],
-                &rows[row_ptr[s]..row_ptr[s + 1]],
-                &values[val_ptr[s]..val_ptr[s + 1]],
-            )
-        })
     }
 }

@@ -148,9 +148,20 @@ pub struct Structure<'a> {
     pub val_ptr: &'a [usize],
 }
 
-impl Structure<'_> {
-    fn n_supernodes(&self) -> usize {
+impl<'a> Structure<'a> {
+    /// Number of supernodes.
+    pub fn n_supernodes(&self) -> usize {
         self.begin.len() - 1
+    }
+
+    /// Supernode `s` of the factor with values `values`, in the block's own numbering.
+    pub fn supernode<T: Value>(&self, values: &'a [T], s: usize) -> Supernode<'a, T, usize> {
+        (
+            self.begin[s],
+            self.begin[s + 1] - self.begin[s],
+            &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]],
+            &values[self.val_ptr[s]..self.val_ptr[s + 1]],
+        )
     }
 
     fn pattern(&self, s: usize) -> &[usize] {
@@ -287,7 +298,7 @@ impl Subtree {
 /// increasing: closed under ancestors).
 pub struct Split {
     /// Disjoint subtrees.
-    pub subtrees: Vec<Subtree>,
+    subtrees: Vec<Subtree>,
     /// Supernodes in no subtree, increasing.
     top: Vec<usize>,
 }
@@ -418,7 +429,7 @@ pub fn forward_blocks<T: Value>(
             }
         }
         let (split, st, v) = (&splits[b], &structures[b], values[b]);
-        forward(split.top.iter().map(|&s| global(st, v, s)), &mut xb);
+        forward(split.top.iter().map(|&s| st.supernode(v, s)), &mut xb);
     };
     rayon::scope_fifo(|scope| {
         for b in by_work(splits) {
@@ -474,7 +485,7 @@ pub fn back_blocks<T: Value>(
                 {
                     let (split, st, v) = (&splits[b], &structures[b], values[b]);
                     let mut xb = lock(&blocks[b]);
-                    back(split.top.iter().rev().map(|&s| global(st, v, s)), &mut xb);
+                    back(split.top.iter().rev().map(|&s| st.supernode(v, s)), &mut xb);
                 }
                 for t in &splits[b].subtrees {
                     scope.spawn_fifo(move |_| subtree(b, t));
@@ -490,18 +501,4 @@ fn by_work(splits: &[Split]) -> Vec<usize> {
     let mut order: Vec<usize> = (0..splits.len()).collect();
     order.sort_by_key(|&b| (std::cmp::Reverse(work(&splits[b])), b));
     order
-}
-
-/// Supernode `s` in the block's own numbering.
-fn global<'a, T: Value>(
-    structure: &'a Structure,
-    values: &'a [T],
-    s: usize,
-) -> Supernode<'a, T, usize> {
-    (
-        structure.begin[s],
-        structure.begin[s + 1] - structure.begin[s],
-        structure.pattern(s),
-        &values[structure.val_ptr[s]..structure.val_ptr[s + 1]],
-    )
 }
