@@ -50,17 +50,24 @@ const PRODUCT_CHUNK: usize = 4096;
 impl SparseSystem {
     /// A zero matrix with `pattern`.
     pub fn new(pattern: &Pattern) -> Self {
-        let sym = SymbolicSparseColMat::new_checked(
-            pattern.n,
-            pattern.n,
-            pattern.col_ptr.clone(),
-            None,
-            pattern.row_idx.clone(),
-        );
-        let mat = SparseColMat::new(sym, vec![0.0; pattern.nnz()]);
+        Self::with_values(pattern.clone(), vec![0.0; pattern.nnz()])
+    }
+
+    /// The matrix with `pattern` and `values` (pattern order), taking both: no copy of the
+    /// pattern (at 34,432 dofs 3.8 MB of fresh pages, about 1 ms of newton's set-up).
+    pub fn with_values(pattern: Pattern, values: Vec<f64>) -> Self {
+        assert_eq!(values.len(), pattern.nnz(), "one value per slot");
+        let blocks = pattern.diagonal_blocks();
+        let Pattern {
+            n,
+            col_ptr,
+            row_idx,
+        } = pattern;
+        let sym = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        let mat = SparseColMat::new(sym, values);
         SparseSystem {
             mat,
-            blocks: pattern.diagonal_blocks(),
+            blocks,
             symbolic_llt: None,
             symbolic_lu: None,
             llt: None,

@@ -248,27 +248,24 @@ impl<'a> Newton<'a> {
             pieces::time("setup.pattern", 0, || p.model.stiffness_pattern(&[], n));
         let rows = p.free_rows();
         let viscoplastic = p.model.materials.iter().any(|m| m.viscoplastic.is_some());
-        let (stiffness, elastic_values) = pieces::time("setup.values", 0, || {
-            let mut stiffness = SparseSystem::new(&pattern);
-            let vals = stiffness.values_mut();
+        let (values, elastic_values) = pieces::time("setup.values", 0, || {
+            let mut values = vec![0.0; pattern.nnz()];
             p.model
-                .add_tangent(&p.model.elastic_tangents(), &slots, vals);
+                .add_tangent(&p.model.elastic_tangents(), &slots, &mut values);
             // The elastic stiffness the tangents are assembled on; an elastic run keeps it
             // in `stiffness` alone.
             let elastic_values = match viscoplastic {
-                true => vals.to_vec(),
+                true => values.clone(),
                 false => Vec::new(),
             };
-            (stiffness, elastic_values)
+            (values, elastic_values)
         });
         // Stiffness scale: the mean diagonal of the elastic stiffness.
-        let c_scale = (0..n)
-            .map(|i| stiffness.values()[pattern.slot(i, i)])
-            .sum::<f64>()
-            / n.max(1) as f64;
+        let c_scale = (0..n).map(|i| values[pattern.slot(i, i)]).sum::<f64>() / n.max(1) as f64;
         let factorization = pieces::time("setup.interface_analysis", 0, || {
             InterfaceFactorization::new(&pattern, &rows)
         })?;
+        let stiffness = SparseSystem::with_values(pattern, values);
         let body_split = p.model.body_slot_split(&slots);
         let setup_s = t_setup.elapsed().as_secs_f64();
         pieces::record("setup.total", 0, setup_s);

@@ -16,6 +16,7 @@
 //! 92,160 equations), so the larger one set the time: one preconditioner solve 9.3 ms on
 //! two threads against 13.5 ms on one.
 
+use rayon::prelude::*;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -371,31 +372,38 @@ pub fn split(structures: &[Structure]) -> Vec<Split> {
         top_work += own;
         candidates.extend(children[b][s].iter().map(|&c| (b, c)));
     }
-    // Per block, the subtrees heaviest first: the order they are scheduled in.
+    // Per block, the subtrees heaviest first: the order they are scheduled in. Each built
+    // on its own (scratch of its own), on rayon's threads: the same subtrees on any number.
     candidates.reverse();
-    tops.into_iter()
-        .enumerate()
-        .map(|(b, mut top)| {
-            top.sort_unstable();
+    let mut subtrees: Vec<Subtree> = candidates
+        .par_iter()
+        .map(|&(b, root)| {
             let st = &structures[b];
             let mut inside = vec![false; st.n_supernodes()];
             let mut local = vec![0; of_column[b].len()];
-            let subtrees = (candidates.iter())
-                .filter(|c| c.0 == b)
-                .map(|&(_, root)| {
-                    Subtree::new(
-                        st,
-                        &children[b],
-                        root,
-                        &of_column[b],
-                        &mut inside,
-                        &mut local,
-                    )
-                })
-                .collect();
-            Split { subtrees, top }
+            Subtree::new(
+                st,
+                &children[b],
+                root,
+                &of_column[b],
+                &mut inside,
+                &mut local,
+            )
         })
-        .collect()
+        .collect();
+    let mut splits: Vec<Split> = (tops.into_iter())
+        .map(|mut top| {
+            top.sort_unstable();
+            Split {
+                subtrees: Vec::new(),
+                top,
+            }
+        })
+        .collect();
+    for (&(b, _), subtree) in candidates.iter().zip(subtrees.drain(..)) {
+        splits[b].subtrees.push(subtree);
+    }
+    splits
 }
 
 /// A lock that a panic elsewhere does not poison for the substitutions (they only read
