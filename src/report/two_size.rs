@@ -267,7 +267,10 @@ fn fmt_fit(f: &SizeFit, b: usize) -> String {
             format!("poor fit (rms {:.2})", x.rms_log_residual)
         }
         Some(x) if !(x.se[b] <= FIT_SE) || !(0.0..6.0).contains(&x.a[b]) => {
-            format!("not identified ({:.2} ± {:.2})", x.a[b], x.se[b])
+            match x.se[b].is_finite() {
+                true => format!("not identified ({:.2} ± {:.2})", x.a[b], x.se[b]),
+                false => format!("not identified ({:.2}, standard error unbounded)", x.a[b]),
+            }
         }
         Some(x) => format!("{:.3} ± {:.3}", x.a[b], x.se[b]),
     }

@@ -399,6 +399,15 @@ pub fn assess(levels: &[LevelError], truth_error: f64) -> Result<Assessment, Equ
     Ok(out)
 }
 
+/// The standard error sqrt(v) of a parameter of variance `v` from an inverted J^T J; a
+/// variance that is not positive comes from a J^T J singular to round-off (a term
+/// vanishing on the grid, its exponent undetermined), and is no evidence of an exact
+/// exponent: infinite, not zero (a zero read "a2 = -36.9 ± 0.0" in a two-size fit whose
+/// second term was 1e-67 of the first).
+fn standard_error(v: f64) -> f64 {
+    if v > 0.0 { v.sqrt() } else { f64::INFINITY }
+}
+
 /// The fit of errors over two mesh sizes to E(h1, h2) = C1 h1^a1 + C2 h2^a2 (Lemma 3.1's
 /// form: one term per body), in log space (relative residuals: the errors span decades).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -407,7 +416,9 @@ pub struct PowerSumFit {
     pub c: [f64; 2],
     /// Exponents a1 (in h1) and a2 (in h2).
     pub a: [f64; 2],
-    /// Standard errors of a1 and a2 (from s^2 (J^T J)^-1 at the optimum).
+    /// Standard errors of a1 and a2 (from s^2 (J^T J)^-1 at the optimum); infinite where
+    /// that diagonal is not positive (J^T J singular to round-off: the exponent is not
+    /// determined by the data).
     pub se: [f64; 2],
     /// Root mean square of the log residuals ln E - ln E_fit.
     pub rms_log_residual: f64,
@@ -517,7 +528,7 @@ pub fn fit_power_sum(points: &[(f64, f64, f64)]) -> Option<PowerSumFit> {
     let fit = PowerSumFit {
         c: [th[0].exp(), th[2].exp()],
         a: [th[1], th[3]],
-        se: [cov[(1, 1)].max(0.0).sqrt(), cov[(3, 3)].max(0.0).sqrt()],
+        se: [standard_error(cov[(1, 1)]), standard_error(cov[(3, 3)])],
         rms_log_residual: (f / n as f64).sqrt(),
         points: n,
     };
