@@ -83,17 +83,19 @@ pub const REFERENCE_LEVEL: usize = 6;
 pub const STEPS: usize = 4;
 /// Runs below these many dofs are timed this often (solver and floor alternately) and the
 /// fastest time is kept: on a shared 2-core machine single timings of 0.01-1 s scatter by
-/// up to a factor 2. Two studies of the same code with three timings at 34,432 dofs read
-/// ratios 1.13 and 1.20 (elastic, mortar) and 1.93 and 1.63 (viscoplastic, nts): the
-/// fastest of three is still a draw there, so the levels up to 137,472 dofs get nine.
+/// up to a factor 2. Two studies with three timings at 34,432 dofs, the second after a
+/// change that made newton's solves faster, read ratios 1.13 then 1.20 (elastic, mortar)
+/// and 1.93 then 1.63 (viscoplastic, nts): the fastest of three is still a draw there, so
+/// the levels up to 137,472 dofs get nine.
 pub const REPEATS: [(usize, usize); 2] = [(200_000, 9), (600_000, 3)];
 
 /// How often larger runs are timed: three times, because the first large solve after
 /// the mesh is built is slow for reasons of the process, not of the solver (measured at
 /// 2.2e6 dofs: the stiffness pattern took 7.6 s in the first run, 2.6 s in the second,
 /// and the floor's, always run second, 2.5-3.1 s), and the fastest of the other two still
-/// moved the ratio at 2,196,480 dofs from 1.68 to 1.80 between two studies of one code
-/// (viscoplastic, mortar); the fastest is kept, for both sides alike.
+/// moved the ratio at 2,196,480 dofs from 1.68 to 1.80 between the same two studies
+/// (viscoplastic, mortar; the second's solves faster); the fastest is kept, for both sides
+/// alike.
 pub const REPEATS_ABOVE: usize = 3;
 
 /// How often a newton run with `dofs` unknowns is timed ([`REPEATS`], [`REPEATS_ABOVE`]).
