@@ -166,12 +166,12 @@ impl<'a> Structure<'a> {
         (
             self.begin[s],
             self.begin[s + 1] - self.begin[s],
-            &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]],
+            self.pattern(s),
             &values[self.val_ptr[s]..self.val_ptr[s + 1]],
         )
     }
 
-    fn pattern(&self, s: usize) -> &[usize] {
+    fn pattern(&self, s: usize) -> &'a [usize] {
         &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]]
     }
 
@@ -225,16 +225,16 @@ pub struct Subtree {
 
 impl Subtree {
     /// The subtree below `root` (its descendants: `children` lists them). `of_column`:
-    /// [`Structure::of_column`]; `inside` (per supernode, all false) and `local` (per
-    /// column) are scratch.
+    /// [`Structure::of_column`].
     fn new(
         structure: &Structure,
         children: &[Vec<usize>],
         root: usize,
         of_column: &[usize],
-        inside: &mut [bool],
-        local: &mut [usize],
     ) -> Self {
+        // Per supernode: in the subtree; per column: local number.
+        let mut inside = vec![false; structure.n_supernodes()];
+        let mut local = vec![0; of_column.len()];
         let mut supernodes = vec![root];
         let mut next = 0;
         while next < supernodes.len() {
@@ -270,9 +270,6 @@ impl Subtree {
             row_ptr.push(rows.len());
         }
         let weight = supernodes.iter().map(|&s| structure.weight(s)).sum();
-        for &s in &supernodes {
-            inside[s] = false;
-        }
         Subtree {
             supernodes,
             columns,
@@ -373,23 +370,11 @@ pub fn split(structures: &[Structure]) -> Vec<Split> {
         candidates.extend(children[b][s].iter().map(|&c| (b, c)));
     }
     // Per block, the subtrees heaviest first: the order they are scheduled in. Each built
-    // on its own (scratch of its own), on rayon's threads: the same subtrees on any number.
+    // on its own, on rayon's threads: the same subtrees on any number.
     candidates.reverse();
-    let mut subtrees: Vec<Subtree> = candidates
+    let subtrees: Vec<Subtree> = candidates
         .par_iter()
-        .map(|&(b, root)| {
-            let st = &structures[b];
-            let mut inside = vec![false; st.n_supernodes()];
-            let mut local = vec![0; of_column[b].len()];
-            Subtree::new(
-                st,
-                &children[b],
-                root,
-                &of_column[b],
-                &mut inside,
-                &mut local,
-            )
-        })
+        .map(|&(b, root)| Subtree::new(&structures[b], &children[b], root, &of_column[b]))
         .collect();
     let mut splits: Vec<Split> = (tops.into_iter())
         .map(|mut top| {
@@ -400,7 +385,7 @@ pub fn split(structures: &[Structure]) -> Vec<Split> {
             }
         })
         .collect();
-    for (&(b, _), subtree) in candidates.iter().zip(subtrees.drain(..)) {
+    for (&(b, _), subtree) in candidates.iter().zip(subtrees) {
         splits[b].subtrees.push(subtree);
     }
     splits
