@@ -867,18 +867,32 @@ impl StepSolver for Newton<'_> {
             if let Some(a) = &last_active {
                 changes += a.iter().zip(&active).filter(|(x, y)| x != y).count();
             }
-            if iterations > 0 && res <= self.settings.tol && compl <= self.settings.tol && same_set
-            {
+            // Converged: residual and complementarity within the tolerance, and the active
+            // set the one the last step was computed with. A predictor (the extrapolation of
+            // the last steps) that already meets the tolerance is the step's solution: no
+            // iteration can improve on the tolerance the run asks for. Measured: an elastic
+            // run whose load is linear in time (`rates-elastic`, 34,432 dofs, 4 steps)
+            // starts steps 2-4 at residuals 9e-14 to 1.1e-13, where a Newton iteration
+            // cost a preconditioner solve, a product and a return map each (5 iterations
+            // to 2).
+            let settled = same_set || iterations == 0;
+            if res <= self.settings.tol && compl <= self.settings.tol && settled {
                 // Inactive rows carry no force; GMRES leaves round-off there.
                 for i in 0..m {
                     if !active[i] {
                         lambda[i] = 0.0;
                     }
                 }
-                let reason = format!(
-                    "residual {res:.2e} and complementarity {compl:.2e} below {:.0e}, active set settled ({factorizations} factorizations)",
-                    self.settings.tol
-                );
+                let reason = match iterations {
+                    0 => format!(
+                        "the predictor's residual {res:.2e} and complementarity {compl:.2e} below {:.0e}: no iteration needed",
+                        self.settings.tol
+                    ),
+                    _ => format!(
+                        "residual {res:.2e} and complementarity {compl:.2e} below {:.0e}, active set settled ({factorizations} factorizations)",
+                        self.settings.tol
+                    ),
+                };
                 let state = State {
                     time: t,
                     u,
