@@ -558,7 +558,10 @@ impl Newton<'_> {
         // than 5 and more than the fresh factorization needed. The rule counts iterations,
         // not seconds, so the results do not depend on the machine's load.
         let budget = 10;
-        let forcing = self.forcing_term(distance);
+        let forcing = match self.model_is_exact(ev) {
+            true => self.exact_forcing(distance),
+            false => self.forcing_term(distance),
+        };
         self.assemble_tangent(&ev.tangents);
         let reusable = match &self.preconditioner {
             Preconditioner::Interface => true,
@@ -671,12 +674,7 @@ impl Newton<'_> {
     /// last iteration of a step). While only the active set is searched (residual at
     /// round-off), the semismooth steps terminate finitely and want the solve to tolerance:
     /// a 1e-2 solve there left 4e-9 behind and cost one more iteration in other units.
-    /// The same rule holds where the Newton model is exact (elastic bodies): the
-    /// single-precision solve is not, and a second iteration costs less than solving to
-    /// the tolerance in the first (measured, `rates-elastic` at 137,472 dofs, 4 steps: 5
-    /// iterations and 6 preconditioner applications, solves 0.064 s, against 4, 7 and
-    /// 0.088 s when a step whose triangles are all elastic is solved to a tenth of the
-    /// tolerance; `rates`: 11 iterations and 29 applications against 10 and 30).
+    /// Where the Newton model is exact, [`Newton::exact_forcing`] applies instead.
     fn forcing_term(&self, distance: &Distance) -> f64 {
         let res = distance.residual;
         let tol_term = 0.3 * self.settings.tol / res.max(distance.complementarity);
@@ -688,6 +686,32 @@ impl Newton<'_> {
             res.max(tol_term).min(1e-2)
         }
         .max(1e-12)
+    }
+
+    /// Whether every triangle's tangent at the iterate of `ev` is its body's elastic one:
+    /// the Newton model is then the step's linear problem itself (up to the active set,
+    /// which the interface model predicts), and its solution to the tolerance ends the
+    /// step in one iteration.
+    fn model_is_exact(&self, ev: &Evaluation) -> bool {
+        let model = &self.p.model;
+        !self.viscoplastic
+            || (ev.tangents.iter().zip(&model.elements))
+                .all(|(d, e)| *d == model.materials[e.body].elastic.matrix())
+    }
+
+    /// The forcing term where the Newton model is exact ([`Newton::model_is_exact`]): the
+    /// solve that leaves the next residual below the tolerance, so that the step ends at
+    /// the next evaluation. Measured (`speed_pieces`, 34,432 dofs, 4 steps, six rounds of
+    /// five runs alternating with the 1e-2 forcing): `rates-elastic` 2 iterations and 3
+    /// preconditioner applications become 1 and 3 (loop 0.0355 -> 0.0328 s, fastest);
+    /// `rates`, whose first step is elastic, 11 and 26 become 10 and 26 (0.110 -> 0.107
+    /// s). Before steps whose predictor meets the tolerance took no iteration, the same
+    /// rule for every all-elastic step cost more than it saved (137,472 dofs: 4
+    /// iterations and 7 applications against 5 and 6): a step that the extrapolation
+    /// nearly solves ended in one iteration on the loose solve.
+    fn exact_forcing(&self, distance: &Distance) -> f64 {
+        (0.3 * self.settings.tol / distance.residual.max(distance.complementarity))
+            .clamp(1e-12, 0.5)
     }
 
     /// Nonlinear elimination of a line-search trial `(ut, lt)` (evaluated in `ev`) from
