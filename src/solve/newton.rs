@@ -735,10 +735,9 @@ impl Newton<'_> {
             Elimination::failed_triangles(
                 model,
                 u,
-                &current.sigma,
-                &current.tangents,
+                (&current.sigma, &current.tangents),
                 ut,
-                &ev.sigma,
+                (&ev.sigma, &ev.tangents),
             )
         });
         if failed.is_empty() {
