@@ -7,8 +7,10 @@
 //! solve on the interface and never a sparse refactorization. The sparse matrix is
 //! refactorized only when GMRES needs many iterations (the tangent moved far from the
 //! factored one). The factorization is in single precision (see
-//! [`InterfaceFactorization::factor`]): for elastic bodies K_s = K_t, a step ends in one or
-//! two iterations and the whole run factorizes the stiffness once, like the floor.
+//! [`InterfaceFactorization::factor`]): for elastic bodies K_s = K_t, a step is solved to
+//! the tolerance in one iteration (`Newton::exact_forcing`), a step whose predictor
+//! already meets the tolerance takes none, and the whole run factorizes the stiffness
+//! once, like the floor.
 
 use super::elimination::{Elimination, Increment};
 use super::interface::{ActiveSet, InterfaceFactorization, Precision};
