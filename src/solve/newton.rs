@@ -691,9 +691,10 @@ impl Newton<'_> {
     }
 
     /// Whether every triangle's tangent at the iterate of `ev` is its body's elastic one:
-    /// the Newton model is then the step's linear problem itself (up to the active set,
-    /// which the interface model predicts), and its solution to the tolerance ends the
-    /// step in one iteration.
+    /// the Newton model is then the step's linear problem itself, up to the active set,
+    /// which the interface model predicts. Where that prediction is the solution's set
+    /// (every `rates-elastic` run so far), its solution to the tolerance ends the step in
+    /// one iteration; where it is not, the next iteration corrects the set as before.
     fn model_is_exact(&self, ev: &Evaluation) -> bool {
         let model = &self.p.model;
         !self.viscoplastic
