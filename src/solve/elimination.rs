@@ -171,6 +171,8 @@ impl Elimination {
         if model.materials.iter().all(|m| m.viscoplastic.is_none()) {
             return Vec::new();
         }
+        let elastic: Vec<Matrix3<f64>> =
+            model.materials.iter().map(|m| m.elastic.matrix()).collect();
         // Every triangle alone: the same list on any number of threads.
         model
             .elements
@@ -178,11 +180,10 @@ impl Elimination {
             .enumerate()
             .with_min_len(4096)
             .filter(|(i, e)| {
-                let material = &model.materials[e.body];
-                let Some(vp) = material.viscoplastic else {
+                let Some(vp) = model.materials[e.body].viscoplastic else {
                     return false;
                 };
-                let elastic = material.elastic.matrix();
+                let elastic = elastic[e.body];
                 if tangents[*i] == elastic && tangents_trial[*i] == elastic {
                     return false;
                 }

@@ -679,7 +679,7 @@ impl Newton<'_> {
     /// Where the Newton model is exact, [`Newton::exact_forcing`] applies instead.
     fn forcing_term(&self, distance: &Distance) -> f64 {
         let res = distance.residual;
-        let tol_term = 0.3 * self.settings.tol / res.max(distance.complementarity);
+        let tol_term = self.tolerance_forcing(distance);
         if tol_term > 1e-2 {
             // Within 30x of the tolerance: a loose solve ends it (the quadratic term is far
             // below the tolerance there).
@@ -697,9 +697,17 @@ impl Newton<'_> {
     /// one iteration; where it is not, the next iteration corrects the set as before.
     fn model_is_exact(&self, ev: &Evaluation) -> bool {
         let model = &self.p.model;
+        let elastic: Vec<Matrix3<f64>> =
+            model.materials.iter().map(|m| m.elastic.matrix()).collect();
         !self.viscoplastic
-            || (ev.tangents.iter().zip(&model.elements))
-                .all(|(d, e)| *d == model.materials[e.body].elastic.matrix())
+            || (ev.tangents.iter().zip(&model.elements)).all(|(d, e)| *d == elastic[e.body])
+    }
+
+    /// The forcing that leaves the next residual within the tolerance (0.3 tol / the
+    /// larger of residual and complementarity): [`Newton::forcing_term`]'s bound and
+    /// [`Newton::exact_forcing`]'s target.
+    fn tolerance_forcing(&self, distance: &Distance) -> f64 {
+        0.3 * self.settings.tol / distance.residual.max(distance.complementarity)
     }
 
     /// The forcing term where the Newton model is exact ([`Newton::model_is_exact`]): the
@@ -713,8 +721,7 @@ impl Newton<'_> {
     /// iterations and 7 applications against 5 and 6): a step that the extrapolation
     /// nearly solves ended in one iteration on the loose solve.
     fn exact_forcing(&self, distance: &Distance) -> f64 {
-        (0.3 * self.settings.tol / distance.residual.max(distance.complementarity))
-            .clamp(1e-12, 0.5)
+        self.tolerance_forcing(distance).clamp(1e-12, 0.5)
     }
 
     /// Nonlinear elimination of a line-search trial `(ut, lt)` (evaluated in `ev`) from
