@@ -8,7 +8,7 @@ use crate::material::{Material, Strain, Stress};
 use crate::mesh::{BodyMesh, RawMesh};
 use crate::quadrature;
 use crate::scene::Scene;
-use nalgebra::{Matrix3, SMatrix, SVector};
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use rayon::prelude::*;
 use std::path::Path;
 
@@ -716,21 +716,19 @@ impl Model {
         values: &mut [f64],
     ) {
         for ((e, d), sl) in self.elements.iter().zip(tangents).zip(slots) {
-            scatter_tangent(e, d, sl, 0, Orientation::AsIs, values);
+            scatter_tangent(e, d, sl, 0, values);
         }
     }
 
     /// Add `|T| B^T (D - E) S B` for the elements whose tangent D differs from the elastic
     /// E of their body (the viscoplastic ones): on top of the assembled elastic stiffness,
     /// this assembles the consistent tangent while elastic triangles cost nothing.
-    /// `split`: [`Model::body_slot_split`] of `slots`, computed once by the caller;
-    /// `orientation`: whether `values` hold the matrix or its transpose.
+    /// `split`: [`Model::body_slot_split`] of `slots`, computed once by the caller.
     pub fn add_tangent_change(
         &self,
         tangents: &[Matrix3<f64>],
         slots: &[[usize; 36]],
         split: Option<usize>,
-        orientation: Orientation,
         values: &mut [f64],
     ) {
         // A body with no viscoplastic part is skipped whole. From PARALLEL_ELEMENTS
@@ -745,7 +743,7 @@ impl Model {
             let elastic = self.materials[body].elastic.matrix();
             for ((e, d), sl) in self.elements.iter().zip(tangents).zip(slots) {
                 if e.body == body && *d != elastic {
-                    scatter_tangent(e, &(d - elastic), sl, offset, orientation, values);
+                    scatter_tangent(e, &(d - elastic), sl, offset, values);
                 }
             }
         };
@@ -761,6 +759,42 @@ impl Model {
                 add(1, values, 0);
             }
         }
+    }
+
+    /// The viscoplastic triangles' share of the consistent tangent stiffness whose
+    /// per-triangle tangents are `tangents` ([`TangentChange`]): the triangles whose
+    /// tangent is not their body's elastic one, with `|T| (D - E)`. A body with no
+    /// viscoplastic part is skipped whole; from [`PARALLEL_ELEMENTS`] triangles on, the
+    /// bodies on two threads.
+    pub fn tangent_change(&self, tangents: &[Matrix3<f64>]) -> TangentChange {
+        let collect = |body: usize| -> Vec<ChangedTriangle> {
+            if self.materials[body].viscoplastic.is_none() {
+                return Vec::new();
+            }
+            let elastic = self.materials[body].elastic.matrix();
+            self.elements
+                .iter()
+                .zip(tangents)
+                .filter(|(e, d)| e.body == body && **d != elastic)
+                .map(|(e, d)| ChangedTriangle {
+                    equations: e.dofs().map(|dof| self.equation[dof]),
+                    grads: e.grads,
+                    change: (d - elastic) * e.area,
+                })
+                .collect()
+        };
+        let bodies = match self.elements.len() >= PARALLEL_ELEMENTS {
+            true => {
+                let (first, second) = rayon::join(|| collect(0), || collect(1));
+                [first, second]
+            }
+            false => [collect(0), collect(1)],
+        };
+        let split = self.equation[..2 * self.node_offset[1]]
+            .iter()
+            .filter(|&&eq| eq != FIXED)
+            .count();
+        TangentChange { bodies, split }
     }
 
     /// The first value slot of body 1 when every slot of body 0's triangles is below it
@@ -803,22 +837,82 @@ pub fn split_ranges_mut<'a>(
     parts
 }
 
+/// The viscoplastic triangles' share `K_t - K_el` of a consistent tangent stiffness over
+/// the free equations, kept per triangle and applied as a product: `|T| B^T (D - E) S B x`
+/// summed over the triangles whose tangent D is not their body's elastic E (S halves B's
+/// engineering shear). Newton's products `K_t x = K_el x + (K_t - K_el) x` then need no
+/// assembled K_t: a product over the changed triangles costs less than a copy of the
+/// stiffness's values and a scatter of their 6 x 6 matrices per iteration (see
+/// [`Model::tangent_change`]).
+#[derive(Debug, Clone, Default)]
+pub struct TangentChange {
+    /// Per body, its changed triangles in element order.
+    bodies: [Vec<ChangedTriangle>; 2],
+    /// The first equation of body 1 (every equation of body 0 lies below it).
+    split: usize,
+}
+
+/// One triangle of a [`TangentChange`].
+#[derive(Debug, Clone)]
+struct ChangedTriangle {
+    /// Equations of the triangle's 6 dofs ([`FIXED`] where constrained).
+    equations: [usize; 6],
+    /// Shape-function gradients (1/length).
+    grads: [[f64; 2]; 3],
+    /// `|T| (D - E)`: the tangent's change times the area (force).
+    change: Matrix3<f64>,
+}
+
+impl TangentChange {
+    /// Whether no triangle's tangent differs from the elastic one.
+    pub fn is_empty(&self) -> bool {
+        self.bodies.iter().all(Vec::is_empty)
+    }
+
+    /// `y += (K_t - K_el) x` over the free equations. From [`PARALLEL_ELEMENTS`] changed
+    /// triangles on, the two bodies (disjoint equations) on two threads, each in element
+    /// order: the same sums as on one thread.
+    pub fn add_product(&self, x: &[f64], y: &mut [f64]) {
+        let add = |triangles: &[ChangedTriangle], y: &mut [f64], offset: usize| {
+            let at = |eq: usize| if eq == FIXED { 0.0 } else { x[eq] };
+            for t in triangles {
+                let (eq, g) = (&t.equations, &t.grads);
+                // Tensor strain S B x, the stress change, and B^T of it (as Element::strain
+                // and Element::internal_force).
+                let mut strain = Vector3::zeros();
+                for a in 0..3 {
+                    let (ux, uy) = (at(eq[2 * a]), at(eq[2 * a + 1]));
+                    strain[0] += g[a][0] * ux;
+                    strain[1] += g[a][1] * uy;
+                    strain[2] += 0.5 * (g[a][1] * ux + g[a][0] * uy);
+                }
+                let s = t.change * strain;
+                for a in 0..3 {
+                    if eq[2 * a] != FIXED {
+                        y[eq[2 * a] - offset] += g[a][0] * s[0] + g[a][1] * s[2];
+                    }
+                    if eq[2 * a + 1] != FIXED {
+                        y[eq[2 * a + 1] - offset] += g[a][1] * s[1] + g[a][0] * s[2];
+                    }
+                }
+            }
+        };
+        let [first, second] = &self.bodies;
+        if first.len() + second.len() >= PARALLEL_ELEMENTS {
+            let (y0, y1) = y.split_at_mut(self.split);
+            rayon::join(|| add(first, y0, 0), || add(second, y1, self.split));
+        } else {
+            add(first, y, 0);
+            add(second, y, 0);
+        }
+    }
+}
+
 /// Triangles from which the constitutive update and the internal force run on rayon's
 /// threads. Measured at level 4 of `study speed` (about 17,000 triangles, 34,432 dofs, 4
 /// steps, fastest of 6 runs), serial against 2 threads: the constitutive updates of
 /// `rates` 0.032 s against 0.021-0.024 s, of `rates-elastic` 0.0046 s against 0.0032-0.0036 s.
 pub const PARALLEL_ELEMENTS: usize = 8_000;
-
-/// How assembled values are laid out in a pattern's slots: the matrix itself (entry (i, j)
-/// in the slot of row i, column j), or its transpose (in the slot of row j, column i: the
-/// matrix by rows, as a row-wise product wants it; see `SparseSystem::transpose_matvec`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Orientation {
-    /// Entry (i, j) in slot (i, j).
-    AsIs,
-    /// Entry (i, j) in slot (j, i).
-    Transposed,
-}
 
 /// Add `|T| B^T D S B` of one element into `values` through its slot map (S halves the
 /// engineering shear).
@@ -827,16 +921,12 @@ fn scatter_tangent(
     d: &Matrix3<f64>,
     slots: &[usize; 36],
     offset: usize,
-    orientation: Orientation,
     values: &mut [f64],
 ) {
     let ke = e.stiffness(d);
     for i in 0..6 {
         for j in 0..6 {
-            let slot = match orientation {
-                Orientation::AsIs => slots[6 * i + j],
-                Orientation::Transposed => slots[6 * j + i],
-            };
+            let slot = slots[6 * i + j];
             if slot != FIXED {
                 values[slot - offset] += ke[(i, j)];
             }

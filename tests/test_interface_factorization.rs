@@ -176,3 +176,50 @@ fn an_elastic_run_factorizes_once_and_takes_at_most_two_iterations_per_step() {
         assert!(sol.reports.iter().all(|r| r.iterations <= 2));
     }
 }
+
+/// Newton's products K_t x read the elastic stiffness and add the viscoplastic triangles'
+/// share per triangle (`TangentChange`) instead of an assembled K_t: the two agree to
+/// round-off (1e-12 of the largest entry) at a state where part of the mesh flows, on one
+/// thread (level 1) and with the bodies on two (level 4, from PARALLEL_ELEMENTS triangles).
+#[test]
+fn the_per_triangle_tangent_change_is_the_assembled_one() {
+    for level in [1, 4] {
+        let case = common::case("rates", level, Method::Mortar, &[]);
+        let model = &case.problem.model;
+        let (elastic, _, _, pattern) = elastic_system(&case);
+        // A displacement of pseudo-random nodal values, strains of order 0.1 (stresses
+        // about 3 sigma_Y in the triangles with large gradients, elastic elsewhere).
+        let h = model.h();
+        let u: Vec<f64> = sequence(2 * model.n_nodes)
+            .iter()
+            .map(|v| 0.05 * h * v)
+            .collect();
+        let zero_u = vec![0.0; u.len()];
+        let zero_sigma = vec![contact_rates::material::Stress::zeros(); model.elements.len()];
+        let (_, tangents) = model.update_stresses(&u, &zero_u, &zero_sigma, 0.01, None, true);
+        let change = model.tangent_change(&tangents);
+        let flowing = (tangents.iter().zip(&model.elements))
+            .filter(|(d, e)| **d != model.materials[e.body].elastic.matrix())
+            .count();
+        assert!(
+            flowing > 0 && flowing < model.elements.len(),
+            "level {level}: {flowing} of {} triangles flow: the test needs both kinds",
+            model.elements.len()
+        );
+        let n = model.n_free;
+        let (_, slots) = model.stiffness_pattern(&[], n);
+        let mut assembled = SparseSystem::new(&pattern);
+        model.add_tangent(&tangents, &slots, assembled.values_mut());
+        let x = sequence(n + 7)[7..].to_vec();
+        let mut expected = vec![0.0; n];
+        assembled.matvec(&x, &mut expected);
+        let mut product = vec![0.0; n];
+        elastic.matvec(&x, &mut product);
+        change.add_product(&x, &mut product);
+        let difference = common::rel_diff(&product, &expected);
+        assert!(
+            difference < 1e-12,
+            "level {level}: per-triangle product differs from the assembled K_t by {difference:.2e}"
+        );
+    }
+}

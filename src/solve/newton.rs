@@ -20,7 +20,7 @@ use super::{Timings, timed};
 use super::{ordering, pieces};
 use crate::contact;
 use crate::error::{Error, Result};
-use crate::fe::{FIXED, Orientation, Pattern};
+use crate::fe::{FIXED, Pattern, TangentChange};
 use crate::material::Stress;
 use nalgebra::Matrix3;
 use rayon::prelude::*;
@@ -33,12 +33,14 @@ pub struct Newton<'a> {
     n: usize,
     /// Slots of each triangle's 6 x 6 entries in the stiffness pattern.
     slots: Vec<[usize; 36]>,
-    /// The current tangent stiffness, stored transposed (K_t^T: the viscoplastic
-    /// triangles' changes are assembled transposed; the elastic part as it is, being
-    /// symmetric up to round-off: its element matrices B^T (D S) B |T| differ from their
-    /// transposes in the last bit, so the products are K_t x to 2.5e-16 relative, not to the
-    /// bit), for GMRES's products by rows.
+    /// The elastic stiffness K_el, assembled once. GMRES's products read it by rows (its
+    /// transpose product: its element matrices B^T (E S) B |T| differ from their
+    /// transposes in the last bit, so the products are K_el x to 2.5e-16 relative, not
+    /// to the bit).
     stiffness: SparseSystem,
+    /// The viscoplastic triangles' share K_t - K_el of the current tangent, applied per
+    /// triangle in the products (empty while every tangent is elastic).
+    change: TangentChange,
     /// The contact rows over the free unknowns: (equation, coefficient).
     rows: Vec<Vec<(usize, f64)>>,
     factorization: InterfaceFactorization,
@@ -59,15 +61,13 @@ pub struct Newton<'a> {
     /// distances, the active set and its flips, the plastic triangles and how many switched,
     /// the line search's step length.
     trace: bool,
-    /// The elastic stiffness in pattern order (empty with no viscoplastic body: the
-    /// stiffness is never reassembled).
-    elastic_values: Vec<f64>,
     /// Whether a body is viscoplastic; if not, every tangent is elastic: the constitutive
     /// update stores none ([`Evaluation::tangents`] is empty) and the stiffness is never
     /// reassembled.
     viscoplastic: bool,
-    /// The first value slot of body 1 in the stiffness ([`Model::body_slot_split`]).
-    body_split: Option<usize>,
+    /// The first value slot of body 1 in the stiffness ([`Model::body_slot_split`]),
+    /// computed at the first factorization of a viscoplastic tangent.
+    body_split: std::cell::OnceCell<Option<usize>>,
     /// Lower triangle of the symmetric stiffness handed to the LDL^T (pattern order).
     symmetric_values: Vec<f64>,
     /// GMRES iterations of the first solve after the last factorization.
@@ -250,17 +250,11 @@ impl<'a> Newton<'a> {
             pieces::time("setup.pattern", 0, || p.model.stiffness_pattern(&[], n));
         let rows = p.free_rows();
         let viscoplastic = p.model.materials.iter().any(|m| m.viscoplastic.is_some());
-        let (values, elastic_values) = pieces::time("setup.values", 0, || {
+        let values = pieces::time("setup.values", 0, || {
             let mut values = vec![0.0; pattern.nnz()];
             p.model
                 .add_tangent(&p.model.elastic_tangents(), &slots, &mut values);
-            // The elastic stiffness the tangents are assembled on; an elastic run keeps it
-            // in `stiffness` alone.
-            let elastic_values = match viscoplastic {
-                true => values.clone(),
-                false => Vec::new(),
-            };
-            (values, elastic_values)
+            values
         });
         // Stiffness scale: the mean diagonal of the elastic stiffness.
         let c_scale = (0..n).map(|i| values[pattern.slot(i, i)]).sum::<f64>() / n.max(1) as f64;
@@ -268,7 +262,6 @@ impl<'a> Newton<'a> {
             InterfaceFactorization::new(&pattern, &rows)
         })?;
         let stiffness = SparseSystem::with_values(pattern, values);
-        let body_split = p.model.body_slot_split(&slots);
         let setup_s = t_setup.elapsed().as_secs_f64();
         pieces::record("setup.total", 0, setup_s);
         Ok(Newton {
@@ -277,6 +270,7 @@ impl<'a> Newton<'a> {
             n,
             slots,
             stiffness,
+            change: TangentChange::default(),
             rows,
             factorization,
             active_set: None,
@@ -286,9 +280,8 @@ impl<'a> Newton<'a> {
             c_scale,
             clock: Default::default(),
             setup_s,
-            elastic_values,
             viscoplastic,
-            body_split,
+            body_split: std::cell::OnceCell::new(),
             symmetric_values: Vec::new(),
             fresh_iterations: 0,
             predicted_changes: 0,
@@ -302,9 +295,9 @@ impl<'a> Newton<'a> {
         let (n, c) = (self.n, self.c_scale);
         let (xu, xl) = x.split_at(n);
         let (yu, yl) = y.split_at_mut(n);
-        // The stiffness holds K_t^T (see `assemble_tangent`): its transpose product is K_t x
-        // (to round-off in the elastic part: see the field).
+        // K_t x = K_el x (by rows, to round-off: see the field) + (K_t - K_el) x.
         self.stiffness.transpose_matvec(xu, yu);
+        self.change.add_product(xu, yu);
         for (i, row) in self.rows.iter().enumerate() {
             let xi = c * xl[i];
             if xi != 0.0 {
@@ -321,9 +314,10 @@ impl<'a> Newton<'a> {
     }
 
     /// Factorize the symmetric counterpart K_s of the tangent stiffness (see the module).
-    /// With no viscoplastic body K_s is the stiffness itself, factorized as it is.
+    /// Where no triangle's tangent differs from the elastic one (`change`, set from the
+    /// same tangents just before), K_s is the stiffness itself, factorized as it is.
     fn factor(&mut self, tangents: &[Matrix3<f64>]) -> Result<()> {
-        if !self.viscoplastic {
+        if !self.viscoplastic || self.change.is_empty() {
             self.factorization
                 .factor(self.stiffness.values(), self.c_scale, Precision::Single)?;
         } else {
@@ -331,7 +325,7 @@ impl<'a> Newton<'a> {
             let mut vals = std::mem::take(&mut self.symmetric_values);
             timed(&clock.assembly, || {
                 vals.clear();
-                vals.extend_from_slice(&self.elastic_values);
+                vals.extend_from_slice(self.stiffness.values());
                 let model = &self.p.model;
                 let symmetric: Vec<Matrix3<f64>> = (model
                     .elements
@@ -340,11 +334,13 @@ impl<'a> Newton<'a> {
                 .with_min_len(4096)
                 .map(|(e, d)| symmetric_tangent(d, &model.materials[e.body].elastic.matrix()))
                 .collect();
+                let split = *self
+                    .body_split
+                    .get_or_init(|| model.body_slot_split(&self.slots));
                 model.add_tangent_change(
                     &symmetric,
                     &self.slots,
-                    self.body_split,
-                    Orientation::AsIs,
+                    split,
                     &mut vals,
                 );
             });
@@ -514,26 +510,17 @@ impl Newton<'_> {
                 .sum::<f64>()
     }
 
-    /// Write the current tangent stiffness into the matrix GMRES multiplies with: the
-    /// elastic stiffness (assembled once) plus the viscoplastic triangles' changes, as
-    /// K_t^T (the consistent tangent is not symmetric; the products read it by rows).
+    /// Set the current tangent for GMRES's products: the viscoplastic triangles' changes
+    /// against the elastic stiffness ([`Model::tangent_change`]), kept per triangle. Before,
+    /// the products read an assembled K_t: a copy of the elastic values and a scatter of
+    /// the changed triangles' 6 x 6 matrices per iteration.
     fn assemble_tangent(&mut self, tangents: &[Matrix3<f64>]) {
         if !self.viscoplastic {
-            // Every tangent is elastic: the stiffness holds them since the set-up.
+            // Every tangent is elastic: the stiffness is the tangent.
             return;
         }
         let clock = std::rc::Rc::clone(&self.clock);
-        timed(&clock.assembly, || {
-            let vals = self.stiffness.values_mut();
-            vals.copy_from_slice(&self.elastic_values);
-            self.p.model.add_tangent_change(
-                tangents,
-                &self.slots,
-                self.body_split,
-                Orientation::Transposed,
-                vals,
-            );
-        });
+        self.change = timed(&clock.assembly, || self.p.model.tangent_change(tangents));
     }
 
     /// The Newton step at the iterate of `ev` and `lambda`, and the active set it was
