@@ -491,21 +491,31 @@ impl Newton<'_> {
             )
         });
         let f_int = timed(&clock.assembly, || model.internal_force(&sigma));
-        let mut r = f_int.clone();
-        for (ri, f) in r.iter_mut().zip(&data.f_ext) {
-            *ri -= f;
+        // f_int - F over the free dofs and the largest free |f_int|, in one pass, then
+        // C^T lambda row by row: the same sums as over every dof, restricted after.
+        let mut residual = vec![0.0; self.n];
+        let mut internal = 0.0f64;
+        for ((&eq, f), f_ext) in model.equation.iter().zip(&f_int).zip(&data.f_ext) {
+            if eq != FIXED {
+                residual[eq] = f - f_ext;
+                internal = internal.max(f.abs());
+            }
         }
         let gaps = timed(&clock.contact, || {
-            contact::add_transpose(&self.p.rows, lambda, &mut r);
+            for (row, l) in self.rows.iter().zip(lambda) {
+                for &(eq, v) in row {
+                    residual[eq] += v * l;
+                }
+            }
             contact::apply_rows(&self.p.rows, u)
         });
         let scale = inf_norm(&data.f_free)
-            .max(inf_norm(&model.restrict(&f_int)))
+            .max(internal)
             .max(f64::MIN_POSITIVE);
         Evaluation {
             sigma,
             tangents,
-            residual: model.restrict(&r),
+            residual,
             gaps,
             scale,
         }
