@@ -232,12 +232,13 @@ fn readme(res: &SpeedResult) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "# Study `speed`\n\nWhat each accuracy costs, on two families of the same non-matching meshes (h1/h2 = 1.4142, h_upper = 0.28 at level 0, every level splits each triangle in 4), {} time steps: `rates` (viscoplastic, about half the domain flows) and `rates-elastic` (no yield stress). Each run's cost, the solver's set-up (pattern, symbolic analysis) plus its time loop, is compared with the floor measured on the same mesh: what the problem cannot avoid, from scratch: the elastic stiffness's pattern and values, one sparse Cholesky of it (faer; ordering, symbolic and numeric; shifted by 1e-8 of its mean diagonal so that a body held only by contact does not make it singular), and one solve (two triangular solves) per time step. newton's runs below {} dofs are timed {} times, below {} dofs {} times, larger ones {} times, solver and floor alternately (the paper's solver once), each on a heap handed back to the system as in a fresh process, and the fastest of each is kept (single timings of 0.01-1 s scatter by up to a factor 2 on this shared 2-core machine). Errors (viscoplastic family) are in the theorem norm against a matching-mesh reference at level {} ({} dofs), shown where the reference is at least 3 levels finer. `peak RSS` is the process's peak during the solve (reset before it). Regenerate with `cargo run --release -- study speed` ({:.0} s).\n",
+        "# Study `speed`\n\nWhat each accuracy costs, on two families of the same non-matching meshes (h1/h2 = 1.4142, h_upper = 0.28 at level 0, every level splits each triangle in 4), {} time steps: `rates` (viscoplastic, about half the domain flows) and `rates-elastic` (no yield stress). Each run's cost, the solver's set-up (pattern, symbolic analysis) plus its time loop, is compared with the floor measured on the same mesh: what the problem cannot avoid, from scratch: the elastic stiffness's pattern and values, one sparse Cholesky of it (faer; ordering, symbolic and numeric; shifted by 1e-8 of its mean diagonal so that a body held only by contact does not make it singular), and one solve (two triangular solves) per time step. newton's runs are timed {} times, larger ones {} times, solver and floor alternately (the paper's solver once), each on a heap handed back to the system as in a fresh process, and the fastest of each is kept (single timings of 0.01-1 s scatter by up to a factor 2 on this shared 2-core machine). Errors (viscoplastic family) are in the theorem norm against a matching-mesh reference at level {} ({} dofs), shown where the reference is at least 3 levels finer. `peak RSS` is the process's peak during the solve (reset before it). Regenerate with `cargo run --release -- study speed` ({:.0} s).\n",
         crate::study::speed::STEPS,
-        crate::study::speed::REPEATS[0].0,
-        crate::study::speed::REPEATS[0].1,
-        crate::study::speed::REPEATS[1].0,
-        crate::study::speed::REPEATS[1].1,
+        crate::study::speed::REPEATS
+            .iter()
+            .map(|(below, times)| format!("{times} below {below} dofs"))
+            .collect::<Vec<_>>()
+            .join(", "),
         crate::study::speed::REPEATS_ABOVE,
         crate::study::speed::REFERENCE_LEVEL,
         res.reference_dofs,

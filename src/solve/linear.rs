@@ -162,8 +162,9 @@ impl SparseSystem {
 
     /// `y = A^T x` with the current values: per column of A, its dot product with x (each
     /// y_i the same sum, in increasing row order, on any number of threads). For a
-    /// symmetric A this is `A x` read row by row: the sums stay in registers and the rows split evenly between the threads, where [`Self::matvec`]
-    /// scatters into y and splits by the diagonal blocks (the bodies, unequal in size).
+    /// symmetric A this is `A x` read row by row: the sums stay in registers and the rows
+    /// split evenly between the threads, where [`Self::matvec`] scatters into y and splits
+    /// by the diagonal blocks (the bodies, unequal in size).
     pub fn transpose_matvec(&self, x: &[f64], y: &mut [f64]) {
         let (sym, val) = self.mat.parts();
         let (cp, ri) = (sym.col_ptr(), sym.row_idx());

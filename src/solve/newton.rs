@@ -354,12 +354,7 @@ impl<'a> Newton<'a> {
                 let split = *self
                     .body_split
                     .get_or_init(|| model.body_slot_split(&self.slots));
-                model.add_tangent_change(
-                    &symmetric,
-                    &self.slots,
-                    split,
-                    &mut vals,
-                );
+                model.add_tangent_change(&symmetric, &self.slots, split, &mut vals);
             });
             let result = self
                 .factorization
@@ -516,9 +511,7 @@ impl Newton<'_> {
             }
             contact::apply_rows(&self.p.rows, u)
         });
-        let scale = inf_norm(&data.f_free)
-            .max(internal)
-            .max(f64::MIN_POSITIVE);
+        let scale = inf_norm(&data.f_free).max(internal).max(f64::MIN_POSITIVE);
         Evaluation {
             sigma,
             tangents,
@@ -695,8 +688,8 @@ impl Newton<'_> {
         let res = distance.residual;
         let tol_term = self.tolerance_forcing(distance, TOLERANCE_MARGIN);
         if tol_term > 1e-2 {
-            // Within 30x of the tolerance: a loose solve ends it (the quadratic term is far
-            // below the tolerance there).
+            // Within TOLERANCE_MARGIN / 1e-2 = 50x of the tolerance: a loose solve ends it (the
+            // quadratic term is far below the tolerance there).
             tol_term.min(0.5)
         } else {
             res.max(tol_term).min(1e-2)
@@ -735,7 +728,8 @@ impl Newton<'_> {
     /// iterations and 7 applications against 5 and 6): a step that the extrapolation
     /// nearly solves ended in one iteration on the loose solve.
     fn exact_forcing(&self, distance: &Distance) -> f64 {
-        self.tolerance_forcing(distance, EXACT_MARGIN).clamp(1e-12, 0.5)
+        self.tolerance_forcing(distance, EXACT_MARGIN)
+            .clamp(1e-12, 0.5)
     }
 
     /// Nonlinear elimination of a line-search trial `(ut, lt)` (evaluated in `ev`) from

@@ -89,8 +89,13 @@ pub const STEPS: usize = 4;
 /// the levels up to 137,472 dofs get nine. At 549,376 dofs three were a draw too: a study
 /// read 1.84 (viscoplastic, mortar; set-up 1.33 s, loop 3.94 s, floor 2.86 s) where the
 /// same two binaries timed in turn right after read 1.64-1.72 (set-up 1.27 s, loop
-/// 3.19-3.46 s, floor 2.72-2.76 s); that level gets five.
-pub const REPEATS: [(usize, usize); 2] = [(200_000, 9), (600_000, 5)];
+/// 3.19-3.46 s, floor 2.72-2.76 s); that level gets five. At 34,432 dofs nine were a
+/// draw too: a study read 2.07 (viscoplastic, mortar; set-up 0.057 s, loop 0.124 s, floor
+/// 0.088 s) where `speed_pieces` with the same solver, 54 runs alternating with the older
+/// one the same hour, read 1.95 fastest to fastest (solver 0.150 s, floor 0.077 s), and
+/// runs of nine with it that hour read 1.90 to 2.42 (mortar) and 1.66 to 2.10 (nts); a
+/// pair there takes 0.25 s, so the levels below 50,000 dofs get twenty-five.
+pub const REPEATS: [(usize, usize); 3] = [(50_000, 25), (200_000, 9), (600_000, 5)];
 
 /// How often larger runs are timed: three times, because the first large solve after
 /// the mesh is built is slow for reasons of the process, not of the solver (measured at
