@@ -790,10 +790,12 @@ impl Model {
             }
             false => [collect(0), collect(1)],
         };
-        let split = self.equation[..2 * self.node_offset[1]]
+        // Equations are numbered in dof order, body 0 first: body 1's first free equation.
+        let split = self.equation[2 * self.node_offset[1]..]
             .iter()
-            .filter(|&&eq| eq != FIXED)
-            .count();
+            .find(|&&eq| eq != FIXED)
+            .copied()
+            .unwrap_or(self.n_free);
         TangentChange { bodies, split }
     }
 

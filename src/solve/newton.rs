@@ -62,8 +62,7 @@ pub struct Newton<'a> {
     /// the line search's step length.
     trace: bool,
     /// Whether a body is viscoplastic; if not, every tangent is elastic: the constitutive
-    /// update stores none ([`Evaluation::tangents`] is empty) and the stiffness is never
-    /// reassembled.
+    /// update stores none ([`Evaluation::tangents`] is empty) and `change` stays empty.
     viscoplastic: bool,
     /// The first value slot of body 1 in the stiffness ([`Model::body_slot_split`]),
     /// computed at the first factorization of a viscoplastic tangent.
@@ -331,10 +330,10 @@ impl<'a> Newton<'a> {
     }
 
     /// Factorize the symmetric counterpart K_s of the tangent stiffness (see the module).
-    /// Where no triangle's tangent differs from the elastic one (`change`, set from the
-    /// same tangents just before), K_s is the stiffness itself, factorized as it is.
+    /// Where the model is exact ([`Newton::model_is_exact`], `change` set from the same
+    /// tangents just before), K_s is the stiffness itself, factorized as it is.
     fn factor(&mut self, tangents: &[Matrix3<f64>]) -> Result<()> {
-        if !self.viscoplastic || self.change.is_empty() {
+        if self.model_is_exact() {
             self.factorization
                 .factor(self.stiffness.values(), self.c_scale, Precision::Single)?;
         } else {
@@ -567,11 +566,11 @@ impl Newton<'_> {
         // than 5 and more than the fresh factorization needed. The rule counts iterations,
         // not seconds, so the results do not depend on the machine's load.
         let budget = 10;
-        let forcing = match self.model_is_exact(ev) {
+        self.assemble_tangent(&ev.tangents);
+        let forcing = match self.model_is_exact() {
             true => self.exact_forcing(distance),
             false => self.forcing_term(distance),
         };
-        self.assemble_tangent(&ev.tangents);
         let reusable = match &self.preconditioner {
             Preconditioner::Interface => true,
             Preconditioner::KktLu(a) => *a == active,
@@ -697,17 +696,14 @@ impl Newton<'_> {
         .max(1e-12)
     }
 
-    /// Whether every triangle's tangent at the iterate of `ev` is its body's elastic one:
-    /// the Newton model is then the step's linear problem itself, up to the active set,
-    /// which the interface model predicts. Where that prediction is the solution's set
-    /// (every `rates-elastic` run so far), its solution to the tolerance ends the step in
-    /// one iteration; where it is not, the next iteration corrects the set as before.
-    fn model_is_exact(&self, ev: &Evaluation) -> bool {
-        let model = &self.p.model;
-        let elastic: Vec<Matrix3<f64>> =
-            model.materials.iter().map(|m| m.elastic.matrix()).collect();
-        !self.viscoplastic
-            || (ev.tangents.iter().zip(&model.elements)).all(|(d, e)| *d == elastic[e.body])
+    /// Whether every triangle's tangent at the iterate last assembled
+    /// ([`Newton::assemble_tangent`]) is its body's elastic one (`change` empty): the
+    /// Newton model is then the step's linear problem itself, up to the active set, which
+    /// the interface model predicts. Where that prediction is the solution's set (every
+    /// `rates-elastic` run so far), its solution to the tolerance ends the step in one
+    /// iteration; where it is not, the next iteration corrects the set as before.
+    fn model_is_exact(&self) -> bool {
+        !self.viscoplastic || self.change.is_empty()
     }
 
     /// The forcing that leaves the next residual within `margin` of the tolerance
