@@ -611,21 +611,38 @@ impl Model {
             .collect()
     }
 
+    /// The strain of `u` (global dofs) in every element, tensor components: the
+    /// `strain_prev` of [`Model::update_stresses`], computed once per time step.
+    pub fn strains(&self, u: &[f64]) -> Vec<Strain> {
+        match self.elements.len() >= PARALLEL_ELEMENTS {
+            true => self
+                .elements
+                .par_iter()
+                .with_min_len(4096)
+                .map(|e| e.strain(u))
+                .collect(),
+            false => self.elements.iter().map(|e| e.strain(u)).collect(),
+        }
+    }
+
     /// Constitutive update of every element: `sigma = sigma_prev + E (eps(u) - eps(u_prev))
     /// + k G(sigma) + k s` with `s` the element's constitutive source at t_n, if any
-    /// ([`Model::constitutive_source`]; it only shifts the trial stress). Returns the
-    /// stresses and, if `tangent`, the consistent tangents.
+    /// ([`Model::constitutive_source`]; it only shifts the trial stress), and
+    /// `strain_prev` the elements' eps(u_prev) ([`Model::strains`]: the same per iteration
+    /// of a step, so gathered once). Returns the stresses and, if `tangent`, the
+    /// consistent tangents.
     pub fn update_stresses(
         &self,
         u: &[f64],
-        u_prev: &[f64],
+        strain_prev: &[Strain],
         sigma_prev: &[Stress],
         k: f64,
         source: Option<&[Stress]>,
         tangent: bool,
     ) -> (Vec<Stress>, Vec<Matrix3<f64>>) {
-        let update =
-            |(i, _): (usize, &Element)| self.update_element(i, u, u_prev, sigma_prev, k, source);
+        let update = |(i, _): (usize, &Element)| {
+            self.update_element(i, u, strain_prev, sigma_prev, k, source)
+        };
         // On rayon's threads from PARALLEL_ELEMENTS triangles on (each triangle alone: the
         // same numbers on any number of threads); below, serial. Without `tangent` no
         // tangent is stored (at 2.2e6 triangles they are 150 MB of fresh pages per update).
@@ -665,14 +682,14 @@ impl Model {
         &self,
         i: usize,
         u: &[f64],
-        u_prev: &[f64],
+        strain_prev: &[Strain],
         sigma_prev: &[Stress],
         k: f64,
         source: Option<&[Stress]>,
     ) -> (Stress, Matrix3<f64>) {
         let e = &self.elements[i];
         let m = &self.materials[e.body];
-        let de = e.strain(u) - e.strain(u_prev);
+        let de = e.strain(u) - strain_prev[i];
         let mut trial = sigma_prev[i] + m.elastic.apply(&de);
         if let Some(source) = source {
             trial += k * source[i];
@@ -686,10 +703,8 @@ impl Model {
     pub fn internal_force(&self, sigma: &[Stress]) -> Vec<f64> {
         let mut f = vec![0.0; 2 * self.n_nodes];
         let add = |body: usize, f: &mut [f64], dof_offset: usize| {
-            for (e, s) in self.elements.iter().zip(sigma) {
-                if e.body != body {
-                    continue;
-                }
+            let range = self.body_elements(body);
+            for (e, s) in self.elements[range.clone()].iter().zip(&sigma[range]) {
                 let fe = e.internal_force(s);
                 for (k, d) in e.dofs().iter().enumerate() {
                     f[*d - dof_offset] += fe[k];
@@ -772,10 +787,11 @@ impl Model {
                 return Vec::new();
             }
             let elastic = self.materials[body].elastic.matrix();
-            self.elements
+            let range = self.body_elements(body);
+            self.elements[range.clone()]
                 .iter()
-                .zip(tangents)
-                .filter(|(e, d)| e.body == body && **d != elastic)
+                .zip(&tangents[range])
+                .filter(|(_, d)| **d != elastic)
                 .map(|(e, d)| ChangedTriangle {
                     equations: e.dofs().map(|dof| self.equation[dof]),
                     grads: e.grads,
@@ -812,6 +828,16 @@ impl Model {
             }
         }
         (below <= above && above != usize::MAX).then_some(below)
+    }
+
+    /// The elements of `body` (0 or 1): body 0's come first ([`Model::new`]), so each
+    /// body's loops read their own triangles only.
+    pub fn body_elements(&self, body: usize) -> std::ops::Range<usize> {
+        let first_of_1 = self.elements.partition_point(|e| e.body == 0);
+        match body {
+            0 => 0..first_of_1,
+            _ => first_of_1..self.elements.len(),
+        }
     }
 
     /// Elastic tangents of all elements (E of each body).

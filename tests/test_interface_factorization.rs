@@ -194,9 +194,9 @@ fn the_per_triangle_tangent_change_is_the_assembled_one() {
             .iter()
             .map(|v| 0.05 * h * v)
             .collect();
-        let zero_u = vec![0.0; u.len()];
+        let zero_strain = model.strains(&vec![0.0; u.len()]);
         let zero_sigma = vec![contact_rates::material::Stress::zeros(); model.elements.len()];
-        let (_, tangents) = model.update_stresses(&u, &zero_u, &zero_sigma, 0.01, None, true);
+        let (_, tangents) = model.update_stresses(&u, &zero_strain, &zero_sigma, 0.01, None, true);
         let change = model.tangent_change(&tangents);
         let flowing = (tangents.iter().zip(&model.elements))
             .filter(|(d, e)| **d != model.materials[e.body].elastic.matrix())

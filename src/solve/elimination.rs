@@ -23,7 +23,7 @@
 use super::linear::SparseSystem;
 use crate::contact::Row;
 use crate::fe::{FIXED, Model, Pattern};
-use crate::material::{Stress, von_mises};
+use crate::material::{Strain, Stress, von_mises};
 use nalgebra::{DMatrix, DVector, Matrix3};
 use rayon::prelude::*;
 
@@ -96,8 +96,8 @@ impl LocalMatrix {
 
 /// What the local solves of one time step share with the global residual.
 pub struct Increment<'a> {
-    /// Displacements at t_{n-1} (all dofs).
-    pub u_prev: &'a [f64],
+    /// Strains at t_{n-1} per triangle ([`Model::strains`]).
+    pub strain_prev: &'a [Strain],
     /// Stresses at t_{n-1} per triangle.
     pub sigma_prev: &'a [Stress],
     /// Time step.
@@ -268,8 +268,14 @@ impl Elimination {
             let mut r = DVector::from_iterator(dofs.len(), dofs.iter().map(|&d| -step.f_ext[d]));
             for &i in &patch {
                 let e = &model.elements[i];
-                let (s, d) =
-                    model.update_element(i, u, step.u_prev, step.sigma_prev, step.k, step.source);
+                let (s, d) = model.update_element(
+                    i,
+                    u,
+                    step.strain_prev,
+                    step.sigma_prev,
+                    step.k,
+                    step.source,
+                );
                 let fe = e.internal_force(&s);
                 let ke = jacobian.as_ref().map(|_| e.stiffness(&d));
                 let ed = e.dofs();
