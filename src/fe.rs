@@ -834,6 +834,7 @@ impl Model {
     /// body's loops read their own triangles only.
     pub fn body_elements(&self, body: usize) -> std::ops::Range<usize> {
         let first_of_1 = self.elements.partition_point(|e| e.body == 0);
+        debug_assert!(self.elements[first_of_1..].iter().all(|e| e.body == 1));
         match body {
             0 => 0..first_of_1,
             _ => first_of_1..self.elements.len(),
