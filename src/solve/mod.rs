@@ -384,22 +384,31 @@ fn run_steps(
             fixed_point::Inner::Clarabel,
         )?),
     };
-    let mut states = vec![initial.clone()];
+    // t_0 for a run that keeps only t_0 and t_N (a run keeping every state moves them).
+    let first = (!keep_history).then(|| initial.clone());
+    let mut states = Vec::new();
     let mut reports = Vec::new();
-    let mut prev = initial;
-    // The last states before `prev` (newest first), for the predictor.
-    let mut history: Vec<State> = Vec::new();
+    // The last HISTORY + 1 states, oldest first: `prev` and the predictor's points. A state
+    // leaving it moves into `states` when every state is kept (no copy of its fields).
+    let mut window: Vec<State> = vec![initial];
     let mut observer_s = 0.0;
     for n in 1..=steps {
         let t = times[n - 1];
+        let prev = window.last().expect("the window holds prev");
         let k = t - prev.time;
         // Warm start: the Lagrange extrapolation through the last three states (two at the
         // second step): the steps' Newton iterations start closer to the solution.
-        let guess = if history.is_empty() {
-            prev.clone()
+        let guess = if window.len() == 1 {
+            // The solvers read the guess's displacements and multipliers only.
+            State {
+                time: prev.time,
+                u: prev.u.clone(),
+                sigma: Vec::new(),
+                lambda: prev.lambda.clone(),
+            }
         } else {
-            // Lagrange extrapolation through prev and the history to time t.
-            let points: Vec<&State> = std::iter::once(&prev).chain(history.iter()).collect();
+            // Lagrange extrapolation through prev and the states before it to time t.
+            let points: Vec<&State> = window.iter().rev().collect();
             let weights: Vec<f64> = (0..points.len())
                 .map(|i| {
                     (0..points.len())
@@ -421,14 +430,15 @@ fn run_steps(
             State {
                 time: t,
                 u: mix(&|s: &State| s.u.as_slice()),
-                sigma: prev.sigma.clone(),
+                // The solvers read the guess's displacements and multipliers only.
+                sigma: Vec::new(),
                 lambda: mix(&|s: &State| s.lambda.as_slice())
                     .into_iter()
                     .map(|l| l.max(0.0))
                     .collect(),
             }
         };
-        let (state, report) = solver.step(&prev, &guess, t, k).map_err(|e| match e {
+        let (state, report) = solver.step(prev, &guess, t, k).map_err(|e| match e {
             Error::NotConverged(m) => Error::NotConverged(format!(
                 "{} solver, {} cone, step {n} of {steps} (t = {t}): {m}",
                 settings.kind.name(),
@@ -440,14 +450,20 @@ fn run_steps(
         observer(n, steps, &state, &report)?;
         observer_s += observed.elapsed().as_secs_f64();
         reports.push(report);
-        if keep_history {
-            states.push(state.clone());
+        window.push(state);
+        if window.len() > HISTORY + 1 {
+            let oldest = window.remove(0);
+            if keep_history {
+                states.push(oldest);
+            }
         }
-        history.insert(0, std::mem::replace(&mut prev, state));
-        history.truncate(HISTORY);
     }
-    if !keep_history {
-        states.push(prev);
+    match first {
+        Some(first) => {
+            states.push(first);
+            states.push(window.pop().expect("the window holds t_N"));
+        }
+        None => states.extend(window),
     }
     let timings = solver.timings();
     Ok(Solution {
