@@ -269,6 +269,32 @@ fn readme(res: &SpeedResult) -> String {
             }
         }
     }
+    // The spread the specification asks for: every row of a mesh times the same floor.
+    let mut floors: std::collections::BTreeMap<usize, (f64, f64)> = Default::default();
+    for r in res
+        .rows
+        .iter()
+        .filter(|r| r.run.solver == SolverKind::Newton)
+    {
+        if r.run.dofs >= 10_000 {
+            let f = floors.entry(r.run.dofs).or_insert((f64::INFINITY, 0.0));
+            *f = (f.0.min(floor_of(r)), f.1.max(floor_of(r)));
+        }
+    }
+    let _ = writeln!(
+        s,
+        "\nSpread: the floor is the same work in every row of a mesh (the same stiffness, whatever the family and cone), timed anew beside each; its fastest time per row, smallest - largest: {}. A ratio moves with its floor by as much.",
+        floors
+            .iter()
+            .map(|(dofs, (lo, hi))| format!(
+                "{dofs} dofs {} - {} s ({:.0}%)",
+                seconds(*lo),
+                seconds(*hi),
+                100.0 * (hi / lo - 1.0)
+            ))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
     let _ = writeln!(
         s,
         "\nThreads: {} (rayon's pool; `RAYON_NUM_THREADS` sets it), the same for the solver and the floor. The stiffness is block diagonal, one block per body (they meet only through the contact rows): both sides factorize the blocks apart and side by side, in the same ordering (`solve::ordering`: METIS's nested dissection of the nodes for a block of 500,000 equations or more, faer's AMD below), the floor of each whole block, newton of the block's interior with its contact-interface unknowns last; newton's substitutions run as tasks on the threads, one per subtree of the blocks' elimination trees (`solve::substitution`: split until no subtree holds more than a fifth of the work, so that the larger body does not set the time), the floor's (4 per run) as faer's solve of each block, side by side. Newton factorizes in single precision (faer's LDL^T in f32 of the stiffness scaled to unit diagonal; the substitutions' arithmetic in f64) and reaches the tolerance 1e-10 through its Newton and GMRES iterations; the floor is the double-precision Cholesky and its two triangular solves per step, a double-precision answer with no iteration. The fill is the number of entries of the factor L on and below its diagonal (both bodies; newton's includes its interface rows).\n",
@@ -382,5 +408,14 @@ pub fn console(res: &SpeedResult, dir: &Path) -> String {
         table(res),
         dir.display(),
         res.wall_s
+    )
+}
+
+/// Seconds with three significant digits (0.0744, 2.86, 16.3).
+fn seconds(v: f64) -> String {
+    format!(
+        "{:.*}",
+        (2 - v.abs().max(1e-300).log10().floor() as i32).max(0) as usize,
+        v
     )
 }
