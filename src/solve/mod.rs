@@ -397,17 +397,9 @@ fn run_steps(
         let prev = window.last().expect("the window holds prev");
         let k = t - prev.time;
         // Warm start: the Lagrange extrapolation through the last three states (two at the
-        // second step): the steps' Newton iterations start closer to the solution.
-        let guess = if window.len() == 1 {
-            // The solvers read the guess's displacements and multipliers only.
-            State {
-                time: prev.time,
-                u: prev.u.clone(),
-                sigma: Vec::new(),
-                lambda: prev.lambda.clone(),
-            }
-        } else {
-            // Lagrange extrapolation through prev and the states before it to time t.
+        // second step; at the first, the initial state itself): the steps' Newton
+        // iterations start closer to the solution.
+        let guess = {
             let points: Vec<&State> = window.iter().rev().collect();
             let weights: Vec<f64> = (0..points.len())
                 .map(|i| {

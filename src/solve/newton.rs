@@ -819,8 +819,9 @@ impl Newton<'_> {
     /// one step where the monotone one takes 12, and `rates` and `rates-elastic` take the
     /// same iterations either way (levels 1, 3, 5, measured). Each trial whose merit is above
     /// [`ELIMINATION_SKIP`] of `reference` is first moved by [`Newton::eliminate`] where the
-    /// step left the return map's linear model (kept only where that lowers the merit). Returns the best trial with its evaluation (the next
-    /// iteration's residual), its step length, and whether its merit is below `reference`.
+    /// step left the return map's linear model (kept only where that lowers the merit).
+    /// Returns the best trial with its evaluation (the next iteration's residual), its step
+    /// length, and whether its merit is below `reference`.
     fn line_search(
         &self,
         data: &StepData,
@@ -850,25 +851,23 @@ impl Newton<'_> {
             let ev = self.evaluate(data, &ut, &lt);
             // The trial moved by the elimination, unless that raised the merit (a safeguard:
             // the local solves hold the rest of the mesh and can land on a worse point; the
-            // line search then never judges a trial worse than the plain one).
-            // A trial that already cuts the merit to ELIMINATION_SKIP of the iterate's is
-            // judged as it is (see the constant).
+            // line search then never judges a trial worse than the plain one). A trial that
+            // already cuts the merit to ELIMINATION_SKIP of the iterate's is judged as it is
+            // (see the constant), and only a trial the elimination may move is copied.
             let raw_merit = self.merit(&ev, &lt);
-            let (raw_u, raw_l) = (ut.clone(), lt.clone());
-            let moved = (raw_merit > ELIMINATION_SKIP * reference)
-                .then(|| self.eliminate(data, u, current, &mut ut, &mut lt, &ev))
-                .flatten()
-                .map(|moved| {
-                    let merit = self.merit(&moved, &lt);
-                    (moved, merit)
-                });
+            let moved = if raw_merit > ELIMINATION_SKIP * reference {
+                let (mut moved_u, mut moved_l) = (ut.clone(), lt.clone());
+                self.eliminate(data, u, current, &mut moved_u, &mut moved_l, &ev)
+                    .map(|moved| (self.merit(&moved, &moved_l), moved, moved_u, moved_l))
+            } else {
+                None
+            };
             let (ev, merit) = match moved {
-                Some((moved, merit)) if merit <= raw_merit => (moved, merit),
-                Some(_) => {
-                    (ut, lt) = (raw_u, raw_l);
-                    (ev, raw_merit)
+                Some((merit, moved, moved_u, moved_l)) if merit <= raw_merit => {
+                    (ut, lt) = (moved_u, moved_l);
+                    (moved, merit)
                 }
-                None => (ev, raw_merit),
+                _ => (ev, raw_merit),
             };
             let done = merit <= (1.0 - 1e-4 * alpha) * reference;
             if self.trace {
