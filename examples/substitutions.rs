@@ -65,13 +65,17 @@ fn main() -> contact_rates::error::Result<()> {
     }
     let x = first.expect("one solve");
     println!(
-        "level {level} {method:?} dofs {n} threads {} fill {}: solve {:.3} ms (fastest of {repeats}; forward {:.3}, back {:.3}), |x| {:.6e}, spread {spread:.1e}",
+        "level {level} {method:?} dofs {n} threads {} fill {}: solve {:.3} ms (fastest of {repeats}; forward {:.3}, back {:.3}), |x| {:.6e}, spread {spread:.1e}, bits {:016x}",
         rayon::current_num_threads(),
         factorization.factor_entries(),
         best * 1e3,
         forward * 1e3,
         back * 1e3,
-        x.iter().map(|v| v * v).sum::<f64>().sqrt()
+        x.iter().map(|v| v * v).sum::<f64>().sqrt(),
+        // A checksum of every bit of x: two versions of the kernels agree to the bit
+        // where it does.
+        x.iter()
+            .fold(0u64, |h, v| (h ^ v.to_bits()).wrapping_mul(0x100000001b3))
     );
     Ok(())
 }

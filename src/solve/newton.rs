@@ -14,7 +14,7 @@
 
 use super::elimination::{Elimination, Increment};
 use super::interface::{ActiveSet, InterfaceFactorization, Precision};
-use super::linear::{OrderedCholesky, SparseSystem, gmres};
+use super::linear::{OrderedCholesky, SparseSystem, SymmetricProduct, gmres};
 use super::{Problem, Settings, State, StepReport, StepSolver, inf_norm};
 use super::{Timings, timed};
 use super::{ordering, pieces};
@@ -37,7 +37,7 @@ pub struct Newton<'a> {
     /// transpose product: its element matrices B^T (E S) B |T| differ from their
     /// transposes in the last bit, so the products are K_el x to 2.5e-16 relative, not
     /// to the bit).
-    stiffness: SparseSystem,
+    stiffness: SymmetricProduct,
     /// The viscoplastic triangles' share K_t - K_el of the current tangent, applied per
     /// triangle in the products (empty while every tangent is elastic).
     change: TangentChange,
@@ -290,7 +290,7 @@ impl<'a> Newton<'a> {
         let factorization = pieces::time("setup.interface_analysis", 0, || {
             InterfaceFactorization::new(&pattern, &rows)
         })?;
-        let stiffness = SparseSystem::with_values(pattern, values);
+        let stiffness = SymmetricProduct::new(pattern, values);
         let setup_s = t_setup.elapsed().as_secs_f64();
         pieces::record("setup.total", 0, setup_s);
         Ok(Newton {
@@ -325,7 +325,7 @@ impl<'a> Newton<'a> {
         let (xu, xl) = x.split_at(n);
         let (yu, yl) = y.split_at_mut(n);
         // K_t x = K_el x (by rows, to round-off: see the field) + (K_t - K_el) x.
-        self.stiffness.transpose_matvec(xu, yu);
+        self.stiffness.product(xu, yu);
         self.change.add_product(xu, yu);
         for (i, row) in self.rows.iter().enumerate() {
             let xi = c * xl[i];
