@@ -977,6 +977,7 @@ impl StepSolver for Newton<'_> {
             }
             let reference = self.merit(ev, &lambda);
             let tangents_before = self.trace.then(|| ev.tangents.clone());
+            let solves_before = self.factorization.solves.get();
             let (step, set, factorized) = self.newton_step(ev, &lambda, active, &distance)?;
             debug_assert_eq!(step.len(), n + m);
             if self.trace {
@@ -991,7 +992,8 @@ impl StepSolver for Newton<'_> {
                     .sqrt()
                     / rhs.iter().map(|b| b * b).sum::<f64>().sqrt();
                 eprintln!(
-                    "    linear residual {lin:.2e}, |du|/|u| = {:.3e}",
+                    "    linear residual {lin:.2e} ({} preconditioner solves), |du|/|u| = {:.3e}",
+                    self.factorization.solves.get() - solves_before,
                     inf_norm(&step[..n]) / inf_norm(&u).max(1e-300)
                 );
             }
