@@ -493,6 +493,13 @@ struct Distance {
 }
 
 impl Newton<'_> {
+    /// Solves with a factorization so far: the interface factorization's (a prediction's
+    /// forward and back substitutions, or one preconditioner application) and the Newton
+    /// matrix's LU (the fallback).
+    fn solves(&self) -> usize {
+        self.factorization.solves.get() + self.kkt.as_ref().map_or(0, |k| k.system.solves.get())
+    }
+
     /// Return map, internal forces and constraint values at (u, lambda).
     fn evaluate(&self, data: &StepData, u: &[f64], lambda: &[f64]) -> Evaluation {
         let (model, clock) = (&self.p.model, &self.clock);
@@ -977,7 +984,7 @@ impl StepSolver for Newton<'_> {
             }
             let reference = self.merit(ev, &lambda);
             let tangents_before = self.trace.then(|| ev.tangents.clone());
-            let solves_before = self.factorization.solves.get();
+            let solves_before = self.solves();
             let (step, set, factorized) = self.newton_step(ev, &lambda, active, &distance)?;
             debug_assert_eq!(step.len(), n + m);
             if self.trace {
@@ -992,8 +999,8 @@ impl StepSolver for Newton<'_> {
                     .sqrt()
                     / rhs.iter().map(|b| b * b).sum::<f64>().sqrt();
                 eprintln!(
-                    "    linear residual {lin:.2e} ({} preconditioner solves), |du|/|u| = {:.3e}",
-                    self.factorization.solves.get() - solves_before,
+                    "    linear residual {lin:.2e} ({} solves with a factorization), |du|/|u| = {:.3e}",
+                    self.solves() - solves_before,
                     inf_norm(&step[..n]) / inf_norm(&u).max(1e-300)
                 );
             }
@@ -1040,14 +1047,10 @@ impl StepSolver for Newton<'_> {
     }
 
     fn timings(&self) -> Timings {
-        let (kkt_factor_s, kkt_factorizations, kkt_solves) =
-            self.kkt.as_ref().map_or((0.0, 0, 0), |k| {
-                (
-                    k.system.factor_s,
-                    k.system.factorizations,
-                    k.system.solves.get(),
-                )
-            });
+        let (kkt_factor_s, kkt_factorizations) = self
+            .kkt
+            .as_ref()
+            .map_or((0.0, 0), |k| (k.system.factor_s, k.system.factorizations));
         Timings {
             assembly_s: self.clock.assembly.get(),
             factor_s: self.factorization.factor_s.get() + kkt_factor_s,
@@ -1055,7 +1058,7 @@ impl StepSolver for Newton<'_> {
             constitutive_s: self.clock.constitutive.get(),
             contact_s: self.clock.contact.get(),
             factorizations: self.factorization.factorizations + kkt_factorizations,
-            solves: self.factorization.solves.get() + kkt_solves,
+            solves: self.solves(),
             setup_s: self.setup_s,
             factor_entries: self.factorization.factor_entries(),
         }
