@@ -528,6 +528,12 @@ impl Model {
             node_ptr[j + 1] = neighbours.len();
         }
         let free = |dof: usize| self.equation[dof] != FIXED;
+        // The free equations must be numbered in dof order (Model::new does): the rows of a
+        // column are then increasing and the columns follow the nodes.
+        debug_assert!(
+            (self.equation.iter().copied().filter(|&eq| eq != FIXED)).eq(0..self.n_free),
+            "free equations numbered in dof order"
+        );
         // Per node, its rows (the free equations of its neighbours) and, per neighbour, the
         // rows before it (`before[k]` for neighbours[k]).
         let mut before = vec![0usize; neighbours.len()];

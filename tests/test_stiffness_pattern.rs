@@ -3,9 +3,9 @@
 //! Goal: the pattern built from the nodes' neighbours (the fast path every solver and the
 //! floor use) is the one built from the list of every element entry, to the index, and so
 //! are the 36 value slots of every triangle.
-//! Geometry: every built-in scene with a different set of constrained unknowns (`rates`:
-//! rollers and a clamped block, one of a node's two unknowns fixed on the rollers;
-//! `patch`: symmetry sides; `paper-3`: a contact line with corners; `stacked-exact`;
+//! Geometry: six built-in scenes with different constrained unknowns (`rates`: rollers
+//! with x fixed and y free, and a clamped block; `paper-1`: symmetry with y fixed and x
+//! free; `patch`: both kinds; `paper-3`: a contact line with corners; `stacked-exact`;
 //! `contact-mms-vp`), at levels 0-2.
 //! Data: the scenes' own meshes.
 
@@ -15,8 +15,10 @@ use contact_rates::fe::FIXED;
 
 #[test]
 fn nodes_pattern_equals_the_entries_pattern_on_every_scene() {
+    let (mut x_fixed, mut y_fixed) = (0, 0);
     for scene in [
         "rates",
+        "paper-1",
         "patch",
         "paper-3",
         "stacked-exact",
@@ -38,15 +40,18 @@ fn nodes_pattern_equals_the_entries_pattern_on_every_scene() {
                 fast_slots == entries_slots,
                 "{scene} level {level}: the triangles' value slots differ"
             );
-            // Some unknowns are constrained, so the test covers the fixed ones; on `rates`
-            // some node has one of its two fixed (rollers).
+            // Some unknowns are constrained, so the test covers the fixed ones.
             assert!(n < 2 * model.n_nodes, "{scene}: no constrained unknown");
-            let half_fixed = (0..model.n_nodes)
-                .filter(|&j| {
-                    (model.equation[2 * j] == FIXED) != (model.equation[2 * j + 1] == FIXED)
-                })
-                .count();
-            assert!(scene != "rates" || half_fixed > 0, "rates: no roller node");
+            let fixed = |d: usize| model.equation[d] == FIXED;
+            for j in 0..model.n_nodes {
+                x_fixed += (fixed(2 * j) && !fixed(2 * j + 1)) as usize;
+                y_fixed += (!fixed(2 * j) && fixed(2 * j + 1)) as usize;
+            }
         }
     }
+    // Nodes with one of their two unknowns fixed, of both kinds (the slots' offsets differ).
+    assert!(
+        x_fixed > 0 && y_fixed > 0,
+        "x fixed {x_fixed}, y fixed {y_fixed}"
+    );
 }
