@@ -104,6 +104,25 @@ pub struct Pattern {
     pub row_idx: Vec<usize>,
 }
 
+/// The buckets `values[start[b]..start[b + 1]]` each sorted (in place) and without
+/// repeats, packed: (pointers, values), bucket b at `pointers[b]..pointers[b + 1]`.
+fn sorted_unique_buckets(start: &[usize], values: &mut [usize]) -> (Vec<usize>, Vec<usize>) {
+    let mut pointers = vec![0usize; start.len()];
+    let mut unique = Vec::with_capacity(values.len());
+    for b in 0..start.len() - 1 {
+        let bucket = &mut values[start[b]..start[b + 1]];
+        bucket.sort_unstable();
+        let first = unique.len();
+        for &v in bucket.iter() {
+            if unique.len() == first || unique.last() != Some(&v) {
+                unique.push(v);
+            }
+        }
+        pointers[b + 1] = unique.len();
+    }
+    (pointers, unique)
+}
+
 impl Pattern {
     /// Build from (row, col) pairs (duplicates allowed).
     pub fn from_entries(n: usize, entries: Vec<(usize, usize)>) -> Self {
@@ -123,19 +142,7 @@ impl Pattern {
             rows[next[c]] = r;
             next[c] += 1;
         }
-        let mut col_ptr = vec![0usize; n + 1];
-        let mut row_idx = Vec::with_capacity(entries.len());
-        for c in 0..n {
-            let column = &mut rows[start[c]..start[c + 1]];
-            column.sort_unstable();
-            let first = row_idx.len();
-            for &r in column.iter() {
-                if row_idx.len() == first || row_idx.last() != Some(&r) {
-                    row_idx.push(r);
-                }
-            }
-            col_ptr[c + 1] = row_idx.len();
-        }
+        let (col_ptr, row_idx) = sorted_unique_buckets(&start, &mut rows);
         Pattern {
             n,
             col_ptr,
@@ -514,19 +521,7 @@ impl Model {
                 next[j] += 3;
             }
         }
-        let mut node_ptr = vec![0usize; n_nodes + 1];
-        let mut neighbours = Vec::with_capacity(listed.len() / 2);
-        for j in 0..n_nodes {
-            let list = &mut listed[start[j]..start[j + 1]];
-            list.sort_unstable();
-            let first = neighbours.len();
-            for &i in list.iter() {
-                if neighbours.len() == first || neighbours.last() != Some(&i) {
-                    neighbours.push(i);
-                }
-            }
-            node_ptr[j + 1] = neighbours.len();
-        }
+        let (node_ptr, neighbours) = sorted_unique_buckets(&start, &mut listed);
         let free = |dof: usize| self.equation[dof] != FIXED;
         // The free equations must be numbered in dof order (Model::new does): the rows of a
         // column are then increasing and the columns follow the nodes.
