@@ -104,45 +104,43 @@ pub struct Pattern {
     pub row_idx: Vec<usize>,
 }
 
-/// The buckets `values[start[b]..start[b + 1]]` each sorted (in place) and without
-/// repeats, packed: (pointers, values), bucket b at `pointers[b]..pointers[b + 1]`.
-fn sorted_unique_buckets(start: &[usize], values: &mut [usize]) -> (Vec<usize>, Vec<usize>) {
-    let mut pointers = vec![0usize; start.len()];
-    let mut unique = Vec::with_capacity(values.len());
-    for b in 0..start.len() - 1 {
-        let bucket = &mut values[start[b]..start[b + 1]];
-        bucket.sort_unstable();
-        let first = unique.len();
-        for &v in bucket.iter() {
-            if unique.len() == first || unique.last() != Some(&v) {
-                unique.push(v);
-            }
-        }
-        pointers[b + 1] = unique.len();
-    }
-    (pointers, unique)
-}
-
 impl Pattern {
     /// Build from (row, col) pairs (duplicates allowed).
     pub fn from_entries(n: usize, entries: Vec<(usize, usize)>) -> Self {
-        // Bucket the rows by column (counting sort), then sort and deduplicate each short
-        // column: linear in the entries, where one sort of all (36 per triangle) cost about
-        // 1 s at 4e5 dofs.
+        Self::from_pairs(n, || entries.iter().copied())
+    }
+
+    /// Build from the (row, col) pairs that `pairs` yields (duplicates allowed; called
+    /// twice, so that no list of the pairs is kept). Bucket the rows by column (counting
+    /// sort), then sort and deduplicate each short column: linear in the pairs, where one
+    /// sort of all (36 per triangle) cost about 1 s at 4e5 dofs.
+    pub fn from_pairs<I: Iterator<Item = (usize, usize)>>(n: usize, pairs: impl Fn() -> I) -> Self {
         let mut start = vec![0usize; n + 1];
-        for &(_, c) in &entries {
+        for (_, c) in pairs() {
             start[c + 1] += 1;
         }
         for c in 0..n {
             start[c + 1] += start[c];
         }
         let mut next = start.clone();
-        let mut rows = vec![0usize; entries.len()];
-        for &(r, c) in &entries {
+        let mut rows = vec![0usize; start[n]];
+        for (r, c) in pairs() {
             rows[next[c]] = r;
             next[c] += 1;
         }
-        let (col_ptr, row_idx) = sorted_unique_buckets(&start, &mut rows);
+        let mut col_ptr = vec![0usize; n + 1];
+        let mut row_idx = Vec::with_capacity(rows.len());
+        for c in 0..n {
+            let column = &mut rows[start[c]..start[c + 1]];
+            column.sort_unstable();
+            let first = row_idx.len();
+            for &r in column.iter() {
+                if row_idx.len() == first || row_idx.last() != Some(&r) {
+                    row_idx.push(r);
+                }
+            }
+            col_ptr[c + 1] = row_idx.len();
+        }
         Pattern {
             n,
             col_ptr,
@@ -502,26 +500,15 @@ impl Model {
     /// increasing (equations are numbered in dof order).
     fn stiffness_pattern_by_nodes(&self) -> (Pattern, Vec<[usize; 36]>) {
         let n_nodes = self.n_nodes;
-        // Each triangle's three nodes are neighbours of each of its nodes (itself included):
-        // counting sort by node, then sort and deduplicate each node's short list.
-        let mut start = vec![0usize; n_nodes + 1];
-        for e in &self.elements {
-            for &j in &e.nodes {
-                start[j + 1] += 3;
-            }
-        }
-        for j in 0..n_nodes {
-            start[j + 1] += start[j];
-        }
-        let mut next = start.clone();
-        let mut listed = vec![0usize; start[n_nodes]];
-        for e in &self.elements {
-            for &j in &e.nodes {
-                listed[next[j]..next[j] + 3].copy_from_slice(&e.nodes);
-                next[j] += 3;
-            }
-        }
-        let (node_ptr, neighbours) = sorted_unique_buckets(&start, &mut listed);
+        // Each triangle's three nodes are neighbours of each of its nodes (itself
+        // included): the nodes' graph as a pattern, node j's neighbours in column j.
+        let graph = Pattern::from_pairs(n_nodes, || {
+            self.elements.iter().flat_map(|e| {
+                let nodes = e.nodes;
+                (0..9).map(move |k| (nodes[k / 3], nodes[k % 3]))
+            })
+        });
+        let (node_ptr, neighbours) = (graph.col_ptr, graph.row_idx);
         let free = |dof: usize| self.equation[dof] != FIXED;
         // The free equations must be numbered in dof order (Model::new does): the rows of a
         // column are then increasing and the columns follow the nodes.
