@@ -7,6 +7,17 @@
 //! Prints one line per run: the run's totals, then `piece@block=seconds` (block: the
 //! first equation of the diagonal block, 0 for a piece of the whole matrix; a piece run
 //! several times, such as the solves, is summed and its count given in parentheses).
+//! Before each run's line, `faults solver|floor N cpu S`: the minor page faults of that
+//! run (a first touch of a fresh 4 KB page cost 2.0-2.2 us on the 2-core machine of issue
+//! 24, so 15,000 faults are about 30 ms of CPU time) and the process's user + system CPU
+//! seconds over it (both threads; rayon's spinning included).
+//!
+//! Environment, for experiments: `SKIP_FLOOR=1` times the solver only (for `perf record`
+//! of newton alone); `HISTORY_LEVEL=L` first solves `rates` at level L and measures its
+//! floor once, then drops it, so that the timed runs follow a large run in the same
+//! process, as the small levels of `study speed`'s second family do (measured: after
+//! level 7, `rates-elastic` level 4 mortar read 0.0713 s against a floor of 0.0715 s,
+//! against 0.0650 and 0.0629 s in a fresh process run right after: no lasting effect).
 use contact_rates::case::{Case, release_free_heap};
 use contact_rates::contact::Method;
 use contact_rates::scene::Scene;
@@ -30,6 +41,24 @@ fn pieces_line() -> String {
         .join(" ")
 }
 
+/// The process's (minor page faults, user + system CPU seconds) so far.
+fn usage() -> (i64, f64) {
+    // SAFETY: getrusage only writes the struct it is given.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
+    let seconds = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+    (u.ru_minflt, seconds(u.ru_utime) + seconds(u.ru_stime))
+}
+
+/// `faults WHO N cpu S` since `before` (a [`usage`]).
+fn usage_line(who: &str, before: (i64, f64)) -> String {
+    let now = usage();
+    format!(
+        "faults {who} {} cpu {:.4}",
+        now.0 - before.0,
+        now.1 - before.1
+    )
+}
 fn main() -> contact_rates::error::Result<()> {
     contact_rates::init();
     assert!(pieces::enabled(), "set CONTACT_RATES_PIECES=1");
@@ -45,6 +74,16 @@ fn main() -> contact_rates::error::Result<()> {
         ("h_upper".to_string(), 0.28),
         ("h_lower".to_string(), 0.28 / 1.4142),
     ];
+    if let Some(history) = std::env::var("HISTORY_LEVEL").ok() {
+        let history: usize = history.parse().expect("HISTORY_LEVEL: a level");
+        let large = Case::build(&Scene::load("rates")?, history, method, &sizes)?;
+        drop(solve::solve(&large.problem, &Settings::default(), 4, true)?);
+        release_free_heap();
+        solve::floor_time(&large.problem, 4)?;
+        drop(large);
+        release_free_heap();
+        println!("history: level {history} solved and its floor measured");
+    }
     let case = Case::build(&Scene::load(scene)?, level, method, &sizes)?;
     println!(
         "level {level} {method:?} {scene} dofs {} threads {}",
@@ -54,8 +93,10 @@ fn main() -> contact_rates::error::Result<()> {
     pieces::take();
     for r in 0..repeats {
         release_free_heap();
+        let before = usage();
         let sol = solve::solve(&case.problem, &Settings::default(), 4, true)?;
         let t = &sol.timings;
+        println!("{}", usage_line("solver", before));
         println!(
             "run {r} solver total={:.4} setup={:.4} loop={:.4} factor={:.4} solve={:.4} assembly={:.4} constitutive={:.4} contact={:.4} iterations={} factorizations={} solves={} {}",
             sol.wall_s + t.setup_s,
@@ -73,7 +114,12 @@ fn main() -> contact_rates::error::Result<()> {
         );
         drop(sol);
         release_free_heap();
+        if std::env::var_os("SKIP_FLOOR").is_some() {
+            continue;
+        }
+        let before = usage();
         let floor = solve::floor_time(&case.problem, 4)?;
+        println!("{}", usage_line("floor", before));
         println!("run {r} floor total={floor:.4} {}", pieces_line());
     }
     Ok(())
