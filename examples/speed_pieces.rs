@@ -4,20 +4,23 @@
 //! `CONTACT_RATES_PIECES=1 cargo run --release --example speed_pieces -- LEVEL [mortar|nts]
 //! [rates|rates-elastic] [REPEATS]`.
 //!
-//! Prints one line per run: the run's totals, then `piece@block=seconds` (block: the
-//! first equation of the diagonal block, 0 for a piece of the whole matrix; a piece run
-//! several times, such as the solves, is summed and its count given in parentheses).
-//! Before each run's line, `faults solver|floor N cpu S`: the minor page faults of that
-//! run (a first touch of a fresh 4 KB page cost 2.0-2.2 us on the 2-core machine of issue
-//! 24, so 15,000 faults are about 30 ms of CPU time) and the process's user + system CPU
-//! seconds over it (both threads; rayon's spinning included).
+//! Prints two lines per run and side: `faults solver|floor N cpu S`, the minor page faults
+//! of that run (a first touch of a fresh 4 KB page cost 2.0-2.2 us on the 2-core machine of
+//! issue 24, so 15,000 faults are about 30 ms of CPU time) and the user + system CPU
+//! seconds of all the process's threads over it (rayon's spinning within the run
+//! included); then the run's totals and `piece@block=seconds` (block: the first equation
+//! of the diagonal block, 0 for a piece of the whole matrix; a piece run several times,
+//! such as the solves, is summed and its count given in parentheses).
 //!
-//! Environment, for experiments: `SKIP_FLOOR=1` times the solver only (for `perf record`
-//! of newton alone); `HISTORY_LEVEL=L` first solves `rates` at level L and measures its
-//! floor once, then drops it, so that the timed runs follow a large run in the same
-//! process, as the small levels of `study speed`'s second family do (measured: after
-//! level 7, `rates-elastic` level 4 mortar read 0.0713 s against a floor of 0.0715 s,
-//! against 0.0650 and 0.0629 s in a fresh process run right after: no lasting effect).
+//! Environment, for experiments (set means present, whatever the value): `SKIP_FLOOR`
+//! times the solver only (for `perf record` of newton alone); `HISTORY_LEVEL=L` first
+//! solves `rates` at level L with the same cone and measures its floor once, then drops
+//! it, so that the timed runs follow a large run in the same process, as most blocks of
+//! `study speed` after the first do (there the large run is the previous block's level 7,
+//! of the other cone or family). Measured once each: after level 7, `rates-elastic` level
+//! 4 mortar read 0.0713 s against a floor of 0.0715 s (ratio 1.00), a fresh process right
+//! after 0.0650 and 0.0629 s (1.03): both sides slower by 10-14% in that sample, the ratio
+//! alike.
 use contact_rates::case::{Case, release_free_heap};
 use contact_rates::contact::Method;
 use contact_rates::scene::Scene;
