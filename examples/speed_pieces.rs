@@ -12,8 +12,8 @@
 //! of the diagonal block, 0 for a piece of the whole matrix; a piece run several times,
 //! such as the solves, is summed and its count given in parentheses).
 //!
-//! Environment, for experiments (set means present, whatever the value): `SKIP_FLOOR`
-//! times the solver only (for `perf record` of newton alone); `HISTORY_LEVEL=L` first
+//! Environment, for experiments: `SKIP_FLOOR` (set, whatever its value) times the solver
+//! only (for `perf record` of newton alone); `HISTORY_LEVEL=L` first
 //! solves `rates` at level L with the same cone and measures its floor once, then drops
 //! it, so that the timed runs follow a large run in the same process, as most blocks of
 //! `study speed` after the first do (there the large run is the previous block's level 7,
@@ -62,6 +62,7 @@ fn usage_line(who: &str, before: (i64, f64)) -> String {
         now.1 - before.1
     )
 }
+
 fn main() -> contact_rates::error::Result<()> {
     contact_rates::init();
     assert!(pieces::enabled(), "set CONTACT_RATES_PIECES=1");
