@@ -4,12 +4,13 @@
 
 use crate::error::{Error, Result};
 use crate::expr::{distinct_kinks, kink_functions};
-use crate::material::{Material, Strain, Stress};
+use crate::material::{LANES, Material, Strain, Stress};
 use crate::mesh::{BodyMesh, RawMesh};
 use crate::quadrature;
 use crate::scene::Scene;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use rayon::prelude::*;
+use std::mem::MaybeUninit;
 use std::path::Path;
 
 /// Marker for a constrained degree of freedom.
@@ -755,40 +756,97 @@ impl Model {
         source: Option<&[Stress]>,
         tangent: bool,
     ) -> (Vec<Stress>, Vec<Matrix3<f64>>) {
-        let update = |(i, _): (usize, &Element)| {
-            self.update_element(i, u, strain_prev, sigma_prev, k, source)
+        let n = self.elements.len();
+        let mut sigma: Vec<Stress> = Vec::with_capacity(n);
+        // Without `tangent` no tangent is stored (at 2.2e6 triangles they are 150 MB of
+        // fresh pages per update).
+        let mut tangents: Vec<Matrix3<f64>> = Vec::with_capacity(if tangent { n } else { 0 });
+        let blocks = n.div_ceil(UPDATE_BLOCK);
+        let tangent_blocks: Vec<Option<&mut [MaybeUninit<Matrix3<f64>>]>> = match tangent {
+            true => (tangents.spare_capacity_mut()[..n].chunks_mut(UPDATE_BLOCK))
+                .map(Some)
+                .collect(),
+            false => (0..blocks).map(|_| None).collect(),
+        };
+        let jobs: Vec<_> = (sigma.spare_capacity_mut()[..n].chunks_mut(UPDATE_BLOCK))
+            .zip(tangent_blocks)
+            .enumerate()
+            .collect();
+        let update = |(b, (sigma, tangents))| {
+            let first = b * UPDATE_BLOCK;
+            self.update_block(first, sigma, tangents, u, strain_prev, sigma_prev, k, source);
         };
         // On rayon's threads from PARALLEL_ELEMENTS triangles on (each triangle alone: the
-        // same numbers on any number of threads); below, serial. Without `tangent` no
-        // tangent is stored (at 2.2e6 triangles they are 150 MB of fresh pages per update).
-        let parallel = self.elements.len() >= PARALLEL_ELEMENTS;
-        match (tangent, parallel) {
-            (true, true) => self
-                .elements
-                .par_iter()
-                .enumerate()
-                .with_min_len(4096)
-                .map(update)
-                .unzip(),
-            (true, false) => self.elements.iter().enumerate().map(update).unzip(),
-            (false, true) => (
-                self.elements
-                    .par_iter()
-                    .enumerate()
-                    .with_min_len(4096)
-                    .map(|x| update(x).0)
-                    .collect(),
-                Vec::new(),
-            ),
-            (false, false) => (
-                self.elements
-                    .iter()
-                    .enumerate()
-                    .map(|x| update(x).0)
-                    .collect(),
-                Vec::new(),
-            ),
+        // same numbers on any number of threads); below, serial.
+        match n >= PARALLEL_ELEMENTS {
+            true => jobs.into_par_iter().for_each(update),
+            false => jobs.into_iter().for_each(update),
         }
+        // SAFETY: update_block wrote every slot of every block (and the blocks cover
+        // 0..n), the tangents' only where `tangent`.
+        unsafe {
+            sigma.set_len(n);
+            if tangent {
+                tangents.set_len(n);
+            }
+        }
+        (sigma, tangents)
+    }
+
+    /// [`Model::update_stresses`] of the triangles `first..first + sigma.len()` into
+    /// `sigma` and, if given, `tangents` (every slot written), [`LANES`] at a time
+    /// ([`Material::update_lanes`]). Written in place: the unzip of per-triangle pairs
+    /// it replaces cost 0.30 ms per update of `rates-elastic` at 34,304 triangles, this
+    /// 0.18 ms.
+    #[allow(clippy::too_many_arguments)]
+    fn update_block(
+        &self,
+        first: usize,
+        sigma: &mut [MaybeUninit<Stress>],
+        mut tangents: Option<&mut [MaybeUninit<Matrix3<f64>>]>,
+        u: &[f64],
+        strain_prev: &[Strain],
+        sigma_prev: &[Stress],
+        k: f64,
+        source: Option<&[Stress]>,
+    ) {
+        for start in (0..sigma.len()).step_by(LANES) {
+            let lanes = LANES.min(sigma.len() - start);
+            let mut materials = [&self.materials[0]; LANES];
+            let mut trials = [Stress::zeros(); LANES];
+            for l in 0..lanes {
+                let i = first + start + l;
+                (materials[l], trials[l]) =
+                    self.trial_stress(i, u, strain_prev, sigma_prev, k, source);
+            }
+            Material::update_lanes(&materials[..lanes], &trials[..lanes], k, |l, s, d| {
+                sigma[start + l].write(s);
+                if let Some(t) = tangents.as_deref_mut() {
+                    t[start + l].write(d);
+                }
+            });
+        }
+    }
+
+    /// The material and the trial stress `sigma_prev + E (eps(u) - eps(u_prev)) + k s` of
+    /// element `i` (see [`Model::update_stresses`]).
+    fn trial_stress(
+        &self,
+        i: usize,
+        u: &[f64],
+        strain_prev: &[Strain],
+        sigma_prev: &[Stress],
+        k: f64,
+        source: Option<&[Stress]>,
+    ) -> (&Material, Stress) {
+        let e = &self.elements[i];
+        let m = &self.materials[e.body];
+        let de = e.strain(u) - strain_prev[i];
+        let mut trial = sigma_prev[i] + m.elastic.apply(&de);
+        if let Some(source) = source {
+            trial += k * source[i];
+        }
+        (m, trial)
     }
 
     /// The constitutive update of element `i` alone (see [`Model::update_stresses`]): its
@@ -802,13 +860,7 @@ impl Model {
         k: f64,
         source: Option<&[Stress]>,
     ) -> (Stress, Matrix3<f64>) {
-        let e = &self.elements[i];
-        let m = &self.materials[e.body];
-        let de = e.strain(u) - strain_prev[i];
-        let mut trial = sigma_prev[i] + m.elastic.apply(&de);
-        if let Some(source) = source {
-            trial += k * source[i];
-        }
+        let (m, trial) = self.trial_stress(i, u, strain_prev, sigma_prev, k, source);
         m.update(&trial, k)
     }
 
@@ -1057,6 +1109,10 @@ impl TangentChange {
 /// steps, fastest of 6 runs), serial against 2 threads: the constitutive updates of
 /// `rates` 0.032 s against 0.021-0.024 s, of `rates-elastic` 0.0046 s against 0.0032-0.0036 s.
 pub const PARALLEL_ELEMENTS: usize = 8_000;
+
+/// Triangles per task of [`Model::update_stresses`] on rayon's threads (the least a task
+/// took before, as `with_min_len`).
+const UPDATE_BLOCK: usize = 4096;
 
 /// Add `|T| B^T D S B` of one element into `values` through its slot map (S halves the
 /// engineering shear).

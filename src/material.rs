@@ -59,12 +59,87 @@ fn from_pdt(v: &Vector3<f64>) -> Stress {
     Vector3::new(v[0] + v[1], v[0] - v[1], v[2])
 }
 
+/// Newton iterations allowed for a root (the monotone iterates converge long before).
+const ROOT_ITERATIONS: usize = 200;
+
+/// Triangles whose return maps [`Material::update_lanes`] runs side by side.
+pub const LANES: usize = 8;
+
+/// A trial stress of [`Material::trial`].
+enum Trial {
+    /// In the elastic set, or an elastic body: the trial stress and the elastic tangent.
+    Settled(Stress, Matrix3<f64>),
+    /// Outside: the flow whose multiplier is the root of [`Flow::h`].
+    Flowing(Flow),
+}
+
+/// The return map of a trial stress outside the elastic set, up to its multiplier mu.
+struct Flow {
+    /// The trial stress in (p, d, t) coordinates, p, and |(d, t)|^2.
+    v: Vector3<f64>,
+    p: f64,
+    r2: f64,
+    /// sigma_Y^2.
+    y2: f64,
+    /// A = 1 + mu da, Bq = 1 + mu db.
+    da: f64,
+    db: f64,
+    /// The norm weights of the elastic tensor and k / (2 lambda).
+    alpha: f64,
+    beta: f64,
+    c: f64,
+    /// The elastic tensor.
+    e: Matrix3<f64>,
+    /// A start below the root.
+    start: f64,
+}
+
+impl Flow {
+    /// h(mu) and h'(mu): convex and decreasing, zero at the multiplier.
+    fn h(&self, mu: f64) -> (f64, f64) {
+        let (p, r2, da, db) = (self.p, self.r2, self.da, self.db);
+        let a = 1.0 + mu * da;
+        let bq = 1.0 + mu * db;
+        let val = p * p / (a * a) + 3.0 * r2 / (bq * bq) - self.y2;
+        let der = -2.0 * p * p * da / (a * a * a) - 6.0 * r2 * db / (bq * bq * bq);
+        (val, der)
+    }
+
+    /// The stress and the consistent tangent at the multiplier `mu`.
+    fn finish(&self, mu: f64) -> (Stress, Matrix3<f64>) {
+        let (v, p, r2, da, db, c) = (self.v, self.p, self.r2, self.da, self.db, self.c);
+        let a = 1.0 + mu * da;
+        let bq = 1.0 + mu * db;
+        // sigma_p = P_p (1 + mu/alpha), sigma_q = P_q (1 + 3 mu / beta).
+        let phi = (1.0 + mu / self.alpha) / a;
+        let psi = (1.0 + 3.0 * mu / self.beta) / bq;
+        let sigma = from_pdt(&Vector3::new(v[0] * phi, v[1] * psi, v[2] * psi));
+        // Tangent in (p, d, t): diag(phi, psi, psi) + (p phi', q psi') (grad mu)^T.
+        let dphi = -0.5 * c / (a * a);
+        let dpsi = -1.5 * c / (bq * bq);
+        let h_mu = -2.0 * p * p * da / (a * a * a) - 6.0 * r2 * db / (bq * bq * bq);
+        let grad_h = Vector3::new(
+            2.0 * v[0] / (a * a),
+            6.0 * v[1] / (bq * bq),
+            6.0 * v[2] / (bq * bq),
+        );
+        let grad_mu = -grad_h / h_mu;
+        let col = Vector3::new(v[0] * dphi, v[1] * dpsi, v[2] * dpsi);
+        let j_pdt =
+            Matrix3::from_diagonal(&Vector3::new(phi, psi, psi)) + col * grad_mu.transpose();
+        // Chain rule: tensor -> (p, d, t) -> tensor.
+        let to = Matrix3::new(0.5, 0.5, 0.0, 0.5, -0.5, 0.0, 0.0, 0.0, 1.0);
+        let from = Matrix3::new(1.0, 1.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, 1.0);
+        (sigma, from * j_pdt * to * self.e)
+    }
+}
+
 /// Root of a convex, strictly decreasing function, by Newton from `start`, a point with
 /// `f(start) >= 0` (below the root): the iterates increase monotonically to the root, so
 /// no safeguard is needed.
 fn convex_decreasing_root(start: f64, f: impl Fn(f64) -> (f64, f64)) -> f64 {
     let mut mu = start;
-    for _ in 0..200 {
+    for _ in 0..ROOT_ITERATIONS {
         let (v, dv) = f(mu);
         if v <= 0.0 || dv >= 0.0 {
             break;
@@ -156,14 +231,23 @@ impl Material {
     /// solve `sigma = sigma_trial + k G(sigma)` with `sigma_trial = sigma_prev + E d_eps`.
     /// Returns sigma and the consistent tangent `d sigma / d eps` (tensor components).
     pub fn update(&self, sigma_trial: &Stress, k: f64) -> (Stress, Matrix3<f64>) {
+        match self.trial(sigma_trial, k) {
+            Trial::Settled(sigma, tangent) => (sigma, tangent),
+            Trial::Flowing(flow) => flow.finish(convex_decreasing_root(flow.start, |mu| flow.h(mu))),
+        }
+    }
+
+    /// The return map of `sigma_trial` up to its root: settled where the trial stress
+    /// lies in the elastic set (or the body is elastic), else the flow to solve for.
+    fn trial(&self, sigma_trial: &Stress, k: f64) -> Trial {
         let e = self.elastic.matrix();
         let Some(vp) = self.viscoplastic else {
-            return (*sigma_trial, e);
+            return Trial::Settled(*sigma_trial, e);
         };
         let y2 = vp.yield_stress * vp.yield_stress;
         let vm = von_mises(sigma_trial);
         if vm * vm <= y2 {
-            return (*sigma_trial, e);
+            return Trial::Settled(*sigma_trial, e);
         }
         let (alpha, beta) = self.elastic.norm_weights();
         let c = 0.5 * k / vp.lambda;
@@ -179,36 +263,80 @@ impl Material {
         // dofs, 4 steps, 93,352 plastic updates): 5.31 Newton steps per update against
         // 7.22 from 0, the constitutive updates 16.5 -> 15.8 ms (fastest of 25 runs).
         let start = (vm / vp.yield_stress - 1.0) / da.max(db);
-        let mu = convex_decreasing_root(start, |mu| {
-            let a = 1.0 + mu * da;
-            let bq = 1.0 + mu * db;
-            let val = p * p / (a * a) + 3.0 * r2 / (bq * bq) - y2;
-            let der = -2.0 * p * p * da / (a * a * a) - 6.0 * r2 * db / (bq * bq * bq);
-            (val, der)
-        });
-        let a = 1.0 + mu * da;
-        let bq = 1.0 + mu * db;
-        // sigma_p = P_p (1 + mu/alpha), sigma_q = P_q (1 + 3 mu / beta).
-        let phi = (1.0 + mu / alpha) / a;
-        let psi = (1.0 + 3.0 * mu / beta) / bq;
-        let sigma = from_pdt(&Vector3::new(v[0] * phi, v[1] * psi, v[2] * psi));
-        // Tangent in (p, d, t): diag(phi, psi, psi) + (p phi', q psi') (grad mu)^T.
-        let dphi = -0.5 * c / (a * a);
-        let dpsi = -1.5 * c / (bq * bq);
-        let h_mu = -2.0 * p * p * da / (a * a * a) - 6.0 * r2 * db / (bq * bq * bq);
-        let grad_h = Vector3::new(
-            2.0 * v[0] / (a * a),
-            6.0 * v[1] / (bq * bq),
-            6.0 * v[2] / (bq * bq),
-        );
-        let grad_mu = -grad_h / h_mu;
-        let col = Vector3::new(v[0] * dphi, v[1] * dpsi, v[2] * dpsi);
-        let j_pdt =
-            Matrix3::from_diagonal(&Vector3::new(phi, psi, psi)) + col * grad_mu.transpose();
-        // Chain rule: tensor -> (p, d, t) -> tensor.
-        let to = Matrix3::new(0.5, 0.5, 0.0, 0.5, -0.5, 0.0, 0.0, 0.0, 1.0);
-        let from = Matrix3::new(1.0, 1.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, 1.0);
-        (sigma, from * j_pdt * to * e)
+        Trial::Flowing(Flow {
+            v,
+            p,
+            r2,
+            y2,
+            da,
+            db,
+            alpha,
+            beta,
+            c,
+            e,
+            start,
+        })
+    }
+
+    /// [`Material::update`] of several triangles (`trials[i]` of `materials[i]`, at most
+    /// [`LANES`]) into `out`, to the same bits: the Newton iterations of their return maps'
+    /// roots run interleaved. One root is a chain of dependent divisions (two per
+    /// iteration, 5.3 iterations on average in `rates`), which the processor cannot
+    /// overlap with the next triangle's work past the loop's exit; side by side, the
+    /// chains of several triangles overlap. Measured ([`Model::update_stresses`] at the
+    /// last state of `rates`, 34,304 triangles, fastest of 100, 2 threads): 1.06 ms one at
+    /// a time, 0.81 / 0.60 / 0.55 / 0.52 ms with 2 / 4 / 8 / 16 lanes.
+    ///
+    /// [`Model::update_stresses`]: crate::fe::Model::update_stresses
+    pub fn update_lanes(
+        materials: &[&Material],
+        trials: &[Stress],
+        k: f64,
+        mut out: impl FnMut(usize, Stress, Matrix3<f64>),
+    ) {
+        let n = trials.len();
+        assert!(n <= LANES && materials.len() == n, "at most LANES triangles");
+        let mut flows: [Option<Flow>; LANES] = Default::default();
+        let mut mu = [0.0; LANES];
+        let mut running = [false; LANES];
+        for i in 0..n {
+            match materials[i].trial(&trials[i], k) {
+                Trial::Settled(sigma, tangent) => out(i, sigma, tangent),
+                Trial::Flowing(flow) => {
+                    mu[i] = flow.start;
+                    running[i] = true;
+                    flows[i] = Some(flow);
+                }
+            }
+        }
+        // Each lane runs convex_decreasing_root's loop, pass by pass.
+        for _ in 0..ROOT_ITERATIONS {
+            let mut any = false;
+            for i in 0..LANES {
+                if !running[i] {
+                    continue;
+                }
+                let flow = flows[i].as_ref().expect("a running lane has its flow");
+                let (v, dv) = flow.h(mu[i]);
+                if v <= 0.0 || dv >= 0.0 {
+                    running[i] = false;
+                    continue;
+                }
+                let step = -v / dv;
+                mu[i] += step;
+                running[i] = step > 4.0 * f64::EPSILON * mu[i];
+                any |= running[i];
+            }
+            if !any {
+                break;
+            }
+        }
+        for (i, flow) in flows.iter().enumerate() {
+            if let Some(flow) = flow {
+                let (sigma, tangent) = flow.finish(mu[i]);
+                out(i, sigma, tangent);
+            }
+        }
     }
 
     /// Lipschitz-type scale `|E| / (2 lambda)` of G (1/time); zero for elastic bodies.

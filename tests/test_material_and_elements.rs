@@ -3,11 +3,14 @@
 //! Goal: shape gradients form a partition of unity's derivative (sum to zero) and
 //! reproduce linear fields; the backward-Euler update solves its equation to round-off
 //! for every k (including k E / lambda = 1e4); P_B is the E-orthogonal projection; the
-//! consistent tangent matches central finite differences.
+//! consistent tangent matches central finite differences; the return maps run side by
+//! side (`Material::update_lanes`) give the bits of one at a time.
 //! Data: E = 100, nu = 0.3, lambda = 100, sigma_Y = sqrt(10) unless stated.
 
 use contact_rates::fe::p1_gradients;
-use contact_rates::material::{Elasticity, Material, Stress, Viscoplasticity, von_mises};
+use contact_rates::material::{
+    Elasticity, LANES, Material, Stress, Viscoplasticity, von_mises,
+};
 use nalgebra::{Matrix3, Vector3};
 
 fn material(young: f64, lambda: f64) -> Material {
@@ -163,4 +166,41 @@ fn elastic_body_pays_nothing() {
     assert_eq!(sig, s);
     assert_eq!(d, m.elastic.matrix());
     assert_eq!(m.g(&s), Vector3::zeros());
+}
+
+#[test]
+fn update_lanes_gives_the_bits_of_update() {
+    // Three materials side by side (stiff, viscous, elastic), every group size up to LANES,
+    // trial stresses inside and far outside the elastic set.
+    let elastic = Material {
+        elastic: Elasticity {
+            young: 100.0,
+            poisson: 0.3,
+        },
+        viscoplastic: None,
+    };
+    let materials = [material(100.0, 100.0), material(3e5, 100.0), elastic];
+    let mut trials = Vec::new();
+    for (i, s) in stresses().iter().enumerate() {
+        for j in 0..7 {
+            trials.push(s * (0.3 + 0.7 * j as f64) + Vector3::new(0.1 * i as f64, 0.0, 0.2));
+        }
+    }
+    for k in [1e-3, 0.25, 1e4] {
+        for size in 1..=LANES {
+            for (g, group) in trials.chunks(size).enumerate() {
+                let ms: Vec<&Material> = (0..group.len())
+                    .map(|i| &materials[(g + i) % materials.len()])
+                    .collect();
+                let mut got = vec![None; group.len()];
+                Material::update_lanes(&ms, group, k, |i, s, d| {
+                    assert!(got[i].is_none(), "lane {i} written twice");
+                    got[i] = Some((s, d));
+                });
+                for (i, s) in group.iter().enumerate() {
+                    assert_eq!(got[i], Some(ms[i].update(s, k)), "k = {k}, lane {i} of {size}");
+                }
+            }
+        }
+    }
 }
