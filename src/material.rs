@@ -288,6 +288,7 @@ impl Material {
     /// a time, 0.81 / 0.60 / 0.55 / 0.52 ms with 2 / 4 / 8 / 16 lanes.
     ///
     /// [`Model::update_stresses`]: crate::fe::Model::update_stresses
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
     pub fn update_lanes(
         materials: &[&Material],
         trials: &[Stress],
@@ -324,7 +325,8 @@ impl Material {
                 }
                 let step = -v / dv;
                 mu[i] += step;
-                running[i] = step > 4.0 * f64::EPSILON * mu[i];
+                // The negation, as convex_decreasing_root's test: a NaN step goes on there.
+                running[i] = !(step <= 4.0 * f64::EPSILON * mu[i]);
                 any |= running[i];
             }
             if !any {
