@@ -774,7 +774,16 @@ impl Model {
             .collect();
         let update = |(b, (sigma, tangents))| {
             let first = b * UPDATE_BLOCK;
-            self.update_block(first, sigma, tangents, u, strain_prev, sigma_prev, k, source);
+            self.update_block(
+                first,
+                sigma,
+                tangents,
+                u,
+                strain_prev,
+                sigma_prev,
+                k,
+                source,
+            );
         };
         // On rayon's threads from PARALLEL_ELEMENTS triangles on (each triangle alone: the
         // same numbers on any number of threads); below, serial.
@@ -829,8 +838,9 @@ impl Model {
     }
 
     /// The material and the trial stress `sigma_prev + E (eps(u) - eps(u_prev)) + k s` of
-    /// element `i` (see [`Model::update_stresses`]).
-    fn trial_stress(
+    /// element `i` (see [`Model::update_stresses`]); its constitutive update alone is
+    /// [`Material::update`] of them.
+    pub fn trial_stress(
         &self,
         i: usize,
         u: &[f64],
@@ -847,21 +857,6 @@ impl Model {
             trial += k * source[i];
         }
         (m, trial)
-    }
-
-    /// The constitutive update of element `i` alone (see [`Model::update_stresses`]): its
-    /// stress and consistent tangent `d sigma / d eps` (tensor components).
-    pub fn update_element(
-        &self,
-        i: usize,
-        u: &[f64],
-        strain_prev: &[Strain],
-        sigma_prev: &[Stress],
-        k: f64,
-        source: Option<&[Stress]>,
-    ) -> (Stress, Matrix3<f64>) {
-        let (m, trial) = self.trial_stress(i, u, strain_prev, sigma_prev, k, source);
-        m.update(&trial, k)
     }
 
     /// Internal force `sum_T |T| B^T sigma_T` over global dofs. From

@@ -233,7 +233,9 @@ impl Material {
     pub fn update(&self, sigma_trial: &Stress, k: f64) -> (Stress, Matrix3<f64>) {
         match self.trial(sigma_trial, k) {
             Trial::Settled(sigma, tangent) => (sigma, tangent),
-            Trial::Flowing(flow) => flow.finish(convex_decreasing_root(flow.start, |mu| flow.h(mu))),
+            Trial::Flowing(flow) => {
+                flow.finish(convex_decreasing_root(flow.start, |mu| flow.h(mu)))
+            }
         }
     }
 
@@ -296,7 +298,10 @@ impl Material {
         mut out: impl FnMut(usize, Stress, Matrix3<f64>),
     ) {
         let n = trials.len();
-        assert!(n <= LANES && materials.len() == n, "at most LANES triangles");
+        assert!(
+            n <= LANES && materials.len() == n,
+            "at most LANES triangles"
+        );
         let mut flows: [Option<Flow>; LANES] = Default::default();
         let mut mu = [0.0; LANES];
         let mut running = [false; LANES];

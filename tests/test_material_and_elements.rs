@@ -8,9 +8,7 @@
 //! Data: E = 100, nu = 0.3, lambda = 100, sigma_Y = sqrt(10) unless stated.
 
 use contact_rates::fe::p1_gradients;
-use contact_rates::material::{
-    Elasticity, LANES, Material, Stress, Viscoplasticity, von_mises,
-};
+use contact_rates::material::{Elasticity, LANES, Material, Stress, Viscoplasticity, von_mises};
 use nalgebra::{Matrix3, Vector3};
 
 fn material(young: f64, lambda: f64) -> Material {
@@ -198,7 +196,11 @@ fn update_lanes_gives_the_bits_of_update() {
                     got[i] = Some((s, d));
                 });
                 for (i, s) in group.iter().enumerate() {
-                    assert_eq!(got[i], Some(ms[i].update(s, k)), "k = {k}, lane {i} of {size}");
+                    assert_eq!(
+                        got[i],
+                        Some(ms[i].update(s, k)),
+                        "k = {k}, lane {i} of {size}"
+                    );
                 }
             }
         }

@@ -268,7 +268,7 @@ impl Elimination {
             let mut r = DVector::from_iterator(dofs.len(), dofs.iter().map(|&d| -step.f_ext[d]));
             for &i in &patch {
                 let e = &model.elements[i];
-                let (s, d) = model.update_element(
+                let (m, trial) = model.trial_stress(
                     i,
                     u,
                     step.strain_prev,
@@ -276,6 +276,7 @@ impl Elimination {
                     step.k,
                     step.source,
                 );
+                let (s, d) = m.update(&trial, step.k);
                 let fe = e.internal_force(&s);
                 let ke = jacobian.as_ref().map(|_| e.stiffness(&d));
                 let ed = e.dofs();
