@@ -828,12 +828,16 @@ impl Model {
                 (materials[l], trials[l]) =
                     self.trial_stress(i, u, strain_prev, sigma_prev, k, source);
             }
+            let mut written = 0;
             Material::update_lanes(&materials[..lanes], &trials[..lanes], k, |l, s, d| {
                 sigma[start + l].write(s);
                 if let Some(t) = tangents.as_deref_mut() {
                     t[start + l].write(d);
                 }
+                written += 1;
             });
+            // The set_len of update_stresses needs every slot written.
+            assert_eq!(written, lanes, "update_lanes wrote every triangle once");
         }
     }
 

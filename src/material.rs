@@ -281,7 +281,9 @@ impl Material {
     }
 
     /// [`Material::update`] of several triangles (`trials[i]` of `materials[i]`, at most
-    /// [`LANES`]) into `out`, to the same bits: the Newton iterations of their return maps'
+    /// [`LANES`]), handed to `out(i, stress, tangent)` exactly once per triangle (the
+    /// in-place fill of [`Model::update_stresses`] relies on it), to the same bits (NaN
+    /// results aside, whose sign bit may differ): the Newton iterations of their return maps'
     /// roots run interleaved. One root is a chain of dependent divisions (two per
     /// iteration, 5.3 iterations on average in `rates`), which the processor cannot
     /// overlap with the next triangle's work past the loop's exit; side by side, the
