@@ -7,6 +7,10 @@ use contact_rates::solve::{self, Settings};
 
 fn main() -> contact_rates::error::Result<()> {
     contact_rates::init();
+    contact_rates::on_pool(body)
+}
+
+fn body() -> contact_rates::error::Result<()> {
     let args: Vec<String> = std::env::args().collect();
     let level: usize = args.get(1).map_or(3, |s| s.parse().unwrap());
     let repeats: usize = args.get(2).map_or(10, |s| s.parse().unwrap());

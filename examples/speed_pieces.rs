@@ -65,6 +65,10 @@ fn usage_line(who: &str, before: (i64, f64)) -> String {
 
 fn main() -> contact_rates::error::Result<()> {
     contact_rates::init();
+    contact_rates::on_pool(body)
+}
+
+fn body() -> contact_rates::error::Result<()> {
     assert!(pieces::enabled(), "set CONTACT_RATES_PIECES=1");
     let args: Vec<String> = std::env::args().collect();
     let level: usize = args.get(1).map_or(5, |s| s.parse().expect("level"));

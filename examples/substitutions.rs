@@ -11,6 +11,10 @@ use std::time::Instant;
 
 fn main() -> contact_rates::error::Result<()> {
     contact_rates::init();
+    contact_rates::on_pool(body)
+}
+
+fn body() -> contact_rates::error::Result<()> {
     let args: Vec<String> = std::env::args().collect();
     let level: usize = args.get(1).map_or(5, |s| s.parse().expect("level"));
     let method = match args.get(2).map(String::as_str) {

@@ -31,3 +31,17 @@ pub use error::{Error, Result};
 pub fn init() {
     faer::set_global_parallelism(faer::Par::Seq);
 }
+
+/// Run `f` (a program's whole work) on a thread of rayon's global pool, the calling thread
+/// waiting. Why: a solve enters the pool some hundred times (every constitutive update,
+/// residual and substitution), and from a thread outside the pool each entry hands the
+/// work over and sleeps until a worker wakes it; from inside, the parallel loops start at
+/// once. Measured (`speed_pieces 4 mortar rates 30`, 2 threads, fastest of 30, three
+/// runs each, alternating): newton's time loop 0.0943 / 0.0945 / 0.0954 s -> 0.0856 /
+/// 0.0868 / 0.0864 s; the floor 0.064 / 0.059 / 0.064 s -> 0.063 / 0.057 / 0.055 s. (Making
+/// the main thread itself one of the pool's threads, `use_current_thread`, gave the same
+/// loop but slowed the floor's numeric Cholesky 0.019 -> 0.023 s: its buffers then come
+/// from the main thread's heap, as with `MALLOC_ARENA_MAX=1`.)
+pub fn on_pool<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    rayon::scope(|_| f())
+}

@@ -289,7 +289,7 @@ fn solve_one(req: &SolveRequest) -> anyhow::Result<()> {
 }
 
 fn main() {
-    if let Err(e) = run() {
+    if let Err(e) = contact_rates::on_pool(run) {
         eprintln!("error: {e:#}");
         std::process::exit(1);
     }
