@@ -43,5 +43,11 @@ pub fn init() {
 /// loop but slowed the floor's numeric Cholesky 0.019 -> 0.023 s: its buffers then come
 /// from the main thread's heap, as with `MALLOC_ARENA_MAX=1`.)
 pub fn on_pool<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    // The pool's threads get the main thread's stack (8 MiB on Linux; Rust gives a spawned
+    // thread 2 MiB), since the work that ran on the main thread runs on one of them now.
+    // An error means the pool exists already (built by an earlier call): keep it.
+    let _ = rayon::ThreadPoolBuilder::new()
+        .stack_size(8 << 20)
+        .build_global();
     rayon::scope(|_| f())
 }
