@@ -41,10 +41,11 @@ pub fn init() {
 /// 0.0868 / 0.0864 s; the floor 0.064 / 0.059 / 0.064 s -> 0.063 / 0.057 / 0.055 s. (Making
 /// the main thread itself one of the pool's threads, `use_current_thread`, gave the same
 /// loop but slowed the floor's numeric Cholesky 0.019 -> 0.023 s: its buffers then come
-/// from the main thread's heap, as with `MALLOC_ARENA_MAX=1`.)
+/// from the main thread's heap, as with `MALLOC_ARENA_MAX=1`.) The pool's threads get the
+/// main thread's stack, 8 MiB: loading a manufactured scene differentiates its expressions
+/// recursively (exmex), 1.5-1.6 MiB in a release build, past the 2 MiB Rust gives a
+/// spawned thread in a debug one (tests/test_cli_thread_stack.rs).
 pub fn on_pool<R: Send>(f: impl FnOnce() -> R + Send) -> R {
-    // The pool's threads get the main thread's stack (8 MiB on Linux; Rust gives a spawned
-    // thread 2 MiB), since the work that ran on the main thread runs on one of them now.
     // An error means the pool exists already (built by an earlier call): keep it.
     let _ = rayon::ThreadPoolBuilder::new()
         .stack_size(8 << 20)
