@@ -107,7 +107,7 @@ impl Flow {
 
     /// The stress and the consistent tangent at the multiplier `mu`.
     fn finish(&self, mu: f64) -> (Stress, Matrix3<f64>) {
-        let (v, p, r2, da, db, c) = (self.v, self.p, self.r2, self.da, self.db, self.c);
+        let (v, da, db, c) = (self.v, self.da, self.db, self.c);
         let a = 1.0 + mu * da;
         let bq = 1.0 + mu * db;
         // sigma_p = P_p (1 + mu/alpha), sigma_q = P_q (1 + 3 mu / beta).
@@ -117,7 +117,7 @@ impl Flow {
         // Tangent in (p, d, t): diag(phi, psi, psi) + (p phi', q psi') (grad mu)^T.
         let dphi = -0.5 * c / (a * a);
         let dpsi = -1.5 * c / (bq * bq);
-        let h_mu = -2.0 * p * p * da / (a * a * a) - 6.0 * r2 * db / (bq * bq * bq);
+        let (_, h_mu) = self.h(mu);
         let grad_h = Vector3::new(
             2.0 * v[0] / (a * a),
             6.0 * v[1] / (bq * bq),
