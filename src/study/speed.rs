@@ -68,6 +68,8 @@ pub struct SpeedResult {
     pub reference_dofs: usize,
     /// Total wall time (s).
     pub wall_s: f64,
+    /// The machine the times were measured on ([`machine`]): the ratios depend on it.
+    pub machine: String,
     /// Threads of rayon's pool (RAYON_NUM_THREADS, or the machine's cores), used alike by
     /// the solver and the floor.
     pub threads: usize,
@@ -233,6 +235,36 @@ pub fn run() -> Result<SpeedResult> {
         rows,
         reference_dofs: rcase.problem.model.n_free,
         wall_s: t0.elapsed().as_secs_f64(),
+        machine: machine(),
         threads,
     })
+}
+
+/// The processor's model name, its logical cores and its last-level cache, as Linux
+/// reports them (`/proc/cpuinfo`, `/sys/devices/system/cpu/cpu0/cache`); "unknown" for
+/// what it does not. Why the report names it: newton's preconditioner applications read
+/// the whole factor from memory each time, about 24 of them per run against the floor's 4
+/// solves, so the ratio moves with the machine's memory bandwidth. Measured at 137,472
+/// dofs (`speed_pieces 5 mortar rates`): 1.64 on one 2-core machine, 2.2 on another with
+/// the same floor time (0.39 s), where one application costs 7.4 ms with the factor
+/// cached and 11.7 ms after 400 MB of other reads (`substitutions 5`).
+pub fn machine() -> String {
+    let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+    let model = cpuinfo
+        .lines()
+        .find_map(|l| l.strip_prefix("model name")?.split_once(':').map(|(_, m)| m.trim()))
+        .unwrap_or("unknown processor")
+        .to_string();
+    let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
+    // The highest cache level of cpu0 (index3 on most x86 machines).
+    let cache = (0..8)
+        .rev()
+        .find_map(|i| {
+            let dir = format!("/sys/devices/system/cpu/cpu0/cache/index{i}");
+            let level = std::fs::read_to_string(format!("{dir}/level")).ok()?;
+            let size = std::fs::read_to_string(format!("{dir}/size")).ok()?;
+            Some(format!("L{} cache {}", level.trim(), size.trim()))
+        })
+        .unwrap_or_else(|| "cache size unknown".to_string());
+    format!("{model}, {cores} logical cores, {cache}")
 }
