@@ -240,8 +240,8 @@ pub fn run() -> Result<SpeedResult> {
     })
 }
 
-/// The processor's model name, its logical cores and its last-level cache, as Linux
-/// reports them (`/proc/cpuinfo`, `/sys/devices/system/cpu/cpu0/cache`); "unknown" for
+/// The processor's model name, the cores available to the process and the last-level
+/// cache (sysfs's size string, K = KiB), as Linux reports them (`/proc/cpuinfo`, `/sys/devices/system/cpu/cpu0/cache`); "unknown" for
 /// what it does not. Why the report names it: newton's preconditioner applications read
 /// the whole factor from memory each time, about 24 of them per run against the floor's 4
 /// solves, so the ratio moves with the machine's memory bandwidth. Measured at 137,472
@@ -253,9 +253,12 @@ pub fn machine() -> String {
     let model = cpuinfo
         .lines()
         .find_map(|l| l.strip_prefix("model name")?.split_once(':').map(|(_, m)| m.trim()))
+        .filter(|m| !m.is_empty())
         .unwrap_or("unknown processor")
         .to_string();
-    let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
+    // The cores this process may use (its affinity and cgroup limits applied).
+    let cores = std::thread::available_parallelism()
+        .map_or_else(|_| "an unknown number of".to_string(), |n| n.get().to_string());
     // The highest cache level of cpu0 (index3 on most x86 machines).
     let cache = (0..8)
         .rev()
@@ -266,5 +269,5 @@ pub fn machine() -> String {
             Some(format!("L{} cache {}", level.trim(), size.trim()))
         })
         .unwrap_or_else(|| "cache size unknown".to_string());
-    format!("{model}, {cores} logical cores, {cache}")
+    format!("{model}, {cores} cores available, {cache}")
 }
