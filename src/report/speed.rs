@@ -298,8 +298,7 @@ fn readme(res: &SpeedResult) -> String {
     let _ = writeln!(
         s,
         "\nMachine: {}. The ratios depend on it: newton's runs are about 24 preconditioner applications (each reads the whole factor from memory) against the floor's 4 solves, so a machine with less memory bandwidth per core reads higher ratios for the same code (`study::speed::machine` gives a measured example).\n\nThreads: {} (rayon's pool; `RAYON_NUM_THREADS` sets it), the same for the solver and the floor. The stiffness is block diagonal, one block per body (they meet only through the contact rows): both sides factorize the blocks apart and side by side, in the same ordering (`solve::ordering`: METIS's nested dissection of the nodes for a block of 500,000 equations or more, faer's AMD below), the floor of each whole block, newton of the block's interior with its contact-interface unknowns last; newton's substitutions run as tasks on the threads, one per subtree of the blocks' elimination trees (`solve::substitution`: split until no subtree holds more than a fifth of the work, so that the larger body does not set the time), the floor's (4 per run) as faer's solve of each block, side by side. Newton factorizes in single precision (faer's LDL^T in f32 of the stiffness scaled to unit diagonal; the substitutions' arithmetic in f64) and reaches the tolerance 1e-10 through its Newton and GMRES iterations; the floor is the double-precision Cholesky and its two triangular solves per step, a double-precision answer with no iteration. The fill is the number of entries of the factor L on and below its diagonal (both bodies; newton's includes its interface rows).\n",
-        res.machine,
-        res.threads
+        res.machine, res.threads
     );
     let one: Vec<&SpeedRun> = res.rows.iter().filter(|r| r.one_thread.is_some()).collect();
     if !one.is_empty() {

@@ -241,8 +241,8 @@ pub fn run() -> Result<SpeedResult> {
 }
 
 /// The processor's model name, the cores available to the process and the last-level
-/// cache (sysfs's size string, K = KiB), as Linux reports them (`/proc/cpuinfo`, `/sys/devices/system/cpu/cpu0/cache`); "unknown" for
-/// what it does not. Why the report names it: newton's preconditioner applications read
+/// cache (sysfs's size string, K = KiB), as Linux reports them (`/proc/cpuinfo`,
+/// `/sys/devices/system/cpu/cpu0/cache`); "unknown" for what it does not. Why the report names it: newton's preconditioner applications read
 /// the whole factor from memory each time, about 24 of them per run against the floor's 4
 /// solves, so the ratio moves with the machine's memory bandwidth. Measured at 137,472
 /// dofs (`speed_pieces 5 mortar rates`): 1.64 on one 2-core machine, 2.2 on another with
@@ -252,13 +252,19 @@ pub fn machine() -> String {
     let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
     let model = cpuinfo
         .lines()
-        .find_map(|l| l.strip_prefix("model name")?.split_once(':').map(|(_, m)| m.trim()))
+        .find_map(|l| {
+            l.strip_prefix("model name")?
+                .split_once(':')
+                .map(|(_, m)| m.trim())
+        })
         .filter(|m| !m.is_empty())
         .unwrap_or("unknown processor")
         .to_string();
     // The cores this process may use (its affinity and cgroup limits applied).
-    let cores = std::thread::available_parallelism()
-        .map_or_else(|_| "an unknown number of".to_string(), |n| n.get().to_string());
+    let cores = std::thread::available_parallelism().map_or_else(
+        |_| "an unknown number of".to_string(),
+        |n| n.get().to_string(),
+    );
     // The highest cache level of cpu0 (index3 on most x86 machines).
     let cache = (0..8)
         .rev()
