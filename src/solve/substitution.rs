@@ -88,35 +88,77 @@ impl Row for u32 {
     }
 }
 
-/// x <- L^{-1} x over `supernodes` (increasing). Plain loops over the columns, the
-/// off-diagonal rows gathered and scattered once per supernode: a solve reads the factor
-/// once and is bound by memory.
+/// Columns whose off-diagonal parts one pass of [`forward`] adds into the rows below a
+/// supernode: each row's partial sum is loaded and stored once per four columns instead of
+/// once per column. Each row's terms are still added in column order: the same bits.
+/// Measured with `examples/substitutions.rs` (one preconditioner solve, fastest of 50,
+/// three runs alternating with the column-by-column loop, same bits): forward substitution
+/// at 34,432 dofs 1.03-1.07 -> 0.93-0.95 ms on one thread, at 137,472 dofs 3.27-3.75 ->
+/// 3.14-3.37 ms on two. Eight columns per pass were no faster (1.01-1.10 ms), and the
+/// same grouping of the back substitution's dot products (four chains of additions side
+/// by side, by hand in AVX-512 or left to LLVM) was slower (1.18-1.39 against 1.02-1.05
+/// ms): it computes the off-diagonal dots before the diagonal block's, a second pass over
+/// each supernode.
+const COLUMNS: usize = 4;
+
+/// x <- L^{-1} x over `supernodes` (increasing). Per supernode: the triangular solve on
+/// its diagonal block, column by column; then the off-diagonal rows' sums
+/// `sum_j L_kj x_j` over the columns with x_j != 0, [`COLUMNS`] columns per pass,
+/// gathered once and scattered once. A solve reads the factor once.
 pub fn forward<'a, T: Value, I: Row>(
     supernodes: impl Iterator<Item = Supernode<'a, T, I>>,
     x: &mut [f64],
 ) {
     let mut below = Vec::new();
+    let mut nonzero = Vec::new();
     for (start, width, pattern, values) in supernodes {
-        let rows = width + pattern.len();
-        below.clear();
-        below.resize(pattern.len(), 0.0);
+        let p = pattern.len();
+        let rows = width + p;
+        nonzero.clear();
         for j in 0..width {
             let xj = x[start + j];
             if xj == 0.0 {
                 continue;
             }
-            let column = &values[j * rows..(j + 1) * rows];
+            nonzero.push(j);
+            let column = &values[j * rows..j * rows + width];
             for (xi, l) in x[start + j + 1..start + width]
                 .iter_mut()
                 .zip(&column[j + 1..width])
             {
                 *xi -= l.get() * xj;
             }
-            for (bk, l) in below.iter_mut().zip(&column[width..]) {
+        }
+        below.clear();
+        below.resize(p, 0.0);
+        let below = &mut below[..p];
+        let off = |j: usize| &values[j * rows + width..(j + 1) * rows];
+        let mut groups = nonzero.chunks_exact(COLUMNS);
+        for group in &mut groups {
+            let [c0, c1, c2, c3] = [off(group[0]), off(group[1]), off(group[2]), off(group[3])];
+            let [x0, x1, x2, x3] = [
+                x[start + group[0]],
+                x[start + group[1]],
+                x[start + group[2]],
+                x[start + group[3]],
+            ];
+            let (c0, c1, c2, c3) = (&c0[..p], &c1[..p], &c2[..p], &c3[..p]);
+            for k in 0..p {
+                let mut t = below[k];
+                t += c0[k].get() * x0;
+                t += c1[k].get() * x1;
+                t += c2[k].get() * x2;
+                t += c3[k].get() * x3;
+                below[k] = t;
+            }
+        }
+        for &j in groups.remainder() {
+            let xj = x[start + j];
+            for (bk, l) in below.iter_mut().zip(off(j)) {
                 *bk += l.get() * xj;
             }
         }
-        for (&i, bk) in pattern.iter().zip(&below) {
+        for (&i, bk) in pattern.iter().zip(&*below) {
             x[i.at()] -= bk;
         }
     }
