@@ -242,12 +242,13 @@ pub fn run() -> Result<SpeedResult> {
 
 /// The processor's model name, the cores available to the process and the last-level
 /// cache (sysfs's size string, K = KiB), as Linux reports them (`/proc/cpuinfo`,
-/// `/sys/devices/system/cpu/cpu0/cache`); "unknown" for what it does not. Why the report names it: newton's preconditioner applications read
-/// the whole factor from memory each time, about 24 of them per run against the floor's 4
-/// solves, so the ratio moves with the machine's memory bandwidth. Measured at 137,472
-/// dofs (`speed_pieces 5 mortar rates`): 1.64 on one 2-core machine, 2.2 on another with
-/// the same floor time (0.39 s), where one application costs 7.4 ms with the factor
-/// cached and 11.7 ms after 400 MB of other reads (`substitutions 5`).
+/// `/sys/devices/system/cpu/cpu0/cache`); "unknown" for what it does not. Why the report
+/// names it: newton's preconditioner applications read the whole factor from memory each
+/// time, about 24 of them per run against the floor's 4 solves, so the ratio moves with
+/// the machine's memory bandwidth. Measured at 137,472 dofs (`speed_pieces 5 mortar
+/// rates`): 1.64 on one 2-core machine, 2.2 on another with the same floor time (0.39 s),
+/// where one application costs 7.4 ms with the factor cached and 11.7 ms after 400 MB of
+/// other reads (`substitutions 5`).
 pub fn machine() -> String {
     let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
     let model = cpuinfo
