@@ -30,6 +30,23 @@ impl Method {
             Method::Nts => "nts",
         }
     }
+    /// Theorem 3.1's rate in h of the error in the theorem norm (||u - u_hk||_H1 +
+    /// ||sigma - sigma_hk||_L2): 3/4 for K_h^pi, 1/2 for K_h^I.
+    pub fn theorem_rate(self) -> f64 {
+        match self {
+            Method::Mortar => 0.75,
+            Method::Nts => 0.5,
+        }
+    }
+    /// Lemma 3.1's exponents of the consistency error in the slave's and the master's mesh
+    /// sizes (h1, h2), the meshes refined independently: K_h^pi h1^(3/4) + h2, K_h^I
+    /// h1^(1/2) (from (h1^(1/2) ||e||)^(1/2) with ||e|| bounded) + h2^(3/4).
+    pub fn lemma_exponents(self) -> [f64; 2] {
+        match self {
+            Method::Mortar => [0.75, 1.0],
+            Method::Nts => [0.5, 0.75],
+        }
+    }
     /// Parse "mortar" or "nts".
     pub fn parse(s: &str) -> Option<Self> {
         match s {

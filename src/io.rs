@@ -67,6 +67,12 @@ pub fn finite_or_empty<S: serde::Serializer>(
     }
 }
 
+/// Read back what [`finite_or_empty`] wrote: an empty field is NaN.
+pub fn empty_as_nan<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
+    let v: Option<f64> = serde::Deserialize::deserialize(d)?;
+    Ok(v.unwrap_or(f64::NAN))
+}
+
 /// `{:.3}` of a finite number, "n/a" otherwise.
 pub fn fmt3(v: f64) -> String {
     if v.is_finite() {

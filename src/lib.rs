@@ -3,9 +3,11 @@
 //! of two elastic-viscoplastic bodies on non-matching meshes.
 //!
 //! The modules follow the pipeline: [`mesh`] -> [`scene`] -> [`material`] -> [`fe`] ->
-//! [`contact`] -> [`solve`] -> [`case`] / [`metrics`] / [`io`] -> [`study`] -> [`report`],
-//! with [`expr`], [`quadrature`] and [`analytical`] (exact solutions) beside the scene;
-//! the binary is a thin CLI over them. Scenes are data ([`scene`]).
+//! [`contact`] -> [`solve`] -> [`case`] / [`metrics`] / [`io`] -> [`verify`] (the shared
+//! verification toolkit) -> [`report`] (folders and plots) -> [`studies`] (one folder per
+//! study kind and the table of kinds) -> [`results`] (the Results read back from the
+//! reports), with [`expr`], [`quadrature`] and [`analytical`] (exact solutions) beside the
+//! scene; the binary is a thin CLI over them. Scenes are data ([`scene`]).
 
 pub mod analytical;
 pub mod case;
@@ -20,9 +22,11 @@ pub mod metrics;
 pub mod progress;
 pub mod quadrature;
 pub mod report;
+pub mod results;
 pub mod scene;
 pub mod solve;
-pub mod study;
+pub mod studies;
+pub mod verify;
 
 pub use error::{Error, Result};
 

@@ -8,8 +8,8 @@ use contact_rates::progress::Progress;
 use contact_rates::report::{self, Output, Staging};
 use contact_rates::scene::Scene;
 use contact_rates::solve::{self, Settings, SolverKind};
-use contact_rates::study::Kind;
-use contact_rates::study::jobs::Mode;
+use contact_rates::studies::Study;
+use contact_rates::verify::jobs::Mode;
 use std::path::PathBuf;
 
 #[derive(Parser)]
@@ -122,7 +122,10 @@ fn run() -> anyhow::Result<()> {
             merge,
         } => study(&name, out, shard.as_deref(), merge),
         Command::Results => {
-            print!("{}", report::results::section(&report::reports_dir())?);
+            print!(
+                "{}",
+                contact_rates::results::section(&report::reports_dir())?
+            );
             Ok(())
         }
         Command::Scene {
@@ -182,12 +185,12 @@ fn run() -> anyhow::Result<()> {
 /// error when a threshold is missed.
 fn study(name: &str, out: Option<PathBuf>, shard: Option<&str>, merge: bool) -> anyhow::Result<()> {
     if name == "list" {
-        for (n, d) in Kind::list() {
+        for (n, d) in Study::list() {
             println!("{n:12} {d}");
         }
         return Ok(());
     }
-    let kind = Kind::resolve(name)?;
+    let kind = Study::resolve(name)?;
     let mode = match (shard, merge) {
         (Some(sh), _) => Mode::shard(sh)?,
         (None, true) => Mode::Merge,
@@ -206,8 +209,8 @@ fn study(name: &str, out: Option<PathBuf>, shard: Option<&str>, merge: bool) -> 
     for w in outcome.warnings() {
         eprintln!("warning: {w}");
     }
-    report::write(&outcome, &dir)?;
-    print!("{}", report::console(&outcome, &dir));
+    outcome.write(&dir)?;
+    print!("{}", outcome.console(&dir));
     let failures = outcome.failures();
     if !failures.is_empty() {
         anyhow::bail!("rate below threshold: {}", failures.join("; "));
@@ -252,7 +255,7 @@ fn solve_one(req: &SolveRequest) -> anyhow::Result<()> {
     for w in &case.warnings {
         eprintln!("warning: {w}");
     }
-    let mut series = report::run::Series::new(staging.path(), &case.problem, req.every);
+    let mut series = report::solve_output::Series::new(staging.path(), &case.problem, req.every);
     let progress = Progress::new(steps as u64, "solve");
     let memory = PeakMemory::start();
     let solved = series.write_during(|on_step| {
@@ -284,7 +287,10 @@ fn solve_one(req: &SolveRequest) -> anyhow::Result<()> {
     let wall_s = t0.elapsed().as_secs_f64();
     let written = series.finish(&run, wall_s)?;
     staging.commit()?;
-    print!("{}", report::run::console(&run, wall_s, &written, &req.out));
+    print!(
+        "{}",
+        report::solve_output::console(&run, wall_s, &written, &req.out)
+    );
     Ok(())
 }
 

@@ -4,8 +4,8 @@
 //! `contact-rates results` prints it; the test compares it with README.md.
 
 use crate::error::{Error, Result};
-use crate::study::quantity::Quantity;
-use crate::study::rates::{self, Verdict};
+use crate::verify::quantity::Quantity;
+use crate::verify::rates::{self, Verdict};
 use serde::Deserialize;
 use std::fmt::Write as _;
 use std::path::Path;

@@ -10,10 +10,10 @@ mod common;
 
 use contact_rates::contact::Method;
 use contact_rates::material::Stress;
-use contact_rates::study::contact_error::{
+use contact_rates::verify::contact_error::{
     TruthPressure, band, contact_step, edges, penetration_l2,
 };
-use contact_rates::study::exact_error::ExactComparison;
+use contact_rates::verify::exact_error::ExactComparison;
 
 #[test]
 fn weighted_norm_resultant_and_variation_of_a_linear_pressure() {

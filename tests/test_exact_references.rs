@@ -15,13 +15,14 @@ use contact_rates::analytical::stacked::StackedBlocks;
 use contact_rates::contact::Method;
 use contact_rates::scene::Scene;
 use contact_rates::solve::SolverKind;
-use contact_rates::study::exact_error::ExactComparison;
-use contact_rates::study::quantity::Quantity;
-use contact_rates::study::{self, convergence, solve_case, theorem_distance};
+use contact_rates::studies::convergence;
+use contact_rates::verify::exact_error::ExactComparison;
+use contact_rates::verify::quantity::Quantity;
+use contact_rates::verify::{solve_case, study_file, theorem_distance};
 
 fn quick_study(dir: &std::path::Path, edit: impl Fn(String) -> String) -> String {
     let text =
-        std::fs::read_to_string(study::file::builtin_dir().join("rates-exact-quick.toml")).unwrap();
+        std::fs::read_to_string(study_file::builtin_dir().join("rates-exact-quick.toml")).unwrap();
     let f = dir.join("study.toml");
     std::fs::write(&f, edit(text)).unwrap();
     f.display().to_string()
@@ -30,7 +31,7 @@ fn quick_study(dir: &std::path::Path, edit: impl Fn(String) -> String) -> String
 #[test]
 fn quick_exact_study_meets_the_thresholds_and_its_quadrature_is_converged() {
     contact_rates::init();
-    let res = study::run("rates-exact-quick").unwrap();
+    let res = convergence::run("rates-exact-quick").unwrap();
     assert!(res.reference.is_none(), "no reference solve");
     for r in res.rates.iter().filter(|r| r.quantity == Quantity::Theorem) {
         common::assert_rate_passes(r, &[0, 1, 2]);
@@ -41,7 +42,7 @@ fn quick_exact_study_meets_the_thresholds_and_its_quadrature_is_converged() {
     let doubled = quick_study(dir.path(), |t| {
         t.replace("exact = true", "exact = true\nquadrature = 8")
     });
-    let res8 = study::run(&doubled).unwrap();
+    let res8 = convergence::run(&doubled).unwrap();
     assert_eq!(res.errors.len(), res8.errors.len());
     for (a, b) in res.errors.iter().zip(&res8.errors) {
         assert_eq!(
@@ -76,7 +77,7 @@ fn a_quantity_the_exact_solution_does_not_cover_is_refused_when_the_study_is_rea
     let f = quick_study(dir.path(), |t| {
         t.replace("scene = \"contact-mms\"", "scene = \"patch\"")
     });
-    let e = study::run(&f).unwrap_err().to_string();
+    let e = convergence::run(&f).unwrap_err().to_string();
     assert!(
         e.contains("study.toml")
             && e.contains("quantity 'theorem'")
@@ -88,7 +89,7 @@ fn a_quantity_the_exact_solution_does_not_cover_is_refused_when_the_study_is_rea
     let f = quick_study(dir.path(), |t| {
         t.replace("scene = \"contact-mms\"", "scene = \"rates\"")
     });
-    let e = study::run(&f).unwrap_err().to_string();
+    let e = convergence::run(&f).unwrap_err().to_string();
     assert!(
         e.contains("reference.exact") && e.contains("no exact solution"),
         "{e}"

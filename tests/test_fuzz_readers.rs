@@ -8,7 +8,7 @@
 
 use contact_rates::mesh::msh::parse_msh;
 use contact_rates::scene::Scene;
-use contact_rates::study::file::StudyFile;
+use contact_rates::verify::study_file::StudyFile;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestRunner};
 use std::path::{Path, PathBuf};

@@ -10,8 +10,8 @@ mod common;
 use contact_rates::contact::Method;
 use contact_rates::material::Stress;
 use contact_rates::solve::{self, Settings, State};
-use contact_rates::study::error::{Comparison, norms};
-use contact_rates::study::intersect::{Tri, barycentric, clip};
+use contact_rates::verify::intersect::{Tri, barycentric, clip};
+use contact_rates::verify::norms::{Comparison, norms};
 
 fn area(m: &contact_rates::fe::Model) -> f64 {
     m.elements.iter().map(|e| e.area).sum()

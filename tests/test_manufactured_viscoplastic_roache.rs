@@ -27,7 +27,8 @@ use contact_rates::fe::FIXED;
 use contact_rates::material::{Material, Stress};
 use contact_rates::quadrature;
 use contact_rates::scene::Scene;
-use contact_rates::study::{self, quantity::Quantity, rates::Verdict};
+use contact_rates::studies::convergence as study;
+use contact_rates::verify::{quantity::Quantity, rates::Verdict};
 
 /// Stress, strain (tensor components) and source of body `b` at (x, y, t).
 fn fields(ex: &Exact, b: usize, m: &Material, x: f64, y: f64, t: f64) -> (Stress, Stress, Stress) {

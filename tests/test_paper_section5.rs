@@ -5,7 +5,7 @@
 //! in Test 3 the non-matching solution approaches the matching one under refinement.
 //! Geometry and data: as reconstructed in scenes/paper-1.toml, patch.toml, paper-3.toml.
 
-use contact_rates::study::paper;
+use contact_rates::studies::paper;
 
 #[test]
 fn paper_tests_regenerate_figures_and_numbers() {
@@ -34,7 +34,7 @@ fn paper_tests_regenerate_figures_and_numbers() {
     // The corner nodes of Test 3's piecewise line carry one row per piece.
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("paper");
-    contact_rates::report::paper::write_paper(&res, &dir).unwrap();
+    contact_rates::studies::paper::report::write_paper(&res, &dir).unwrap();
     for f in [
         "test1_mesh",
         "test1_von_mises",

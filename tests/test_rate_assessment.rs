@@ -8,9 +8,9 @@
 //! levels, a stalled quantity gets no slope, a drifting one is named, equal h is an error.
 //! Data: errors e = C h^p on h = 0.4 / 2^l with the deviations named per case.
 
-use contact_rates::study::rates::{LevelError, Verdict, assess, celik};
+use contact_rates::verify::rates::{LevelError, Verdict, assess, celik};
 
-fn assess_ok(levels: &[LevelError], truth: f64) -> contact_rates::study::rates::Assessment {
+fn assess_ok(levels: &[LevelError], truth: f64) -> contact_rates::verify::rates::Assessment {
     assess(levels, truth).expect("distinct h")
 }
 

@@ -5,8 +5,8 @@
 //! "fitted" lies within max(0.15, 2 stderr) of the mean of its last two successive rates.
 //! Data: README.md and reports/*/rates.csv, errors.csv as committed.
 
-use contact_rates::report::results::{RateLine, STUDIES, section};
-use contact_rates::study::rates::Verdict;
+use contact_rates::results::{RateLine, STUDIES, section};
+use contact_rates::verify::rates::Verdict;
 use std::path::Path;
 
 fn root() -> &'static Path {

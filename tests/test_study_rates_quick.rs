@@ -7,7 +7,13 @@
 mod common;
 
 use contact_rates::contact::Method;
-use contact_rates::study::{self, file::StudyFile, jobs::Mode, quantity::Quantity, rates};
+use contact_rates::studies::{Study, convergence as study};
+use contact_rates::verify::{
+    jobs::Mode,
+    quantity::Quantity,
+    rates,
+    study_file::{self, StudyFile},
+};
 
 #[test]
 fn quick_rates_study_meets_the_theorem_thresholds() {
@@ -101,7 +107,7 @@ fn least_squares_rate_recovers_a_known_power_law() {
 #[test]
 fn study_file_errors_name_the_file_and_key() {
     let dir = tempfile::tempdir().unwrap();
-    let base = std::fs::read_to_string(study::file::builtin_dir().join("rates.toml")).unwrap();
+    let base = std::fs::read_to_string(study_file::builtin_dir().join("rates.toml")).unwrap();
     let cases = [
         (
             base.replace("steps = 4", "steps = 4\nspeed = 2"),
@@ -165,7 +171,7 @@ fn shard_argument_is_checked() {
 
 #[test]
 fn study_list_names_every_kind() {
-    let names: Vec<String> = study::Kind::list().into_iter().map(|(n, _)| n).collect();
+    let names: Vec<String> = Study::list().into_iter().map(|(n, _)| n).collect();
     for kind in [
         "paper",
         "patch",
@@ -179,9 +185,13 @@ fn study_list_names_every_kind() {
             "{kind} missing from {names:?}"
         );
     }
-    assert_eq!(study::Kind::resolve("speed").unwrap(), study::Kind::Speed);
-    assert!(matches!(
-        study::Kind::resolve("rates").unwrap(),
-        study::Kind::Convergence(_)
-    ));
+    let speed = Study::resolve("speed").unwrap();
+    assert_eq!((speed.kind.name, speed.file), ("speed", None));
+    let rates = Study::resolve("rates").unwrap();
+    assert_eq!(rates.kind.name, "convergence");
+    assert!(rates.file.unwrap().ends_with("studies/rates.toml"));
+    assert_eq!(
+        Study::resolve("two-size-quick").unwrap().kind.name,
+        "two-size"
+    );
 }

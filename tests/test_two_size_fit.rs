@@ -7,7 +7,7 @@
 //! stated standard errors with 2 % multiplicative noise (a fixed pseudo-random sequence).
 //! Data: levels 0-4, h1 = 0.3 / 2^l1, h2 = 0.3 / 1.4142 / 2^l2.
 
-use contact_rates::study::rates::fit_power_sum;
+use contact_rates::verify::rates::fit_power_sum;
 
 fn grid(noise: impl Fn(usize) -> f64) -> Vec<(f64, f64, f64)> {
     let mut out = Vec::new();

@@ -13,8 +13,8 @@
 //! Geometry and data: the `contact-mms` scene, 1 time step, newton.
 
 use contact_rates::contact::Method;
-use contact_rates::study::quantity::Quantity;
-use contact_rates::study::two_size;
+use contact_rates::studies::two_size;
+use contact_rates::verify::quantity::Quantity;
 
 #[test]
 fn quick_two_size_study_meets_the_lemma_and_reproduces_the_diagonal() {
@@ -31,7 +31,7 @@ fn quick_two_size_study_meets_the_lemma_and_reproduces_the_diagonal() {
             x.se[0] <= 0.5 && x.rms_log_residual <= 0.25,
             "a1 identified"
         );
-        let need = two_size::lemma_exponents(f.method)[0] - 0.05;
+        let need = f.method.lemma_exponents()[0] - 0.05;
         assert!(x.a[0] >= need, "{}: a1 {} < {need}", f.method, x.a[0]);
     }
     // The diagonal against the committed diagonal study.

@@ -1,7 +1,7 @@
 //! The quantities that tell the two cones apart: what happens on Gamma_C. For one state of
 //! a study solution against the truth (a reference solve's profile, or the exact solution)
 //! at the same time:
-//! - the pressure (beside its L2(Gamma_C) error, in [`super::error`]) in the h^(1/2)-weighted L2 norm (the discrete stand-in for
+//! - the pressure (beside its L2(Gamma_C) error, in [`super::norms`]) in the h^(1/2)-weighted L2 norm (the discrete stand-in for
 //!   H^(-1/2), where mortar theory bounds the multiplier), its resultant, and its total
 //!   variation (oscillation);
 //! - the contact edges: the transition points between contact and separation;
@@ -12,7 +12,7 @@
 //! with 8 Gauss points per piece: exact for the piecewise-linear truth of a reference, and
 //! far below the errors measured for a smooth exact pressure.
 
-use super::error::{eval_pl, on_piece, pressure_profile, project};
+use super::norms::{eval_pl, on_piece, pressure_profile, project};
 use crate::analytical::Exact;
 use crate::contact::{Interface, Piece};
 use crate::quadrature::gauss_legendre;

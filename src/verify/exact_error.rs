@@ -6,7 +6,7 @@
 //! `abs` changing branch) is split along it and the rule applied on each piece, as the
 //! loads are ([`crate::quadrature::triangle_rule`]): one implementation for both.
 
-use super::error::{SquaredNorms, pressure_profile};
+use super::norms::{SquaredNorms, pressure_profile};
 use crate::analytical::Exact;
 use crate::expr::kink_functions;
 use crate::fe::Model;

@@ -2,7 +2,7 @@
 //! against the reference's (max over the time steps).
 
 use super::contact_error::ContactStep;
-use super::error::SquaredNorms;
+use super::norms::SquaredNorms;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 

@@ -41,7 +41,7 @@ pub fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
 
 /// Print a fitted rate and assert that it was fitted over exactly `levels` and passed its
 /// threshold.
-pub fn assert_rate_passes(r: &contact_rates::study::RateRow, levels: &[usize]) {
+pub fn assert_rate_passes(r: &contact_rates::studies::convergence::RateRow, levels: &[usize]) {
     println!(
         "{}: rate {:.3} +- {:.3} over {:?}",
         r.method,

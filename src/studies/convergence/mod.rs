@@ -12,15 +12,42 @@
 //! 5. the rate in time on a fixed mesh;
 //! 6. the provenance.
 
-use super::contact_error::{self, ContactStep, TruthPressure, contact_step, reference_profile};
-use super::error::{self, Comparison, SquaredNorms};
-use super::exact_error::{
-    ExactComparison, ExactDifference, exact_profiles, max_exact_displacement,
+pub mod report;
+
+use crate::verify::kind::{Found, Kind, Outcome};
+
+/// The kind: study files without a `[two_size]` table.
+pub const KIND: Kind = Kind {
+    name: "convergence",
+    description: "A study file: rates of both cones on a mesh family against a reference or the exact solution",
+    found: Found::Files {
+        claims: |file| file.two_size.is_none(),
+    },
+    shards: true,
+    run: |file, mode| {
+        let path = file
+            .expect("a convergence study is a file")
+            .display()
+            .to_string();
+        Ok(run_mode(&path, mode)?.map(|r| Box::new(r) as Box<dyn Outcome>))
+    },
 };
-use super::file::{StudyFile, Threshold};
-use super::jobs::{self, Job, JobId, Mode, Solved};
-use super::quantity::{Differences, Quantity};
-use super::rates::{self, Assessment, LevelError, Verdict};
+
+impl Outcome for StudyResult {
+    fn write(&self, dir: &Path) -> Result<()> {
+        report::write_study(self, dir)
+    }
+    fn console(&self, dir: &Path) -> String {
+        report::console(self, dir)
+    }
+    fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+    fn failures(&self) -> Vec<String> {
+        StudyResult::failures(self)
+    }
+}
+
 use crate::analytical::{Exact, Field};
 use crate::case::Case;
 use crate::contact::Method;
@@ -29,32 +56,23 @@ use crate::metrics;
 use crate::progress::Progress;
 use crate::scene::Scene;
 use crate::solve::{Settings, Solution, inf_norm};
+use crate::verify::contact_error::{
+    self, ContactStep, TruthPressure, contact_step, reference_profile,
+};
+use crate::verify::exact_error::{
+    ExactComparison, ExactDifference, exact_profiles, max_exact_displacement,
+};
+use crate::verify::jobs::{self, Job, JobId, Mode, Solved};
+use crate::verify::norms::{self, Comparison, SquaredNorms};
+use crate::verify::quantity::{Differences, Quantity};
+use crate::verify::rates::{self, Assessment, LevelError, Verdict};
+use crate::verify::study_file::{StudyFile, Threshold};
+pub use crate::verify::table::{ErrorRecord, join};
 use rayon::prelude::*;
-use serde::{Serialize, Serializer};
+use serde::{Deserialize, Serialize, Serializer};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-/// One row of errors.csv.
-#[derive(Debug, Clone, Serialize)]
-pub struct ErrorRow {
-    /// Cone.
-    pub method: Method,
-    /// Mesh level.
-    pub level: usize,
-    /// Max element diameter (length).
-    pub h: f64,
-    /// Free dofs.
-    pub dofs: usize,
-    /// Time steps.
-    pub steps: usize,
-    /// Quantity.
-    pub quantity: Quantity,
-    /// Relative error (max over time steps).
-    pub error: f64,
-    /// Wall time of the solve (s).
-    pub wall_s: f64,
-}
 
 /// The fitted rate of one quantity of one cone.
 #[derive(Debug, Clone)]
@@ -88,7 +106,7 @@ impl RateRow {
 }
 
 /// Per-level facts of the mesh family.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct LevelInfo {
     /// Cone.
     pub method: Method,
@@ -188,7 +206,7 @@ pub struct Reference {
 }
 
 /// One run of the time study.
-#[derive(Debug, Clone, Copy, Serialize)]
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
 pub struct TimeRun {
     /// Time steps.
     pub steps: usize,
@@ -237,7 +255,7 @@ pub struct StudyResult {
     /// The scene.
     pub scene: Scene,
     /// Errors per method, level and quantity.
-    pub errors: Vec<ErrorRow>,
+    pub errors: Vec<ErrorRecord>,
     /// Rates per method and quantity.
     pub rates: Vec<RateRow>,
     /// Per-level facts.
@@ -290,15 +308,6 @@ impl StudyResult {
     }
 }
 
-/// Levels as "0 1 2".
-pub fn join(levels: &[usize]) -> String {
-    levels
-        .iter()
-        .map(|l| l.to_string())
-        .collect::<Vec<_>>()
-        .join(" ")
-}
-
 /// A study file with its scene, read and checked.
 pub(crate) struct Study {
     pub(crate) name: String,
@@ -322,7 +331,13 @@ fn study_scene(path: &Path, name: &str) -> Result<Scene> {
 
 impl Study {
     pub(crate) fn load(name: &str) -> Result<Self> {
-        let path = super::file::resolve(name).ok_or_else(|| super::unknown_study(name))?;
+        let path = crate::verify::study_file::resolve(name).ok_or_else(|| {
+            Error::input(
+                name,
+                "study",
+                "no such study file; `study list` lists the built-in studies",
+            )
+        })?;
         let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
         let file = StudyFile::from_toml(&text, &path)?;
         let scene = study_scene(&path, &file.scene)?;
@@ -590,7 +605,7 @@ pub(crate) fn reference(ids: [JobId; 3], solved: &mut Solved, level: usize) -> R
         .states
         .iter()
         .skip(1)
-        .map(|s| error::norms(&case.problem.model, s))
+        .map(|s| norms::norms(&case.problem.model, s))
         .collect();
     let max_displacement = solution
         .states
@@ -662,7 +677,7 @@ impl Truth<'_> {
 /// What step 3 measured.
 #[derive(Default)]
 struct Measured {
-    errors: Vec<ErrorRow>,
+    errors: Vec<ErrorRecord>,
     levels: Vec<LevelInfo>,
     pressure: Vec<ProfilePoint>,
     gap: Vec<ProfilePoint>,
@@ -751,7 +766,7 @@ fn error_rows(
     case: &Case,
     sol: &Solution,
     errors: &BTreeMap<Quantity, f64>,
-) -> Result<Vec<ErrorRow>> {
+) -> Result<Vec<ErrorRecord>> {
     sf.quantities
         .iter()
         .map(|&quantity| {
@@ -762,8 +777,8 @@ fn error_rows(
                     case.level
                 )));
             }
-            Ok(ErrorRow {
-                method,
+            Ok(ErrorRecord {
+                method: method.into(),
                 level: case.level,
                 h: case.h,
                 dofs: case.problem.model.n_free,
@@ -771,6 +786,7 @@ fn error_rows(
                 quantity,
                 error,
                 wall_s: sol.wall_s,
+                parameter: None,
             })
         })
         .collect()
@@ -782,7 +798,7 @@ pub struct Variant {
     /// Size of body 1 at level 0 (length).
     pub coarsest: f64,
     /// Errors per method, level and quantity.
-    pub errors: Vec<ErrorRow>,
+    pub errors: Vec<ErrorRecord>,
     /// Rates per method and quantity.
     pub rates: Vec<RateRow>,
 }
@@ -912,7 +928,7 @@ fn relative_errors(
         .map(|(s, r)| cmp.difference(model, s, rmodel, r))
         .collect();
     let pressure: Vec<(f64, f64)> = steps()
-        .map(|(s, r)| error::pressure_difference(&case.problem, s, &rcase.problem, r))
+        .map(|(s, r)| norms::pressure_difference(&case.problem, s, &rcase.problem, r))
         .collect();
     let band = contact_error::band(&case.problem);
     let band_stress: Vec<f64> = steps().map(|(s, r)| cmp.band_stress(s, r, &band)).collect();
@@ -958,7 +974,7 @@ fn level_info(case: &Case, sol: &Solution, method: Method, flagged: bool) -> Lev
 fn profiles(case: &Case, sol: &Solution, label: Source, out: &mut Measured) {
     let p = &case.problem;
     let s = sol.last();
-    for profile in error::pressure_profile(p, s) {
+    for profile in norms::pressure_profile(p, s) {
         for (x, value) in profile {
             out.pressure.push(ProfilePoint {
                 label,
@@ -1008,7 +1024,7 @@ fn deformed(case: &Case, sol: &Solution, method: Method, magnification: f64) -> 
 fn fit_rates(
     sf: &StudyFile,
     path: &Path,
-    errors: &[ErrorRow],
+    errors: &[ErrorRecord],
     truth: &Truth,
     resultant_fixed: bool,
 ) -> Result<Vec<RateRow>> {
@@ -1016,7 +1032,7 @@ fn fit_rates(
     for &method in &sf.methods {
         let threshold = sf.thresholds.of(method);
         for &quantity in &sf.quantities {
-            let rows: Vec<&ErrorRow> = errors
+            let rows: Vec<&ErrorRecord> = errors
                 .iter()
                 .filter(|r| r.method == method && r.quantity == quantity)
                 .collect();
@@ -1177,8 +1193,8 @@ fn time_reference_error(
     let (mut error, mut norm) = (0.0f64, 0.0f64);
     for (i, state) in sol.states.iter().enumerate().skip(1) {
         let r = &reference.states[i * stride];
-        error = error.max(error::norms_of_difference(model, state, r).theorem());
-        norm = norm.max(error::norms(model, r).theorem());
+        error = error.max(norms::norms_of_difference(model, state, r).theorem());
+        norm = norm.max(norms::norms(model, r).theorem());
     }
     (error / norm, norm)
 }
@@ -1202,7 +1218,7 @@ pub(crate) fn provenance(
             ),
         ),
         ("cores".into(), cores.to_string()),
-        ("commit".into(), super::commit()),
+        ("commit".into(), crate::verify::commit()),
     ])
 }
 

@@ -1,15 +1,16 @@
 //! The report of a convergence study: CSV tables, PNG plots and a README.md, and the lines
 //! printed on the console.
 
-use super::folder::{write, write_folder};
-use super::plot::{self, Panel, Series};
 use crate::contact::Method;
 use crate::error::Result;
 use crate::io::{csv_bytes, fmt3};
-use crate::study::convergence::{RateRow, Source, StudyResult, TimeStudy, join};
-use crate::study::file::Threshold;
-use crate::study::quantity::Quantity;
-use crate::study::rates::{self, Verdict};
+use crate::report::folder::{write, write_folder};
+use crate::report::plot::{self, Panel, Series};
+use crate::studies::convergence::{RateRow, Source, StudyResult, TimeStudy, join};
+use crate::verify::quantity::Quantity;
+use crate::verify::rates::{self, Verdict};
+use crate::verify::study_file::Threshold;
+use crate::verify::table::{MethodLabel, RateRecord};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -19,7 +20,7 @@ use std::path::Path;
 struct VariantCsv {
     /// Size of body 1 at level 0 of the family.
     coarsest: f64,
-    method: Method,
+    method: MethodLabel,
     level: usize,
     h: f64,
     dofs: usize,
@@ -27,62 +28,15 @@ struct VariantCsv {
     error: f64,
 }
 
-/// One row of rates.csv.
-#[derive(Serialize)]
-struct RateCsv {
-    method: Method,
-    quantity: Quantity,
-    #[serde(serialize_with = "crate::io::finite_or_empty")]
-    rate: f64,
-    #[serde(serialize_with = "crate::io::finite_or_empty")]
-    stderr: f64,
-    /// Levels in the fit, space separated.
-    levels_used: String,
-    /// The required rate or the error bound.
-    threshold: Option<f64>,
-    pass: Option<bool>,
-    rate_dofs: Option<f64>,
-    /// Successive rates, space separated ("-" next to a level at round-off).
-    successive: String,
-    /// What the errors support: fitted, drifting, pre-asymptotic, too few levels, not
-    /// converging, round-off, fixed by equilibrium.
-    verdict: &'static str,
-    /// The fit over every usable level (what the window is compared with).
-    #[serde(serialize_with = "crate::io::finite_or_empty")]
-    rate_all_levels: f64,
-    /// Celik et al. 2008 on the last three usable levels: observed order,
-    #[serde(serialize_with = "crate::io::finite_or_empty")]
-    observed_order: f64,
-    /// whether the convergence oscillates (eps32 / eps21 < 0),
-    oscillatory: Option<bool>,
-    /// the GCI of the finest level (units of the error),
-    #[serde(serialize_with = "crate::io::finite_or_empty")]
-    gci_fine: f64,
-    /// and GCI_coarse / (r^p GCI_fine) at the reported rate (1 in the asymptotic range).
-    #[serde(serialize_with = "crate::io::finite_or_empty")]
-    asymptotic_ratio: f64,
-}
-
-impl RateCsv {
-    fn new(r: &RateRow) -> Self {
-        RateCsv {
-            method: r.method,
-            quantity: r.quantity,
-            rate: r.rate(),
-            stderr: r.stderr(),
-            levels_used: join(&r.assessment.used),
-            threshold: r.threshold.map(Threshold::value),
-            pass: r.pass,
-            rate_dofs: r.rate_dofs(),
-            successive: successive(r),
-            verdict: r.assessment.verdict.name(),
-            rate_all_levels: r.assessment.fit_all.map_or(f64::NAN, |f| f.rate),
-            observed_order: r.assessment.celik.map_or(f64::NAN, |c| c.order),
-            oscillatory: r.assessment.celik.map(|c| c.oscillatory),
-            gci_fine: r.assessment.celik.map_or(f64::NAN, |c| c.gci_fine),
-            asymptotic_ratio: r.assessment.asymptotic_ratio.unwrap_or(f64::NAN),
-        }
-    }
+/// The row of rates.csv of `r`.
+fn rate_record(r: &RateRow) -> RateRecord {
+    RateRecord::new(
+        r.method.into(),
+        r.quantity,
+        &r.assessment,
+        r.threshold.map(Threshold::value),
+        r.pass,
+    )
 }
 
 fn successive(r: &RateRow) -> String {
@@ -144,7 +98,7 @@ fn fmt_order(r: &RateRow) -> String {
 pub fn write_study(res: &StudyResult, dir: &Path) -> Result<()> {
     write_folder(dir, |d| {
         write(d, "errors.csv", &csv_bytes(&res.errors)?)?;
-        let rates: Vec<RateCsv> = res.rates.iter().map(RateCsv::new).collect();
+        let rates: Vec<RateRecord> = res.rates.iter().map(rate_record).collect();
         write(d, "rates.csv", &csv_bytes(&rates)?)?;
         write(d, "levels.csv", &csv_bytes(&res.levels)?)?;
         write(d, "pressure.csv", &csv_bytes(&res.pressure)?)?;
@@ -156,7 +110,7 @@ pub fn write_study(res: &StudyResult, dir: &Path) -> Result<()> {
                 .flat_map(|v| {
                     v.errors.iter().map(move |e| VariantCsv {
                         coarsest: v.coarsest,
-                        method: e.method,
+                        method: e.method.clone(),
                         level: e.level,
                         h: e.h,
                         dofs: e.dofs,

@@ -1,7 +1,28 @@
 //! Reproduction of the paper's three numerical tests (section 5): every figure regenerated
 //! and every claim the paper makes there checked by a number.
 
-use super::{solve_case, theorem_distance};
+pub mod report;
+
+use crate::verify::kind::{Found, Kind, Outcome};
+
+/// The kind: one built-in study, `study paper`.
+pub const KIND: Kind = Kind {
+    name: "paper",
+    description: DESCRIPTION,
+    found: Found::BuiltIn,
+    shards: false,
+    run: |_, _| Ok(Some(Box::new(run()?))),
+};
+
+impl Outcome for PaperResult {
+    fn write(&self, dir: &std::path::Path) -> Result<()> {
+        report::write_paper(self, dir)
+    }
+    fn console(&self, dir: &std::path::Path) -> String {
+        report::console(self, dir)
+    }
+}
+
 use crate::case::Case;
 use crate::contact::Method;
 use crate::error::Result;
@@ -9,6 +30,7 @@ use crate::material::von_mises;
 use crate::metrics;
 use crate::scene::Scene;
 use crate::solve::{Solution, SolverKind};
+use crate::verify::{solve_case, theorem_distance};
 use nalgebra::Vector3;
 
 /// One line for `study list`.

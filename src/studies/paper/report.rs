@@ -1,10 +1,10 @@
 //! The report of `study paper`: the paper's section-5 figures regenerated, with the numbers
 //! behind its words.
 
-use super::folder::{write, write_folder};
-use super::plot::{self, MeshPanel, Panel, Series};
 use crate::error::Result;
-use crate::study::paper::{PaperResult, Run};
+use crate::report::folder::{write, write_folder};
+use crate::report::plot::{self, MeshPanel, Panel, Series};
+use crate::studies::paper::{PaperResult, Run};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -302,7 +302,7 @@ fn test3(res: &PaperResult, d: &Path, s: &mut String) -> Result<()> {
     if res.test3_agreement.len() >= 2 {
         let hs: Vec<f64> = res.test3_agreement.iter().map(|a| a.1).collect();
         let ds: Vec<f64> = res.test3_agreement.iter().map(|a| a.2).collect();
-        if let Some(f) = crate::study::rates::fit(&hs, &ds) {
+        if let Some(f) = crate::verify::rates::fit(&hs, &ds) {
             let _ = writeln!(
                 s,
                 "\nThe difference shrinks like h^{:.2} (least squares over the levels above).\n",

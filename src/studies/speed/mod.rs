@@ -3,12 +3,34 @@
 //! assembled once, one sparse Cholesky factorization, two triangular solves per time step;
 //! see [`solve::floor_time`]).
 
-use super::solve_case;
+pub mod report;
+
+use crate::verify::kind::{Found, Kind, Outcome};
+
+/// The kind: one built-in study, `study speed`.
+pub const KIND: Kind = Kind {
+    name: "speed",
+    description: DESCRIPTION,
+    found: Found::BuiltIn,
+    shards: false,
+    run: |_, _| Ok(Some(Box::new(run()?))),
+};
+
+impl Outcome for SpeedResult {
+    fn write(&self, dir: &std::path::Path) -> Result<()> {
+        report::write_speed(self, dir)
+    }
+    fn console(&self, dir: &std::path::Path) -> String {
+        report::console(self, dir)
+    }
+}
+
 use crate::case::{Case, PeakMemory, RunSummary, release_free_heap};
 use crate::contact::Method;
 use crate::error::Result;
 use crate::scene::Scene;
 use crate::solve::{self, Solution, SolverKind};
+use crate::verify::solve_case;
 
 /// One line for `study list`.
 pub const DESCRIPTION: &str = "What each accuracy costs: time split and ratio to the Cholesky floor, viscoplastic and elastic families up to 2.2e6 dofs, newton against the paper's solver";
@@ -229,7 +251,7 @@ pub fn run() -> Result<SpeedResult> {
     )?;
     let (rsol, _) = solve_case(&rcase, SolverKind::Newton, STEPS)?;
     for (i, case, sol) in &kept {
-        rows[*i].error = Some(super::theorem_distance(case, sol, &rcase, &rsol));
+        rows[*i].error = Some(crate::verify::theorem_distance(case, sol, &rcase, &rsol));
     }
     Ok(SpeedResult {
         rows,

@@ -1,66 +1,66 @@
 //! The report of `study speed`: speed.csv, the work-precision and time-against-dofs plots,
 //! the README table, and the lines printed on the console.
 
-use super::folder::{write, write_folder};
-use super::plot::{self, Series};
 use crate::contact::Method;
 use crate::error::Result;
 use crate::io::csv_bytes;
+use crate::report::folder::{write, write_folder};
+use crate::report::plot::{self, Series};
 use crate::solve::SolverKind;
-use crate::study::speed::{FAMILIES, Family, SpeedResult, SpeedRun};
+use crate::studies::speed::{FAMILIES, Family, SpeedResult, SpeedRun};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// One row of speed.csv.
-#[derive(Serialize)]
-struct SpeedCsv {
-    scene: String,
-    method: Method,
-    solver: SolverKind,
-    level: usize,
-    dofs: usize,
-    steps: usize,
+/// One row of speed.csv: one run against its floor.
+#[derive(Debug, Serialize, serde::Deserialize)]
+pub struct SpeedRecord {
+    pub scene: String,
+    pub method: Method,
+    pub solver: SolverKind,
+    pub level: usize,
+    pub dofs: usize,
+    pub steps: usize,
     /// Iterations in total (Newton iterations; inner solves for `paper`).
-    iterations: usize,
-    factorizations: usize,
+    pub iterations: usize,
+    pub factorizations: usize,
     /// Wall time of the time loop (s): the fastest of `repeats` runs.
-    wall_s: f64,
+    pub wall_s: f64,
     /// One-off set-up per mesh, not in wall_s: pattern, slot map, symbolic analysis (s).
-    setup_s: f64,
-    repeats: usize,
+    pub setup_s: f64,
+    pub repeats: usize,
     /// Pattern, assembly, one sparse Cholesky (symbolic and numeric) of the stiffness and
     /// one solve per step (s).
-    floor_s: f64,
+    pub floor_s: f64,
     /// (setup_s + wall_s) / floor_s.
-    ratio_to_floor: f64,
-    factor_s: f64,
-    solve_s: f64,
-    assembly_s: f64,
-    constitutive_s: f64,
-    error: Option<f64>,
+    pub ratio_to_floor: f64,
+    pub factor_s: f64,
+    pub solve_s: f64,
+    pub assembly_s: f64,
+    pub constitutive_s: f64,
+    pub error: Option<f64>,
     /// Peak resident memory of the process during the solve (GiB).
-    peak_rss_gib: Option<f64>,
+    pub peak_rss_gib: Option<f64>,
     /// viscoplastic (`rates`) or elastic (`rates-elastic`).
-    family: &'static str,
+    pub family: String,
     /// Threads of the solver and the floor.
-    threads: usize,
+    pub threads: usize,
     /// The same run's set-up + time loop on one thread (largest level; s).
-    one_thread_s: Option<f64>,
+    pub one_thread_s: Option<f64>,
     /// The floor on one thread (largest level; s).
-    one_thread_floor_s: Option<f64>,
+    pub one_thread_floor_s: Option<f64>,
     /// Fill of the solver's factor of the stiffness: entries of L, both bodies, the
     /// interface rows included (0 for the paper's solver, which has no such factor).
-    factor_entries: usize,
+    pub factor_entries: usize,
     /// Fill of the floor's Cholesky factor: entries of L, both bodies.
-    floor_factor_entries: usize,
+    pub floor_factor_entries: usize,
 }
 
-impl SpeedCsv {
+impl SpeedRecord {
     fn new(r: &SpeedRun, threads: usize) -> Self {
         let run = &r.run;
         let t = &run.timings;
-        SpeedCsv {
+        SpeedRecord {
             scene: run.scene.clone(),
             method: run.method,
             solver: run.solver,
@@ -80,7 +80,7 @@ impl SpeedCsv {
             constitutive_s: t.constitutive_s,
             error: r.error,
             peak_rss_gib: run.peak_rss_gib,
-            family: r.family.label,
+            family: r.family.label.to_string(),
             threads,
             one_thread_s: r.one_thread.map(|o| o.0),
             one_thread_floor_s: r.one_thread.map(|o| o.1),
@@ -124,7 +124,7 @@ fn family_runs<'a>(
 /// dominate), and its label.
 fn exponent_label(name: &str, points: &[(f64, f64)]) -> String {
     let big: Vec<&(f64, f64)> = points.iter().filter(|p| p.0 >= 1e4).collect();
-    let fit = crate::study::rates::fit(
+    let fit = crate::verify::rates::fit(
         &big.iter().map(|p| p.0).collect::<Vec<_>>(),
         &big.iter().map(|p| p.1).collect::<Vec<_>>(),
     );
@@ -145,10 +145,10 @@ const COMBOS: [(Method, SolverKind, usize); 4] = [
 /// Write the report of `study speed`.
 pub fn write_speed(res: &SpeedResult, dir: &Path) -> Result<()> {
     write_folder(dir, |d| {
-        let rows: Vec<SpeedCsv> = res
+        let rows: Vec<SpeedRecord> = res
             .rows
             .iter()
-            .map(|r| SpeedCsv::new(r, res.threads))
+            .map(|r| SpeedRecord::new(r, res.threads))
             .collect();
         write(d, "speed.csv", &csv_bytes(&rows)?)?;
         work_precision(res, d)?;
@@ -233,14 +233,14 @@ fn readme(res: &SpeedResult) -> String {
     let _ = writeln!(
         s,
         "# Study `speed`\n\nWhat each accuracy costs, on two families of the same non-matching meshes (h1/h2 = 1.4142, h_upper = 0.28 at level 0, every level splits each triangle in 4), {} time steps: `rates` (viscoplastic, about half the domain flows) and `rates-elastic` (no yield stress). Each run's cost, the solver's set-up (pattern, symbolic analysis) plus its time loop, is compared with the floor measured on the same mesh: what the problem cannot avoid, from scratch: the elastic stiffness's pattern and values, one sparse Cholesky of it (faer; ordering, symbolic and numeric; shifted by 1e-8 of its mean diagonal so that a body held only by contact does not make it singular), and one solve (two triangular solves) per time step. newton's runs are timed {} times, larger ones {} times, solver and floor alternately (the paper's solver once), each on a heap handed back to the system as in a fresh process, and the fastest of each is kept (single timings of 0.01-1 s scatter by up to a factor 2 on this shared 2-core machine). Errors (viscoplastic family) are in the theorem norm against a matching-mesh reference at level {} ({} dofs), shown where the reference is at least 3 levels finer. `peak RSS` is the process's peak during the solve (reset before it). Regenerate with `cargo run --release -- study speed` ({:.0} s).\n",
-        crate::study::speed::STEPS,
-        crate::study::speed::REPEATS
+        crate::studies::speed::STEPS,
+        crate::studies::speed::REPEATS
             .iter()
             .map(|(below, times)| format!("{times} below {below} dofs"))
             .collect::<Vec<_>>()
             .join(", "),
-        crate::study::speed::REPEATS_ABOVE,
-        crate::study::speed::REFERENCE_LEVEL,
+        crate::studies::speed::REPEATS_ABOVE,
+        crate::studies::speed::REFERENCE_LEVEL,
         res.reference_dofs,
         res.wall_s
     );
@@ -333,7 +333,7 @@ fn readme(res: &SpeedResult) -> String {
     );
     s.push_str(&table(res));
     for m in [Method::Mortar, Method::Nts] {
-        let finest = crate::study::speed::PAPER_LEVELS.iter().max().unwrap();
+        let finest = crate::studies::speed::PAPER_LEVELS.iter().max().unwrap();
         let at_finest = |so| family_runs(res, &FAMILIES[0], m, so).find(|r| r.run.level == *finest);
         if let (Some(a), Some(b)) = (at_finest(SolverKind::Newton), at_finest(SolverKind::Paper)) {
             let _ = writeln!(

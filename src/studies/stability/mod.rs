@@ -3,13 +3,35 @@
 //! not an error. The error of a run is its largest nodal difference to the `newton` solution
 //! of the same discrete problem, relative to the largest displacement.
 
+pub mod report;
+
+use crate::verify::kind::{Found, Kind, Outcome};
+
+/// The kind: one built-in study, `study stability`.
+pub const KIND: Kind = Kind {
+    name: "stability",
+    description: DESCRIPTION,
+    found: Found::BuiltIn,
+    shards: false,
+    run: |_, _| Ok(Some(Box::new(run()?))),
+};
+
+impl Outcome for StabilityResult {
+    fn write(&self, dir: &std::path::Path) -> Result<()> {
+        report::write_stability(self, dir)
+    }
+    fn console(&self, dir: &std::path::Path) -> String {
+        report::console(self, dir)
+    }
+}
+
 use crate::case::Case;
 use crate::contact::Method;
 use crate::error::{Error, Result};
 use crate::metrics;
 use crate::scene::Scene;
 use crate::solve::{self, Settings, Solution, SolverKind};
-use serde::{Serialize, Serializer};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 /// One line for `study list`.
 pub const DESCRIPTION: &str = "Hard cases (stiff viscosity, modulus contrast, mesh-size ratio, slivers, units, ...) with every solver and both cones";
@@ -106,6 +128,22 @@ impl HardCase {
         }
     }
 
+    /// Every case.
+    pub const ALL: [HardCase; 12] = [
+        HardCase::StiffViscosity,
+        HardCase::ModulusContrast,
+        HardCase::MeshSizeRatio,
+        HardCase::SwappedSlave,
+        HardCase::HeldOnlyByContact,
+        HardCase::NearCoincidentNodes,
+        HardCase::CoincidentNodes,
+        HardCase::Slivers,
+        HardCase::UnitsRescaled,
+        HardCase::NewtonAcrossLevels,
+        HardCase::SingleStep,
+        HardCase::OmegaSweep,
+    ];
+
     /// The swept cases in the order their plots are drawn.
     pub const SWEEPS: [HardCase; 4] = [
         HardCase::StiffViscosity,
@@ -121,8 +159,18 @@ impl Serialize for HardCase {
     }
 }
 
+impl<'de> Deserialize<'de> for HardCase {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        HardCase::ALL
+            .into_iter()
+            .find(|c| c.name() == name)
+            .ok_or_else(|| serde::de::Error::custom(format!("unknown hard case '{name}'")))
+    }
+}
+
 /// One row of stability.csv.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct StabilityRow {
     /// The case.
     pub case: HardCase,
@@ -143,10 +191,16 @@ pub struct StabilityRow {
     /// Mean iterations per step.
     pub mean_step_iterations: f64,
     /// Relative nodal difference to newton's solution of the same problem (blank if none).
-    #[serde(serialize_with = "crate::io::finite_or_empty")]
+    #[serde(
+        serialize_with = "crate::io::finite_or_empty",
+        deserialize_with = "crate::io::empty_as_nan"
+    )]
     pub error: f64,
     /// Largest interpenetration over the history (length units; blank if not converged).
-    #[serde(serialize_with = "crate::io::finite_or_empty")]
+    #[serde(
+        serialize_with = "crate::io::finite_or_empty",
+        deserialize_with = "crate::io::empty_as_nan"
+    )]
     pub max_penetration: f64,
     /// Wall time (s).
     pub wall_s: f64,

@@ -1,13 +1,13 @@
 //! The report of `study stability`: stability.csv, the sweep plots, one section per hard
 //! case with its note and table, and the lines printed on the console.
 
-use super::folder::{write, write_folder};
-use super::plot::{self, Series};
 use crate::contact::Method;
 use crate::error::Result;
 use crate::io::csv_bytes;
+use crate::report::folder::{write, write_folder};
+use crate::report::plot::{self, Series};
 use crate::solve::SolverKind;
-use crate::study::stability::{HardCase, StabilityResult};
+use crate::studies::stability::{HardCase, StabilityResult};
 use std::fmt::Write as _;
 use std::path::Path;
 

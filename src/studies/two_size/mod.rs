@@ -16,32 +16,60 @@
 //!    5x of it is left out), and the whole grid to E = C1 h1^a1 + C2 h2^a2
 //!    ([`rates::fit_power_sum`]).
 
-use super::convergence::{Reference, Study, Truth, provenance, reference};
-use super::jobs::{self, Job, JobId, Mode};
-use super::quantity::Quantity;
-use super::rates::{self, Assessment, LevelError, PowerSumFit};
+pub mod report;
+
+use crate::verify::kind::{Found, Kind, Outcome};
+use std::path::Path;
+
+/// The kind: study files with a `[two_size]` table.
+pub const KIND: Kind = Kind {
+    name: "two-size",
+    description: "A study file with a [two_size] table: the slave's and the master's meshes refined independently",
+    found: Found::Files {
+        claims: |file| file.two_size.is_some(),
+    },
+    shards: false,
+    run: |file, _| {
+        let path = file
+            .expect("a two-size study is a file")
+            .display()
+            .to_string();
+        Ok(Some(Box::new(run(&path)?)))
+    },
+};
+
+impl Outcome for TwoSizeResult {
+    fn write(&self, dir: &Path) -> Result<()> {
+        report::write_two_size(self, dir)
+    }
+    fn console(&self, dir: &Path) -> String {
+        report::console(self, dir)
+    }
+    fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+    fn failures(&self) -> Vec<String> {
+        TwoSizeResult::failures(self)
+    }
+}
+
 use crate::case::Case;
 use crate::contact::Method;
 use crate::error::{Error, Result};
 use crate::progress::Progress;
 use crate::scene::Scene;
 use crate::solve::Solution;
+use crate::studies::convergence::{Reference, Study, Truth, provenance, reference};
+use crate::verify::jobs::{self, Job, JobId, Mode};
+use crate::verify::quantity::Quantity;
+use crate::verify::rates::{self, Assessment, LevelError, PowerSumFit};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-/// Lemma 3.1's exponents of the consistency error in (h1, h2): K_h^pi h1^(3/4) + h2,
-/// K_h^I h1^(1/2) (from (h1^(1/2) ||e||)^(1/2) with ||e|| bounded) + h2^(3/4).
-pub fn lemma_exponents(method: Method) -> [f64; 2] {
-    match method {
-        Method::Mortar => [0.75, 1.0],
-        Method::Nts => [0.5, 0.75],
-    }
-}
-
 /// One measured pair of sizes.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, serde::Deserialize)]
 pub struct SizePoint {
     /// The body carrying the constraint.
     pub slave: String,

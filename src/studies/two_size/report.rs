@@ -3,14 +3,15 @@
 //! one-sided sweeps with their fitted slopes, and a README that answers, per cone and
 //! quantity, which mesh limits the error and which body should carry the constraint.
 
-use super::folder::{write, write_folder};
-use super::plot::{self, GridPanel, Series};
 use crate::contact::Method;
 use crate::error::Result;
 use crate::io::{csv_bytes, fmt3};
-use crate::study::quantity::Quantity;
-use crate::study::rates::{Assessment, Verdict};
-use crate::study::two_size::{SizeFit, TwoSizeResult, lemma_exponents};
+use crate::report::folder::{write, write_folder};
+use crate::report::plot::{self, GridPanel, Series};
+use crate::studies::two_size::{SizeFit, TwoSizeResult};
+use crate::verify::quantity::Quantity;
+use crate::verify::rates::{Assessment, Verdict};
+use crate::verify::table::{ErrorRecord, join};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -23,53 +24,46 @@ const MAPPED: [Quantity; 4] = [
     Quantity::MaxPenetration,
 ];
 
-/// One row of fits.csv.
-#[derive(Debug, Serialize)]
-struct FitCsv {
-    slave: String,
-    method: Method,
-    quantity: Quantity,
-    a1: f64,
-    se_a1: f64,
-    a2: f64,
-    se_a2: f64,
-    c1: f64,
-    c2: f64,
-    rms_log_residual: f64,
-    lemma_a1: f64,
-    lemma_a2: f64,
-    rate_h1: f64,
-    stderr_h1: f64,
-    levels_h1: String,
-    verdict_h1: &'static str,
-    rate_h2: f64,
-    stderr_h2: f64,
-    levels_h2: String,
-    verdict_h2: &'static str,
-    floor: f64,
-    term1: f64,
-    term2: f64,
-    gain1_per_dof: f64,
-    gain2_per_dof: f64,
+/// One row of fits.csv: one slave choice, cone and quantity, the grid fitted to
+/// E = C1 h1^a1 + C2 h2^a2 and the one-sided sweeps.
+#[derive(Debug, Serialize, serde::Deserialize)]
+pub struct FitRecord {
+    pub slave: String,
+    pub method: Method,
+    pub quantity: Quantity,
+    pub a1: f64,
+    pub se_a1: f64,
+    pub a2: f64,
+    pub se_a2: f64,
+    pub c1: f64,
+    pub c2: f64,
+    pub rms_log_residual: f64,
+    pub lemma_a1: f64,
+    pub lemma_a2: f64,
+    pub rate_h1: f64,
+    pub stderr_h1: f64,
+    pub levels_h1: String,
+    pub verdict_h1: Verdict,
+    pub rate_h2: f64,
+    pub stderr_h2: f64,
+    pub levels_h2: String,
+    pub verdict_h2: Verdict,
+    pub floor: f64,
+    pub term1: f64,
+    pub term2: f64,
+    pub gain1_per_dof: f64,
+    pub gain2_per_dof: f64,
 }
 
-fn levels_text(levels: &[usize]) -> String {
-    levels
-        .iter()
-        .map(|l| l.to_string())
-        .collect::<Vec<_>>()
-        .join(" ")
-}
-
-impl FitCsv {
+impl FitRecord {
     fn new(f: &SizeFit) -> Self {
         let nan = f64::NAN;
         let fit = f.fit;
-        let lemma = lemma_exponents(f.method);
+        let lemma = f.method.lemma_exponents();
         let rate = |a: &Assessment| a.fit.map_or((nan, nan), |x| (x.rate, x.stderr));
         let (r1, s1) = rate(&f.sweeps[0]);
         let (r2, s2) = rate(&f.sweeps[1]);
-        FitCsv {
+        FitRecord {
             slave: f.slave.clone(),
             method: f.method,
             quantity: f.quantity,
@@ -84,12 +78,12 @@ impl FitCsv {
             lemma_a2: lemma[1],
             rate_h1: r1,
             stderr_h1: s1,
-            levels_h1: levels_text(&f.sweeps[0].used),
-            verdict_h1: f.sweeps[0].verdict.name(),
+            levels_h1: join(&f.sweeps[0].used),
+            verdict_h1: f.sweeps[0].verdict,
             rate_h2: r2,
             stderr_h2: s2,
-            levels_h2: levels_text(&f.sweeps[1].used),
-            verdict_h2: f.sweeps[1].verdict.name(),
+            levels_h2: join(&f.sweeps[1].used),
+            verdict_h2: f.sweeps[1].verdict,
             floor: f.floor,
             term1: f.terms[0],
             term2: f.terms[1],
@@ -103,7 +97,7 @@ impl FitCsv {
 pub fn write_two_size(res: &TwoSizeResult, dir: &Path) -> Result<()> {
     write_folder(dir, |d| {
         write(d, "grid.csv", &csv_bytes(&res.points)?)?;
-        let fits: Vec<FitCsv> = res.fits.iter().map(FitCsv::new).collect();
+        let fits: Vec<FitRecord> = res.fits.iter().map(FitRecord::new).collect();
         write(d, "fits.csv", &csv_bytes(&fits)?)?;
         for slave in &res.slaves {
             for &method in &res.methods {
@@ -141,7 +135,7 @@ fn dofs_line(pairs: &[(usize, usize)]) -> (f64, f64) {
 /// The error maps of one slave choice and cone, with the iso-dofs line through every grid
 /// diagonal point (N1(l1) + N2(l2) constant, each N_b ~ exp(alpha_b + beta_b l) fitted).
 fn maps(res: &TwoSizeResult, slave: &str, method: Method, d: &Path) -> Result<()> {
-    let grid = |p: &&crate::study::two_size::SizePoint| {
+    let grid = |p: &&crate::studies::two_size::SizePoint| {
         res.levels.contains(&p.slave_level) && res.levels.contains(&p.master_level)
     };
     let theorem: Vec<_> = res
@@ -256,7 +250,7 @@ fn sweeps(res: &TwoSizeResult, slave: &str, d: &Path) -> Result<()> {
     )
 }
 
-use crate::study::rates::{FIT_MAX_RMS as FIT_RMS, FIT_MAX_SE as FIT_SE};
+use crate::verify::rates::{FIT_MAX_RMS as FIT_RMS, FIT_MAX_SE as FIT_SE};
 
 /// Exponent `b` of the grid fit, or why the numbers do not support one: a poor fit overall,
 /// or a term too small on the grid to identify its exponent.
@@ -283,7 +277,7 @@ fn fmt_sweep(a: &Assessment) -> String {
             x.rate,
             x.stderr,
             a.verdict.name(),
-            levels_text(&a.used)
+            join(&a.used)
         ),
         _ => a.verdict.name().to_string(),
     }
@@ -354,17 +348,10 @@ fn answer(res: &TwoSizeResult, f: &SizeFit) -> String {
 /// The diagonal pairs against the diagonal study's committed errors (same meshes).
 fn diagonal(res: &TwoSizeResult, s: &mut String) {
     let Some(name) = &res.diagonal else { return };
-    let path = super::reports_dir().join(name).join("errors.csv");
-    #[derive(serde::Deserialize)]
-    struct Row {
-        method: String,
-        level: usize,
-        quantity: String,
-        error: f64,
-    }
-    let rows: Vec<Row> = match csv::Reader::from_path(&path) {
-        Ok(mut r) => r.deserialize().filter_map(|x| x.ok()).collect(),
-        Err(_) => return,
+    let path = crate::report::reports_dir().join(name).join("errors.csv");
+    // Without the diagonal study's report there is nothing to compare with.
+    let Ok(rows) = crate::verify::table::read::<ErrorRecord>(&path) else {
+        return;
     };
     let slave = &res.scene.bodies[0].surface;
     let mut worst: Vec<(String, f64, usize, bool)> = Vec::new();
@@ -378,12 +365,12 @@ fn diagonal(res: &TwoSizeResult, s: &mut String) {
                 let (Some(a), Some(b)) = (
                     res.error(slave, m, q, [l, l]),
                     rows.iter()
-                        .find(|r| r.method == m.name() && r.level == l && r.quantity == q.name())
+                        .find(|r| r.method == m && r.level == l && r.quantity == q)
                         .map(|r| r.error),
                 ) else {
                     continue;
                 };
-                let tiny = crate::study::rates::ROUNDOFF;
+                let tiny = crate::verify::rates::ROUNDOFF;
                 if a > tiny || b > tiny {
                     roundoff = false;
                     w = w.max((a - b).abs() / b.abs().max(f64::MIN_POSITIVE));
@@ -399,14 +386,14 @@ fn diagonal(res: &TwoSizeResult, s: &mut String) {
         s,
         "## The diagonal against `{name}`\n\nWhere both bodies have the same level the mesh is the diagonal study's (each body split from the same gmsh level-0 mesh; slave '{slave}'), so its errors must agree with [`reports/{name}`](../{name}/README.md) to the solver tolerance (this study's {} time steps against its own; a quantity taken as the max over the steps may differ where they do). Largest relative difference per quantity over both cones and levels {}:\n\n| quantity | pairs | largest relative difference |\n|---|---|---|",
         res.steps,
-        levels_text(&res.levels)
+        join(&res.levels)
     );
     for (q, w, n, roundoff) in worst {
         if roundoff {
             let _ = writeln!(
                 s,
                 "| {q} | {n} | both at round-off (<= {:.0e}) |",
-                crate::study::rates::ROUNDOFF
+                crate::verify::rates::ROUNDOFF
             );
         } else {
             let _ = writeln!(s, "| {q} | {n} | {w:.2e} |");
@@ -425,7 +412,7 @@ fn readme(res: &TwoSizeResult) -> String {
         res.name,
         res.wall_s,
         res.provenance.get("cores").cloned().unwrap_or_default(),
-        levels_text(&res.levels),
+        join(&res.levels),
         res.slaves.join(", "),
         res.steps,
         fixed = res.fixed
@@ -451,7 +438,7 @@ fn readme(res: &TwoSizeResult) -> String {
         )
     });
     for f in rows {
-        let lemma = lemma_exponents(f.method);
+        let lemma = f.method.lemma_exponents();
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {} | ({}, {}) | {} | {} | {} | {:.3e} |",
@@ -512,7 +499,7 @@ fn readme(res: &TwoSizeResult) -> String {
                     .collect();
                 let best = if e
                     .iter()
-                    .all(|v| v.is_some_and(|v| v <= crate::study::rates::ROUNDOFF))
+                    .all(|v| v.is_some_and(|v| v <= crate::verify::rates::ROUNDOFF))
                 {
                     "both at round-off".to_string()
                 } else if shown.windows(2).all(|w| w[0] == w[1]) {
@@ -591,7 +578,7 @@ pub fn console(res: &TwoSizeResult, dir: &Path) -> String {
             f.method.name(),
             fmt_fit(f, 0),
             fmt_fit(f, 1),
-            lemma_exponents(f.method),
+            f.method.lemma_exponents(),
             fmt_sweep(&f.sweeps[0]),
             fmt_sweep(&f.sweeps[1])
         );

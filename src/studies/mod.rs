@@ -1,0 +1,110 @@
+//! The study kinds, one folder each (what it measures in `mod.rs`, how it reports in
+//! `report.rs`), and the one table that dispatches to them, [`KINDS`]. A new kind is its
+//! folder and one line in that table.
+//!
+//! - [`convergence`]: a study file (studies/NAME.toml): rates of both cones on a mesh
+//!   family against a fine reference or the exact solution, with Theorem 3.1's thresholds;
+//! - [`two_size`]: a study file with a `[two_size]` table: each body's mesh refined alone;
+//! - [`paper`]: the paper's three numerical tests regenerated;
+//! - [`speed`]: what each accuracy costs, against the floor;
+//! - [`stability`]: hard cases with every solver.
+
+pub mod convergence;
+pub mod paper;
+pub mod speed;
+pub mod stability;
+pub mod two_size;
+
+use crate::error::{Error, Result};
+use crate::verify::jobs::Mode;
+use crate::verify::kind::{Found, Kind, Outcome};
+use crate::verify::study_file::{self, StudyFile};
+use std::path::PathBuf;
+
+/// Every study kind.
+pub const KINDS: &[&Kind] = &[
+    &convergence::KIND,
+    &two_size::KIND,
+    &paper::KIND,
+    &speed::KIND,
+    &stability::KIND,
+];
+
+/// A study to run: its kind and, for a kind found in files, the study file.
+pub struct Study {
+    /// The study's kind.
+    pub kind: &'static Kind,
+    /// The study file, for a kind found in files.
+    pub file: Option<PathBuf>,
+}
+
+impl Study {
+    /// The study called `name`: a built-in kind, a built-in study file or a path.
+    pub fn resolve(name: &str) -> Result<Study> {
+        if let Some(kind) = KINDS
+            .iter()
+            .find(|k| matches!(k.found, Found::BuiltIn) && k.name == name)
+        {
+            return Ok(Study { kind, file: None });
+        }
+        let path = study_file::resolve(name).ok_or_else(|| unknown_study(name))?;
+        let file = StudyFile::load(&path)?;
+        let kind = KINDS
+            .iter()
+            .find(|k| matches!(k.found, Found::Files { claims } if claims(&file)))
+            .expect("every study file is claimed by a kind");
+        Ok(Study {
+            kind,
+            file: Some(path),
+        })
+    }
+
+    /// Every built-in study, name and description, sorted by name.
+    pub fn list() -> Vec<(String, String)> {
+        let mut all = study_file::list();
+        all.extend(
+            KINDS
+                .iter()
+                .filter(|k| matches!(k.found, Found::BuiltIn))
+                .map(|k| (k.name.to_string(), k.description.to_string())),
+        );
+        all.sort();
+        all
+    }
+
+    /// The study's name: its report folder under reports/.
+    pub fn name(&self) -> String {
+        match &self.file {
+            Some(path) => path.file_stem().map_or_else(
+                || path.display().to_string(),
+                |s| s.to_string_lossy().to_string(),
+            ),
+            None => self.kind.name.to_string(),
+        }
+    }
+
+    /// Run the study in `mode` (a shard gives no outcome; kinds that do not shard run whole).
+    pub fn run(&self, mode: Mode) -> Result<Option<Box<dyn Outcome>>> {
+        if mode != Mode::All && !self.kind.shards {
+            return Err(Error::input(
+                self.name(),
+                "--shard/--merge",
+                "only convergence studies (study files) run as shards; run this study without --shard or --merge",
+            ));
+        }
+        (self.kind.run)(self.file.as_deref(), mode)
+    }
+}
+
+/// The error for a study name that is neither built in nor a file.
+pub fn unknown_study(name: &str) -> Error {
+    let names: Vec<String> = Study::list().into_iter().map(|(n, _)| n).collect();
+    Error::input(
+        name,
+        "study",
+        format!(
+            "no built-in study named '{name}' and no such file; built-in studies: {}",
+            names.join(", ")
+        ),
+    )
+}

@@ -1,0 +1,51 @@
+//! What a study kind is: a name, a description, where its studies come from, and a run whose
+//! [`Outcome`] writes the report. The kinds are listed in one table,
+//! `crate::studies::KINDS`; a new kind is its folder under `src/studies/` and one line there.
+
+use crate::error::Result;
+use crate::verify::jobs::Mode;
+use crate::verify::study_file::StudyFile;
+use std::path::Path;
+
+/// Where a kind's studies come from.
+pub enum Found {
+    /// One built-in study, named after the kind (`study paper`).
+    BuiltIn,
+    /// Study files (studies/NAME.toml or a path) for which `claims` holds; the claims of the
+    /// kinds found in files exclude each other.
+    Files {
+        /// Whether a study file is of this kind.
+        claims: fn(&StudyFile) -> bool,
+    },
+}
+
+/// One study kind: a line of the table `crate::studies::KINDS`.
+pub struct Kind {
+    /// The kind's name: the study's name for a built-in kind.
+    pub name: &'static str,
+    /// One line for `study list`.
+    pub description: &'static str,
+    /// Where its studies come from.
+    pub found: Found,
+    /// Whether its studies run as shards (`--shard i/n`, `--merge`).
+    pub shards: bool,
+    /// Run one study: `file` is the study file for a kind found in files. A shard gives no
+    /// outcome (its records are the result).
+    pub run: fn(file: Option<&Path>, mode: Mode) -> Result<Option<Box<dyn Outcome>>>,
+}
+
+/// What a study measured: it writes its report folder and says what the console shows.
+pub trait Outcome {
+    /// Write the report into `dir` (normally reports/NAME), all or nothing.
+    fn write(&self, dir: &Path) -> Result<()>;
+    /// What the console shows after the report was written into `dir`.
+    fn console(&self, dir: &Path) -> String;
+    /// Warnings about the scene, for the user.
+    fn warnings(&self) -> &[String] {
+        &[]
+    }
+    /// The thresholds missed, one sentence each (empty: the study passed).
+    fn failures(&self) -> Vec<String> {
+        Vec::new()
+    }
+}
