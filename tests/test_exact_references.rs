@@ -46,14 +46,14 @@ fn quick_exact_study_meets_the_thresholds_and_its_quadrature_is_converged() {
     assert_eq!(res.errors.len(), res8.errors.len());
     for (a, b) in res.errors.iter().zip(&res8.errors) {
         assert_eq!(
-            (a.method, a.level, a.quantity),
-            (b.method, b.level, b.quantity)
+            (&a.method, a.level, a.quantity),
+            (&b.method, b.level, b.quantity)
         );
         assert_eq!(
             format!("{:.3e}", a.error),
             format!("{:.3e}", b.error),
             "{} level {} {}",
-            a.method,
+            &a.method,
             a.level,
             a.quantity
         );
@@ -62,7 +62,7 @@ fn quick_exact_study_meets_the_thresholds_and_its_quadrature_is_converged() {
         assert!(
             (a.error - b.error).abs() <= 5e-5 * a.error,
             "{} {}: {} vs {}",
-            a.method,
+            &a.method,
             a.quantity,
             a.error,
             b.error
