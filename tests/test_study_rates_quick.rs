@@ -69,8 +69,8 @@ fn quick_rates_study_meets_the_theorem_thresholds() {
     assert_eq!(res.errors.len(), merged.errors.len());
     for (a, b) in res.errors.iter().zip(&merged.errors) {
         assert_eq!(
-            (a.method, a.level, a.quantity, a.error.to_bits()),
-            (b.method, b.level, b.quantity, b.error.to_bits())
+            (&a.method, a.level, a.quantity, a.error.to_bits()),
+            (&b.method, b.level, b.quantity, b.error.to_bits())
         );
     }
     for (a, b) in res.rates.iter().zip(&merged.rates) {
