@@ -17,7 +17,7 @@ pub mod stability;
 pub mod study;
 pub mod two_size;
 
-pub use folder::{Output, Staging, check_writable, reports_dir, write_folder};
+pub use folder::{Output, Staging, check_writable, remove_live, reports_dir, write_folder};
 
 use crate::error::Result;
 use crate::study::Outcome;
