@@ -15,6 +15,7 @@ pub mod contact;
 pub mod error;
 pub mod expr;
 pub mod fe;
+pub mod interrupt;
 pub mod io;
 pub mod material;
 pub mod mesh;

@@ -10,6 +10,9 @@ use contact_rates::scene::Scene;
 use contact_rates::solve::{self, Settings, SolverKind};
 use contact_rates::studies::Study;
 use contact_rates::verify::jobs::Mode;
+use signal_hook::iterator::Signals;
+use signal_hook::low_level::signal_name;
+use std::io::Write as _;
 use std::path::PathBuf;
 
 #[derive(Parser)]
@@ -294,7 +297,36 @@ fn solve_one(req: &SolveRequest) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// On SIGINT, SIGTERM or SIGHUP (those not ignored at the start): remove the run's staging
+/// folders and exit with 128 + the signal's number, the status a shell gives a process that
+/// signal ended (130, 143, 129).
+fn exit_cleanly_on_signals() -> std::io::Result<()> {
+    let mut signals = Signals::new(contact_rates::interrupt::catchable())?;
+    std::thread::spawn(move || {
+        if let Some(signo) = signals.forever().next() {
+            let interrupted = report::remove_live();
+            let name = signal_name(signo).unwrap_or("a signal");
+            for folder in &interrupted.removed {
+                // Not eprintln: after SIGHUP the terminal may be gone, and a panic here
+                // would leave the run going.
+                let _ = writeln!(
+                    std::io::stderr(),
+                    "note: interrupted by {name}; removed {}",
+                    folder.display()
+                );
+            }
+            std::process::exit(128 + signo);
+        }
+    });
+    Ok(())
+}
+
 fn main() {
+    if let Err(e) = exit_cleanly_on_signals() {
+        eprintln!(
+            "warning: cannot catch SIGINT, SIGTERM and SIGHUP ({e}); an interrupted run leaves its staging folder, which the next run removes"
+        );
+    }
     if let Err(e) = contact_rates::on_pool(run) {
         eprintln!("error: {e:#}");
         std::process::exit(1);

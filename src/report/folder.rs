@@ -1,14 +1,17 @@
 //! Output folders written all or nothing, for study reports and `solve` alike: the files go
 //! into a staging sibling `.NAME.staging-PID`, which replaces NAME only once the run has
-//! succeeded. A failed run removes its staging folder; a killed one leaves it, and the next
-//! run into the same folder removes it with a one-line note. The previous folder is never
-//! touched before the swap, so it survives any failure byte for byte. A running run holds an
-//! advisory lock (flock) on its staging folder, which the system releases when the process
-//! ends however it ends: a staging folder is stale exactly when its lock is free, whatever
-//! the process ids say (another PID namespace, another system).
+//! succeeded. A failed run removes its staging folder, and so does one interrupted by a
+//! signal the binary catches (SIGINT, SIGTERM, SIGHUP: see [`remove_live`]); a killed one
+//! (SIGKILL) leaves it, and the next run into the same folder removes it with a one-line
+//! note. The previous folder is never touched before the swap, so it survives any failure
+//! byte for byte. A running run holds an advisory lock (flock) on its staging folder, which
+//! the system releases when the process ends however it ends: a staging folder is stale
+//! exactly when its lock is free, whatever the process ids say (another PID namespace,
+//! another system).
 
 use crate::error::{Error, Result};
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard, PoisonError};
 
 /// The folder of all reports: `reports/` in the crate.
 pub fn reports_dir() -> PathBuf {
@@ -49,6 +52,17 @@ const FIX: &str = "pass --out with a writable folder, or make this one writable"
 /// kind. Creates the parent, never `dir`. Also removes staging debris of killed runs (see
 /// [`Staging`]), returning one note per folder removed.
 pub fn check_writable(dir: &Path, kind: Output) -> Result<Vec<String>> {
+    // Under the registry's lock: an interrupting signal finds the folders created above
+    // `dir` registered, or none created yet.
+    let mut live = live();
+    let created = first_missing(dir);
+    let notes = check(dir, kind)?;
+    live.add(None, created.map(|top| (parent(dir), top)));
+    Ok(notes)
+}
+
+/// [`check_writable`] without the registry.
+fn check(dir: &Path, kind: Output) -> Result<Vec<String>> {
     if dir.file_name().is_none() {
         return Err(Error::input(
             dir,
@@ -119,6 +133,8 @@ pub struct Staging {
     target: PathBuf,
     path: PathBuf,
     committed: bool,
+    /// Its entry in the registry of live folders (see [`remove_live`]).
+    id: u64,
     /// The open staging folder, locked while this run lives (see the module).
     _lock: Option<std::fs::File>,
     /// The first folder above the target this run created, removed again (when empty)
@@ -130,12 +146,11 @@ impl Staging {
     /// Check `dir` as [`check_writable`] does and create its staging folder; the notes say
     /// which stale staging folders were removed.
     pub fn begin(dir: &Path, kind: Output) -> Result<(Staging, Vec<String>)> {
-        let created = parent(dir)
-            .ancestors()
-            .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
-            .last()
-            .map(Path::to_path_buf);
-        let notes = check_writable(dir, kind)?;
+        // Under the registry's lock from the check to the registration: an interrupting
+        // signal finds this staging folder registered, or none created yet.
+        let mut live = live();
+        let created = first_missing(dir);
+        let notes = check(dir, kind)?;
         let path = sibling(dir, "staging", std::process::id());
         let _ = std::fs::remove_dir_all(&path);
         std::fs::create_dir(&path).map_err(|e| {
@@ -146,10 +161,15 @@ impl Staging {
             )
         })?;
         let lock = std::fs::File::open(&path).ok().filter(try_lock);
+        let id = live.add(
+            Some(path.clone()),
+            created.clone().map(|top| (parent(dir), top)),
+        );
         let staging = Staging {
             target: dir.to_path_buf(),
             path,
             committed: false,
+            id,
             _lock: lock,
             created,
         };
@@ -165,44 +185,177 @@ impl Staging {
     /// has it (Linux renameat2), two renames otherwise; then remove the previous output.
     pub fn commit(mut self) -> Result<()> {
         let old = sibling(&self.target, "old", std::process::id());
+        // The swap holds the registry's lock, so an interrupting signal waits for it to end
+        // (see [`remove_live`]): the target is the previous output or the new one, never
+        // half swapped. What is left to remove afterwards, the previous output, is
+        // registered in place of the staging folder.
+        let mut live = live();
         if self.target.exists() {
             let exchanged =
                 exchange(&self.path, &self.target).map_err(|e| Error::io(&self.target, e))?;
-            if !exchanged {
+            let previous = if exchanged {
+                // The staging path now holds the previous output.
+                self.path.clone()
+            } else {
                 std::fs::rename(&self.target, &old).map_err(|e| Error::io(&self.target, e))?;
                 if let Err(e) = std::fs::rename(&self.path, &self.target) {
                     // Put the previous output back: the target is never left missing.
                     let _ = std::fs::rename(&old, &self.target);
                     return Err(Error::io(&self.target, e));
                 }
-                self.committed = true;
-                let _ = std::fs::remove_dir_all(&old);
-                return Ok(());
-            }
-            // The staging path now holds the previous output.
-            let _ = std::fs::remove_dir_all(&self.path);
+                old
+            };
+            self.committed = true;
+            live.set(self.id, Some(previous.clone()));
+            drop(live);
+            let _ = std::fs::remove_dir_all(&previous);
         } else {
             std::fs::rename(&self.path, &self.target).map_err(|e| Error::io(&self.target, e))?;
+            self.committed = true;
+            live.set(self.id, None);
         }
-        self.committed = true;
         Ok(())
     }
 }
 
 impl Drop for Staging {
     fn drop(&mut self) {
+        let mut live = live();
         if !self.committed {
             let _ = std::fs::remove_dir_all(&self.path);
-            // The folders this run created above the target, if they are still empty.
             if let Some(top) = &self.created {
-                for folder in parent(&self.target).ancestors() {
-                    if std::fs::remove_dir(folder).is_err() || folder == top {
-                        break;
-                    }
-                }
+                remove_created(&parent(&self.target), top);
             }
         }
+        live.remove(self.id);
     }
+}
+
+/// The folders of this process that an interrupted run removes: staging folders (or, once
+/// swapped in, the previous output they replaced) and the first folder above an output that
+/// a run created.
+struct Live {
+    entries: Vec<Entry>,
+    next_id: u64,
+}
+
+struct Entry {
+    id: u64,
+    /// A folder to remove whole.
+    folder: Option<PathBuf>,
+    /// (an output's parent, the first folder above the output the run created): the empty
+    /// folders from the first up to the second are removed.
+    created: Option<(PathBuf, PathBuf)>,
+}
+
+impl Live {
+    /// Register `folder` and `created` (see [`Entry`]); the entry's id.
+    fn add(&mut self, folder: Option<PathBuf>, created: Option<(PathBuf, PathBuf)>) -> u64 {
+        let id = self.next_id;
+        self.next_id += 1;
+        self.entries.push(Entry {
+            id,
+            folder,
+            created,
+        });
+        id
+    }
+
+    /// Entry `id` now has `folder` to remove and nothing created (its output is in place).
+    fn set(&mut self, id: u64, folder: Option<PathBuf>) {
+        if let Some(e) = self.entries.iter_mut().find(|e| e.id == id) {
+            e.folder = folder;
+            e.created = None;
+        }
+    }
+
+    fn remove(&mut self, id: u64) {
+        self.entries.retain(|e| e.id != id);
+    }
+}
+
+static LIVE: Mutex<Live> = Mutex::new(Live {
+    entries: Vec::new(),
+    next_id: 0,
+});
+
+/// The registry of live folders, locked (a panic elsewhere while it was held leaves it
+/// usable: every change to it is one push, one field set or one removal).
+fn live() -> MutexGuard<'static, Live> {
+    LIVE.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// The registry of live folders held after [`remove_live`]: while it is held no staging
+/// folder of this process is created, swapped in or removed.
+#[must_use = "hold it until the process exits: dropped, a run may go on writing"]
+pub struct Interrupted {
+    _live: MutexGuard<'static, Live>,
+    /// The folders removed, staging folders first in the order they were created.
+    pub removed: Vec<PathBuf>,
+}
+
+/// Remove what this process's runs have under way, for a run interrupted by a signal that
+/// is about to exit: every staging folder being written (or previous output being deleted
+/// after a swap) and, when they are empty again, the folders the runs created above their
+/// outputs. Waits for a swap under way to end (the target is then the new output). The
+/// returned value holds the registry locked: runs that go on meanwhile wait at their next
+/// staging step (a creation, a swap, a removal) instead of writing a new folder.
+pub fn remove_live() -> Interrupted {
+    let live = live();
+    let mut removed = Vec::new();
+    for e in &live.entries {
+        if let Some(folder) = &e.folder
+            && remove_busy(folder)
+        {
+            removed.push(folder.clone());
+        }
+    }
+    for e in &live.entries {
+        if let Some((below, top)) = &e.created {
+            remove_created(below, top);
+        }
+    }
+    Interrupted {
+        _live: live,
+        removed,
+    }
+}
+
+/// Remove the folder `path` whole while another thread may still be writing into it (the
+/// step-file writer of `solve`): a file created between the listing and the removal makes
+/// the removal fail, so retry, a bounded number of times. Whether `path` was there and is
+/// gone now.
+fn remove_busy(path: &Path) -> bool {
+    if std::fs::symlink_metadata(path).is_err() {
+        return false;
+    }
+    for _ in 0..200 {
+        let _ = std::fs::remove_dir_all(path);
+        if std::fs::symlink_metadata(path).is_err() {
+            return true;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    false
+}
+
+/// Remove the empty folders from `below` up to `top` (the first folder above an output
+/// that its run created), stopping at the first that is not empty.
+fn remove_created(below: &Path, top: &Path) {
+    for folder in below.ancestors() {
+        if std::fs::remove_dir(folder).is_err() || folder == top {
+            break;
+        }
+    }
+}
+
+/// The first folder above `dir` that does not exist yet (a run creates it and those below).
+fn first_missing(dir: &Path) -> Option<PathBuf> {
+    parent(dir)
+        .ancestors()
+        .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
+        .last()
+        .map(Path::to_path_buf)
 }
 
 /// Write a report folder all or nothing (see [`Staging`]).

@@ -9,4 +9,4 @@ pub mod markdown;
 pub mod plot;
 pub mod solve_output;
 
-pub use folder::{Output, Staging, check_writable, reports_dir, write_folder};
+pub use folder::{Output, Staging, check_writable, remove_live, reports_dir, write_folder};
