@@ -43,10 +43,14 @@ enum Command {
         #[arg(long)]
         merge: bool,
     },
-    /// Print the README's Results section, read from the committed reports' CSVs
+    /// Print the Results page docs/results.md, read from the committed reports' CSVs
     /// (reports/rates, rates-exact, rates-exact-vp, patch, two-size-exact, two-size-rates,
     /// speed, stability).
-    Results,
+    Results {
+        /// Print instead README.md's headline table (between its `headline` markers).
+        #[arg(long)]
+        headline: bool,
+    },
     /// The built-in scenes (`scene list`).
     Scene {
         #[command(subcommand)]
@@ -124,11 +128,13 @@ fn run() -> anyhow::Result<()> {
             shard,
             merge,
         } => study(&name, out, shard.as_deref(), merge),
-        Command::Results => {
-            print!(
-                "{}",
-                contact_rates::results::section(&report::reports_dir())?
-            );
+        Command::Results { headline } => {
+            let reports = report::reports_dir();
+            if headline {
+                print!("{}", contact_rates::results::headline(&reports)?);
+            } else {
+                print!("{}", contact_rates::results::section(&reports)?);
+            }
             Ok(())
         }
         Command::Scene {

@@ -1,4 +1,4 @@
-//! Reference: issue "Scenes are data" and the README section "Adding a scene".
+//! Reference: issue "Scenes are data" and docs/scenes.md, "Adding a scene".
 //! Goal: a user adds a scene (a .geo and a TOML file) outside the repo and runs `solve` and
 //! a small `study` on it with both cones, without writing Rust; a body that nothing holds
 //! gets a warning that says so.

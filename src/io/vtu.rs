@@ -228,9 +228,9 @@ impl StateFile {
     /// Both bodies at `state`: point data `displacement` (x, y, 0), `pressure` and
     /// `normal_jump` (at the slave nodes of Gamma_C from `contact`, zero elsewhere); cell
     /// data `body` and `stress` (s11 s22 s12, the solver's P0 stress). Units are the
-    /// scene's. The von Mises stress is not written: it is a function of `stress` (the
-    /// README gives ParaView's Calculator expression), and it would be 15% of a file that
-    /// does not compress.
+    /// scene's. The von Mises stress is not written: it is a function of `stress`
+    /// (docs/solve.md gives ParaView's Calculator expression), and it would be 15% of a file
+    /// that does not compress.
     pub fn file(&self, state: &State, contact: &[ContactNode]) -> Vec<u8> {
         let np = self.mesh.points;
         let displacement: Vec<f64> = (0..np)
