@@ -271,29 +271,115 @@ fn outward_normals(
         .collect()
 }
 
-fn edges_of(
-    raw: &RawMesh,
-    meshes: &[BodyMesh; 2],
+/// The physical curves of the two body meshes read from `mesh_file`, in the model's global
+/// node numbering (body b's nodes start at `offsets[b]`).
+struct Curves<'a> {
+    raw: &'a RawMesh,
+    meshes: &'a [BodyMesh; 2],
     offsets: [usize; 2],
-    curve: &str,
-    mesh_file: &Path,
-    scene_key: &str,
-) -> Result<Vec<(usize, [usize; 2])>> {
-    raw.require_curve(curve, mesh_file, scene_key)?;
-    let mut out = Vec::new();
-    for b in 0..2 {
-        for e in meshes[b].curve_edges(raw, curve) {
-            out.push((b, [e[0] + offsets[b], e[1] + offsets[b]]));
+    mesh_file: &'a Path,
+}
+
+impl Curves<'_> {
+    /// The edges of `curve` on either body as (body, global node pair); errs where the mesh
+    /// has no such curve (named by the scene's `scene_key`) or it has no edge.
+    fn edges(&self, curve: &str, scene_key: &str) -> Result<Vec<(usize, [usize; 2])>> {
+        let (raw, meshes, offsets, mesh_file) =
+            (self.raw, self.meshes, self.offsets, self.mesh_file);
+        raw.require_curve(curve, mesh_file, scene_key)?;
+        let mut out = Vec::new();
+        for b in 0..2 {
+            for e in meshes[b].curve_edges(raw, curve) {
+                out.push((b, [e[0] + offsets[b], e[1] + offsets[b]]));
+            }
+        }
+        if out.is_empty() {
+            return Err(Error::input(
+                mesh_file,
+                curve,
+                format!("physical curve '{curve}' has no edge on either body; check the .geo"),
+            ));
+        }
+        Ok(out)
+    }
+
+    /// The position of global node `g`.
+    fn position(&self, g: usize) -> [f64; 2] {
+        if g < self.offsets[1] {
+            self.meshes[0].nodes[g]
+        } else {
+            self.meshes[1].nodes[g - self.offsets[1]]
         }
     }
-    if out.is_empty() {
-        return Err(Error::input(
-            mesh_file,
-            curve,
-            format!("physical curve '{curve}' has no edge on either body; check the .geo"),
-        ));
+}
+
+/// The P1 elements of both bodies, body 1's first, with global node numbers.
+fn body_elements(meshes: &[BodyMesh; 2], node_offset: [usize; 2]) -> Vec<Element> {
+    let mut elements = Vec::new();
+    for b in 0..2 {
+        for t in &meshes[b].triangles {
+            let p = t.map(|i| meshes[b].nodes[i]);
+            let (area, grads) = p1_gradients(p);
+            elements.push(Element {
+                body: b,
+                nodes: t.map(|i| i + node_offset[b]),
+                area,
+                grads,
+            });
+        }
     }
-    Ok(out)
+    elements
+}
+
+/// Which of the `2 n_nodes` dofs are held: both components on the clamped curves, the
+/// roller's component on each roller curve (which must be straight along the other axis).
+fn fixed_dofs(scene: &Scene, curves: &Curves, n_nodes: usize) -> Result<Vec<bool>> {
+    let mut fixed = vec![false; 2 * n_nodes];
+    for c in &scene.clamps {
+        for (_, e) in curves.edges(c, "clamp.curve")? {
+            for n in e {
+                fixed[2 * n] = true;
+                fixed[2 * n + 1] = true;
+            }
+        }
+    }
+    for r in &scene.rollers {
+        for (_, e) in curves.edges(&r.curve, "roller.curve")? {
+            let (a, b) = (curves.position(e[0]), curves.position(e[1]));
+            let d = [b[0] - a[0], b[1] - a[1]];
+            let len = d[0].hypot(d[1]);
+            // A roller holding u_x lies on a vertical edge, one holding u_y on a horizontal one.
+            if d[r.component].abs() > 1e-9 * len {
+                return Err(Error::input(
+                    &scene.file,
+                    format!("roller '{}'", r.curve),
+                    format!(
+                        "a roller holding u_{} needs a {} curve, but an edge runs from {a:?} to {b:?}; use a clamp or fix the geometry",
+                        ["x", "y"][r.component],
+                        ["vertical", "horizontal"][r.component]
+                    ),
+                ));
+            }
+            for n in e {
+                fixed[2 * n + r.component] = true;
+            }
+        }
+    }
+    Ok(fixed)
+}
+
+/// The equation number of each dof ([`FIXED`] where `fixed`), in dof order, and the number
+/// of equations.
+fn number_equations(fixed: &[bool]) -> (Vec<usize>, usize) {
+    let mut equation = vec![FIXED; fixed.len()];
+    let mut n_free = 0;
+    for (d, f) in fixed.iter().enumerate() {
+        if !f {
+            equation[d] = n_free;
+            n_free += 1;
+        }
+    }
+    (equation, n_free)
 }
 
 impl Model {
@@ -304,88 +390,24 @@ impl Model {
         let meshes = [m0, m1];
         let node_offset = [0, meshes[0].nodes.len()];
         let n_nodes = node_offset[1] + meshes[1].nodes.len();
-        let mut elements = Vec::new();
-        for b in 0..2 {
-            for t in &meshes[b].triangles {
-                let p = t.map(|i| meshes[b].nodes[i]);
-                let (area, grads) = p1_gradients(p);
-                elements.push(Element {
-                    body: b,
-                    nodes: t.map(|i| i + node_offset[b]),
-                    area,
-                    grads,
-                });
-            }
-        }
-        let mut fixed = vec![false; 2 * n_nodes];
-        for c in &scene.clamps {
-            for (_, e) in edges_of(raw, &meshes, node_offset, c, mesh_file, "clamp.curve")? {
-                for n in e {
-                    fixed[2 * n] = true;
-                    fixed[2 * n + 1] = true;
-                }
-            }
-        }
-        let model_pos = |g: usize| -> [f64; 2] {
-            if g < node_offset[1] {
-                meshes[0].nodes[g]
-            } else {
-                meshes[1].nodes[g - node_offset[1]]
-            }
+        let elements = body_elements(&meshes, node_offset);
+        let curves = Curves {
+            raw,
+            meshes: &meshes,
+            offsets: node_offset,
+            mesh_file,
         };
-        for r in &scene.rollers {
-            for (_, e) in edges_of(
-                raw,
-                &meshes,
-                node_offset,
-                &r.curve,
-                mesh_file,
-                "roller.curve",
-            )? {
-                let (a, b) = (model_pos(e[0]), model_pos(e[1]));
-                let d = [b[0] - a[0], b[1] - a[1]];
-                let len = d[0].hypot(d[1]);
-                // A roller holding u_x lies on a vertical edge, one holding u_y on a horizontal one.
-                if d[r.component].abs() > 1e-9 * len {
-                    return Err(Error::input(
-                        &scene.file,
-                        format!("roller '{}'", r.curve),
-                        format!(
-                            "a roller holding u_{} needs a {} curve, but an edge runs from {a:?} to {b:?}; use a clamp or fix the geometry",
-                            ["x", "y"][r.component],
-                            ["vertical", "horizontal"][r.component]
-                        ),
-                    ));
-                }
-                for n in e {
-                    fixed[2 * n + r.component] = true;
-                }
-            }
-        }
-        let mut equation = vec![FIXED; 2 * n_nodes];
-        let mut n_free = 0;
-        for (d, f) in fixed.iter().enumerate() {
-            if !f {
-                equation[d] = n_free;
-                n_free += 1;
-            }
-        }
+        let fixed = fixed_dofs(scene, &curves, n_nodes)?;
+        let (equation, n_free) = number_equations(&fixed);
         let mut traction_edges = Vec::new();
         for (i, t) in scene.tractions.iter().enumerate() {
-            for (_, e) in edges_of(
-                raw,
-                &meshes,
-                node_offset,
-                &t.curve,
-                mesh_file,
-                "traction.curve",
-            )? {
+            for (_, e) in curves.edges(&t.curve, "traction.curve")? {
                 traction_edges.push((i, e));
             }
         }
         // Only derived tractions need the normals.
         let traction_normals = if scene.tractions.iter().any(|t| t.g.is_none()) {
-            outward_normals(&elements, &traction_edges, model_pos)
+            outward_normals(&elements, &traction_edges, |g| curves.position(g))
         } else {
             Vec::new()
         };

@@ -320,193 +320,36 @@ impl Scene {
         Self::validate(sf, file)
     }
 
-    /// Validate a parsed scene file; `file` locates the .geo and names errors.
+    /// Validate a parsed scene file; `file` locates the .geo and names errors. One check per
+    /// table, in a fixed order (the first error found is the one reported).
     fn validate(sf: SceneFile, file: &Path) -> Result<Self> {
         let name = file
             .file_stem()
             .map(|s| s.to_string_lossy().to_string())
             .unwrap_or_default();
-        let dir = file.parent().unwrap_or(Path::new("."));
-        let geo = dir.join(&sf.geo);
-        if !geo.exists() {
-            return Err(Error::input(
-                file,
-                "geo",
-                format!(
-                    "the .geo file {} does not exist; give its path relative to the scene file",
-                    geo.display()
-                ),
-            ));
-        }
-        check_positive(file, "final_time", sf.final_time, "final_time")?;
-        if sf.steps == 0 {
-            return Err(Error::input(
-                file,
-                "steps",
-                "steps must be at least 1; fix the value",
-            ));
-        }
-        if sf.bodies.len() != 2 {
-            return Err(Error::input(
-                file,
-                "bodies",
-                format!(
-                    "a scene has exactly two [[bodies]], found {}",
-                    sf.bodies.len()
-                ),
-            ));
-        }
-        let mut bodies = Vec::new();
-        for (i, b) in sf.bodies.iter().enumerate() {
-            let f = |k: &str| format!("bodies[{i}].{k}");
-            check_positive(file, &f("young"), b.young, "Young's modulus")?;
-            if !(b.poisson > -1.0 && b.poisson < 0.5) {
-                return Err(Error::input(
-                    file,
-                    f("poisson"),
-                    format!(
-                        "Poisson's ratio must lie in (-1, 0.5), got {}; fix the value",
-                        b.poisson
-                    ),
-                ));
-            }
-            let viscoplastic = match (b.lambda, b.yield_stress) {
-                (None, None) => None,
-                (Some(l), Some(y)) => {
-                    check_positive(file, &f("lambda"), l, "the viscosity lambda")?;
-                    check_positive(file, &f("yield_stress"), y, "the yield stress")?;
-                    Some(Viscoplasticity {
-                        lambda: l,
-                        yield_stress: y,
-                    })
-                }
-                (Some(_), None) => {
-                    return Err(Error::input(
-                        file,
-                        f("yield_stress"),
-                        "lambda is given without yield_stress; give both for a viscoplastic body or neither for an elastic one",
-                    ));
-                }
-                (None, Some(_)) => {
-                    return Err(Error::input(
-                        file,
-                        f("lambda"),
-                        "yield_stress is given without lambda; give both for a viscoplastic body or neither for an elastic one",
-                    ));
-                }
-            };
-            let body_force = b
-                .body_force
-                .as_ref()
-                .map(|e| VectorExpr::parse(e, file, &f("body_force")))
-                .transpose()?;
-            bodies.push(SceneBody {
-                surface: b.surface.clone(),
-                material: Material {
-                    elastic: Elasticity {
-                        young: b.young,
-                        poisson: b.poisson,
-                    },
-                    viscoplastic,
-                },
-                body_force,
-            });
-        }
-        let slave = bodies
-            .iter()
-            .position(|b| b.surface == sf.contact.slave_body)
-            .ok_or_else(|| {
-                Error::input(
-                    file,
-                    "contact.slave_body",
-                    format!(
-                        "'{}' is not the surface of either body ({}, {})",
-                        sf.contact.slave_body, bodies[0].surface, bodies[1].surface
-                    ),
-                )
-            })?;
-        if slave == 1 {
-            bodies.swap(0, 1);
-        }
-        let mut claimed: BTreeMap<String, &str> = BTreeMap::new();
-        let mut claim = |curve: &str, what: &'static str, field: String| -> Result<()> {
-            if let Some(prev) = claimed.insert(curve.to_string(), what) {
-                return Err(Error::input(
-                    file,
-                    field,
-                    format!(
-                        "curve '{curve}' is claimed twice ({prev} and {what}); a boundary part takes one condition: split it into two physical curves or drop one"
-                    ),
-                ));
-            }
-            Ok(())
-        };
+        let geo = geo_path(&sf.geo, file)?;
+        check_time(sf.final_time, sf.steps, file)?;
+        let mut bodies = bodies(&sf.bodies, file)?;
+        let swapped = slave_first(&mut bodies, &sf.contact, file)?;
+        let mut claims = Claims::new(file);
         for (i, c) in sf.clamp.iter().enumerate() {
-            claim(&c.curve, "clamp", format!("clamp[{i}].curve"))?;
+            claims.claim(&c.curve, "clamp", format!("clamp[{i}].curve"))?;
         }
-        let mut rollers = Vec::new();
-        for (i, r) in sf.roller.iter().enumerate() {
-            claim(&r.curve, "roller", format!("roller[{i}].curve"))?;
-            let component = match r.component.as_str() {
-                "x" => 0,
-                "y" => 1,
-                other => {
-                    return Err(Error::input(
-                        file,
-                        format!("roller[{i}].component"),
-                        format!("'{other}' is not a component; use \"x\" or \"y\""),
-                    ));
-                }
-            };
-            rollers.push(Roller {
-                curve: r.curve.clone(),
-                component,
-            });
-        }
+        let rollers = rollers(&sf.roller, &mut claims, file)?;
         let manufactured = sf.exact.as_ref().is_some_and(|e| e.manufactured);
-        let mut tractions = Vec::new();
-        for (i, t) in sf.traction.iter().enumerate() {
-            claim(&t.curve, "traction", format!("traction[{i}].curve"))?;
-            let g = match (&t.g, manufactured) {
-                (Some(g), false) => Some(VectorExpr::parse(g, file, &format!("traction[{i}].g"))?),
-                (None, true) => None,
-                (None, false) => {
-                    return Err(Error::input(
-                        file,
-                        format!("traction[{i}].g"),
-                        "missing; give g = [\"gx\", \"gy\"] (only a manufactured scene derives it)",
-                    ));
-                }
-                (Some(_), true) => {
-                    return Err(Error::input(
-                        file,
-                        format!("traction[{i}].g"),
-                        "a manufactured scene derives g = sigma n from the exact fields; remove g",
-                    ));
-                }
-            };
-            tractions.push(Traction {
-                curve: t.curve.clone(),
-                g,
-            });
-        }
-        claim(
+        let tractions = tractions(&sf.traction, manufactured, &mut claims, file)?;
+        claims.claim(
             &sf.contact.slave_curve,
             "contact",
             "contact.slave_curve".into(),
         )?;
-        claim(
+        claims.claim(
             &sf.contact.master_curve,
             "contact",
             "contact.master_curve".into(),
         )?;
         let exact = match &sf.exact {
-            Some(spec) => Some(Box::new(exact_solution(
-                spec,
-                &mut bodies,
-                slave == 1,
-                file,
-            )?)),
+            Some(spec) => Some(Box::new(exact_solution(spec, &mut bodies, swapped, file)?)),
             None => None,
         };
         let [b0, b1]: [SceneBody; 2] = bodies.try_into().expect("two bodies");
@@ -529,6 +372,224 @@ impl Scene {
     }
 }
 
+/// The `geo` key: the .geo file relative to the scene file, which must exist.
+fn geo_path(geo: &Path, file: &Path) -> Result<PathBuf> {
+    let dir = file.parent().unwrap_or(Path::new("."));
+    let geo = dir.join(geo);
+    if !geo.exists() {
+        return Err(Error::input(
+            file,
+            "geo",
+            format!(
+                "the .geo file {} does not exist; give its path relative to the scene file",
+                geo.display()
+            ),
+        ));
+    }
+    Ok(geo)
+}
+
+/// The `final_time` and `steps` keys: a positive interval and at least one step.
+fn check_time(final_time: f64, steps: usize, file: &Path) -> Result<()> {
+    check_positive(file, "final_time", final_time, "final_time")?;
+    if steps == 0 {
+        return Err(Error::input(
+            file,
+            "steps",
+            "steps must be at least 1; fix the value",
+        ));
+    }
+    Ok(())
+}
+
+/// The `[[bodies]]` tables: exactly two, each with its material and body force, in file
+/// order.
+fn bodies(specs: &[BodySpec], file: &Path) -> Result<Vec<SceneBody>> {
+    if specs.len() != 2 {
+        return Err(Error::input(
+            file,
+            "bodies",
+            format!("a scene has exactly two [[bodies]], found {}", specs.len()),
+        ));
+    }
+    specs
+        .iter()
+        .enumerate()
+        .map(|(i, b)| body(i, b, file))
+        .collect()
+}
+
+/// Body `i` of the `[[bodies]]` tables: elastic constants, the viscoplastic pair (both or
+/// neither), and the body force.
+fn body(i: usize, b: &BodySpec, file: &Path) -> Result<SceneBody> {
+    let f = |k: &str| format!("bodies[{i}].{k}");
+    check_positive(file, &f("young"), b.young, "Young's modulus")?;
+    if !(b.poisson > -1.0 && b.poisson < 0.5) {
+        return Err(Error::input(
+            file,
+            f("poisson"),
+            format!(
+                "Poisson's ratio must lie in (-1, 0.5), got {}; fix the value",
+                b.poisson
+            ),
+        ));
+    }
+    let viscoplastic = match (b.lambda, b.yield_stress) {
+        (None, None) => None,
+        (Some(l), Some(y)) => {
+            check_positive(file, &f("lambda"), l, "the viscosity lambda")?;
+            check_positive(file, &f("yield_stress"), y, "the yield stress")?;
+            Some(Viscoplasticity {
+                lambda: l,
+                yield_stress: y,
+            })
+        }
+        (Some(_), None) => {
+            return Err(Error::input(
+                file,
+                f("yield_stress"),
+                "lambda is given without yield_stress; give both for a viscoplastic body or neither for an elastic one",
+            ));
+        }
+        (None, Some(_)) => {
+            return Err(Error::input(
+                file,
+                f("lambda"),
+                "yield_stress is given without lambda; give both for a viscoplastic body or neither for an elastic one",
+            ));
+        }
+    };
+    let body_force = b
+        .body_force
+        .as_ref()
+        .map(|e| VectorExpr::parse(e, file, &f("body_force")))
+        .transpose()?;
+    Ok(SceneBody {
+        surface: b.surface.clone(),
+        material: Material {
+            elastic: Elasticity {
+                young: b.young,
+                poisson: b.poisson,
+            },
+            viscoplastic,
+        },
+        body_force,
+    })
+}
+
+/// `[contact] slave_body`: puts the slave first in `bodies`; true when the file lists it
+/// second (the order swapped).
+fn slave_first(bodies: &mut [SceneBody], contact: &ContactSpec, file: &Path) -> Result<bool> {
+    let slave = bodies
+        .iter()
+        .position(|b| b.surface == contact.slave_body)
+        .ok_or_else(|| {
+            Error::input(
+                file,
+                "contact.slave_body",
+                format!(
+                    "'{}' is not the surface of either body ({}, {})",
+                    contact.slave_body, bodies[0].surface, bodies[1].surface
+                ),
+            )
+        })?;
+    if slave == 1 {
+        bodies.swap(0, 1);
+    }
+    Ok(slave == 1)
+}
+
+/// The boundary curves claimed so far, and by which condition: a curve takes one.
+struct Claims<'f> {
+    file: &'f Path,
+    claimed: BTreeMap<String, &'static str>,
+}
+
+impl<'f> Claims<'f> {
+    fn new(file: &'f Path) -> Self {
+        Claims {
+            file,
+            claimed: BTreeMap::new(),
+        }
+    }
+
+    /// Claim `curve` for the condition `what` (named `field` in the file); errs on a curve
+    /// claimed before.
+    fn claim(&mut self, curve: &str, what: &'static str, field: String) -> Result<()> {
+        if let Some(prev) = self.claimed.insert(curve.to_string(), what) {
+            return Err(Error::input(
+                self.file,
+                field,
+                format!(
+                    "curve '{curve}' is claimed twice ({prev} and {what}); a boundary part takes one condition: split it into two physical curves or drop one"
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The `[[roller]]` tables: each curve claimed, its component "x" or "y".
+fn rollers(specs: &[RollerSpec], claims: &mut Claims, file: &Path) -> Result<Vec<Roller>> {
+    let mut rollers = Vec::new();
+    for (i, r) in specs.iter().enumerate() {
+        claims.claim(&r.curve, "roller", format!("roller[{i}].curve"))?;
+        let component = match r.component.as_str() {
+            "x" => 0,
+            "y" => 1,
+            other => {
+                return Err(Error::input(
+                    file,
+                    format!("roller[{i}].component"),
+                    format!("'{other}' is not a component; use \"x\" or \"y\""),
+                ));
+            }
+        };
+        rollers.push(Roller {
+            curve: r.curve.clone(),
+            component,
+        });
+    }
+    Ok(rollers)
+}
+
+/// The `[[traction]]` tables: each curve claimed, with its g, or none in a manufactured
+/// scene (which derives it).
+fn tractions(
+    specs: &[TractionSpec],
+    manufactured: bool,
+    claims: &mut Claims,
+    file: &Path,
+) -> Result<Vec<Traction>> {
+    let mut tractions = Vec::new();
+    for (i, t) in specs.iter().enumerate() {
+        claims.claim(&t.curve, "traction", format!("traction[{i}].curve"))?;
+        let g = match (&t.g, manufactured) {
+            (Some(g), false) => Some(VectorExpr::parse(g, file, &format!("traction[{i}].g"))?),
+            (None, true) => None,
+            (None, false) => {
+                return Err(Error::input(
+                    file,
+                    format!("traction[{i}].g"),
+                    "missing; give g = [\"gx\", \"gy\"] (only a manufactured scene derives it)",
+                ));
+            }
+            (Some(_), true) => {
+                return Err(Error::input(
+                    file,
+                    format!("traction[{i}].g"),
+                    "a manufactured scene derives g = sigma n from the exact fields; remove g",
+                ));
+            }
+        };
+        tractions.push(Traction {
+            curve: t.curve.clone(),
+            g,
+        });
+    }
+    Ok(tractions)
+}
+
 /// The scene's exact solution from its `[exact]` table; `bodies` are in slave-first order
 /// (`swapped`: the file lists the master first). A manufactured solution's body forces are
 /// set on `bodies`.
@@ -539,69 +600,15 @@ fn exact_solution(
     file: &Path,
 ) -> Result<Exact> {
     let order = |b: usize| if swapped { 1 - b } else { b };
-    let displacement = match &spec.displacement {
-        Some(d) => Some([0, 1].map(|b| {
-            let i = order(b);
-            [0, 1].map(|c| Expr::parse(&d[i][c], file, &format!("exact.displacement[{i}][{c}]")))
-        })),
-        None => None,
-    };
-    let displacement = match displacement {
-        Some([[a, b], [c, d]]) => Some([[a?, b?], [c?, d?]]),
-        None => None,
-    };
-    let mut stress = Vec::new();
-    let mut asymmetry = [None, None];
-    for b in 0..2 {
-        if let Some(spec) = &spec.stress {
-            let (field, s, s21) = spec.of(order(b));
-            stress.push([
-                Expr::parse(s[0], file, &format!("{field}[0]"))?,
-                Expr::parse(s[1], file, &format!("{field}[1]"))?,
-                Expr::parse(s[2], file, &format!("{field}[2]"))?,
-            ]);
-            if let Some(s21) = s21 {
-                let s21 = Expr::parse(s21, file, &format!("{field}[1][0]"))?;
-                asymmetry[b] = Some(Expr::combine(&[(1.0, &stress[b][2]), (-1.0, &s21)]));
-            }
-        }
-    }
-    let stress: Option<[[Expr; 3]; 2]> = stress.try_into().ok();
+    let displacement = exact_displacement(spec, order, file)?;
+    let (stress, asymmetry) = exact_stress(spec, order, file)?;
     let pressure = spec
         .pressure
         .as_ref()
         .map(|p| Expr::parse(p, file, "exact.pressure"))
         .transpose()?;
     if spec.manufactured {
-        if displacement.is_none() {
-            return Err(Error::input(
-                file,
-                "exact.manufactured",
-                "a manufactured solution needs exact.displacement = [[\"ux\", \"uy\"], [\"ux\", \"uy\"]], one pair per body",
-            ));
-        }
-        for b in bodies.iter() {
-            if b.material.viscoplastic.is_some() && stress.is_none() {
-                return Err(Error::input(
-                    file,
-                    "exact.stress",
-                    format!(
-                        "body '{}' is viscoplastic: the constitutive source s = d sigma/dt - E eps(du/dt) - G(sigma) of a manufactured solution needs its stress; give exact.stress = [[\"s11\", \"s22\", \"s12\"], [\"s11\", \"s22\", \"s12\"]], one per body (or remove lambda and yield_stress for an elastic body)",
-                        b.surface
-                    ),
-                ));
-            }
-            if b.body_force.is_some() {
-                return Err(Error::input(
-                    file,
-                    "exact.manufactured",
-                    format!(
-                        "body '{}' gives a body_force; a manufactured scene derives it from the exact fields: remove it",
-                        b.surface
-                    ),
-                ));
-            }
-        }
+        check_manufactured(displacement.is_some(), stress.is_some(), bodies, file)?;
     }
     let mut exact = Exact::new(
         displacement,
@@ -627,4 +634,91 @@ fn exact_solution(
         ));
     }
     Ok(exact)
+}
+
+/// `exact.displacement` per body in slave-first order (`order` maps it to file order).
+fn exact_displacement(
+    spec: &ExactSpec,
+    order: impl Fn(usize) -> usize,
+    file: &Path,
+) -> Result<Option<[[Expr; 2]; 2]>> {
+    let displacement = spec.displacement.as_ref().map(|d| {
+        [0, 1].map(|b| {
+            let i = order(b);
+            [0, 1].map(|c| Expr::parse(&d[i][c], file, &format!("exact.displacement[{i}][{c}]")))
+        })
+    });
+    Ok(match displacement {
+        Some([[a, b], [c, d]]) => Some([[a?, b?], [c?, d?]]),
+        None => None,
+    })
+}
+
+/// An exact stress [s11, s22, s12] per body, slave first.
+type BodyStresses = [[Expr; 3]; 2];
+
+/// `exact.stress` per body in slave-first order (`order` maps it to file order) as [s11,
+/// s22, s12], and per body s12 - s21 where the tensor form gives an s21 of another text.
+fn exact_stress(
+    spec: &ExactSpec,
+    order: impl Fn(usize) -> usize,
+    file: &Path,
+) -> Result<(Option<BodyStresses>, [Option<Expr>; 2])> {
+    let mut stress = Vec::new();
+    let mut asymmetry = [None, None];
+    for b in 0..2 {
+        if let Some(spec) = &spec.stress {
+            let (field, s, s21) = spec.of(order(b));
+            stress.push([
+                Expr::parse(s[0], file, &format!("{field}[0]"))?,
+                Expr::parse(s[1], file, &format!("{field}[1]"))?,
+                Expr::parse(s[2], file, &format!("{field}[2]"))?,
+            ]);
+            if let Some(s21) = s21 {
+                let s21 = Expr::parse(s21, file, &format!("{field}[1][0]"))?;
+                asymmetry[b] = Some(Expr::combine(&[(1.0, &stress[b][2]), (-1.0, &s21)]));
+            }
+        }
+    }
+    Ok((stress.try_into().ok(), asymmetry))
+}
+
+/// `exact.manufactured = true` derives the loads from the fields: it needs the
+/// displacement, the stress of a viscoplastic body, and no body force given.
+fn check_manufactured(
+    has_displacement: bool,
+    has_stress: bool,
+    bodies: &[SceneBody],
+    file: &Path,
+) -> Result<()> {
+    if !has_displacement {
+        return Err(Error::input(
+            file,
+            "exact.manufactured",
+            "a manufactured solution needs exact.displacement = [[\"ux\", \"uy\"], [\"ux\", \"uy\"]], one pair per body",
+        ));
+    }
+    for b in bodies.iter() {
+        if b.material.viscoplastic.is_some() && !has_stress {
+            return Err(Error::input(
+                file,
+                "exact.stress",
+                format!(
+                    "body '{}' is viscoplastic: the constitutive source s = d sigma/dt - E eps(du/dt) - G(sigma) of a manufactured solution needs its stress; give exact.stress = [[\"s11\", \"s22\", \"s12\"], [\"s11\", \"s22\", \"s12\"]], one per body (or remove lambda and yield_stress for an elastic body)",
+                    b.surface
+                ),
+            ));
+        }
+        if b.body_force.is_some() {
+            return Err(Error::input(
+                file,
+                "exact.manufactured",
+                format!(
+                    "body '{}' gives a body_force; a manufactured scene derives it from the exact fields: remove it",
+                    b.surface
+                ),
+            ));
+        }
+    }
+    Ok(())
 }

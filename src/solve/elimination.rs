@@ -230,159 +230,231 @@ impl Elimination {
         lambda: &mut [f64],
         tol: f64,
     ) -> Relaxed {
-        // The unknowns: free dofs of the triangles' nodes, in increasing order.
-        let mut dofs: Vec<usize> = triangles
-            .iter()
-            .flat_map(|&i| model.elements[i].dofs())
-            .filter(|&d| model.equation[d] != FIXED)
-            .collect();
-        dofs.sort_unstable();
-        dofs.dedup();
-        // An active row through them moves with its multiplier all its dofs: they join.
-        let mut joined: Vec<usize> = (0..step.rows.len())
-            .filter(|&i| step.active[i])
-            .filter(|&i| {
-                step.rows[i]
-                    .entries
-                    .iter()
-                    .any(|(d, _)| dofs.binary_search(d).is_ok())
-            })
-            .flat_map(|i| step.rows[i].entries.iter().map(|&(d, _)| d))
-            .filter(|&d| model.equation[d] != FIXED)
-            .collect();
-        dofs.append(&mut joined);
-        dofs.sort_unstable();
-        dofs.dedup();
-        if dofs.is_empty() {
+        let Some(local) = LocalProblem::new(self, model, step, triangles) else {
             return Relaxed::default();
-        }
-        // Every triangle touching them contributes to their residual.
-        let mut patch: Vec<usize> = dofs
-            .iter()
-            .flat_map(|&d| self.node_elements(model)[d / 2].iter().copied())
-            .collect();
-        patch.sort_unstable();
-        patch.dedup();
-        let local = |d: usize| dofs.binary_search(&d).ok();
-        let residual = |u: &[f64], mut jacobian: Option<&mut LocalMatrix>| -> DVector<f64> {
-            let mut r = DVector::from_iterator(dofs.len(), dofs.iter().map(|&d| -step.f_ext[d]));
-            for &i in &patch {
-                let e = &model.elements[i];
-                let (m, trial) = model.trial_stress(
-                    i,
-                    u,
-                    step.strain_prev,
-                    step.sigma_prev,
-                    step.k,
-                    step.source,
-                );
-                let (s, d) = m.update(&trial, step.k);
-                let fe = e.internal_force(&s);
-                let ke = jacobian.as_ref().map(|_| e.stiffness(&d));
-                let ed = e.dofs();
-                for (a, &da) in ed.iter().enumerate() {
-                    let Some(la) = local(da) else { continue };
-                    r[la] += fe[a];
-                    if let (Some(j), Some(ke)) = (jacobian.as_deref_mut(), ke.as_ref()) {
-                        for (b, &db) in ed.iter().enumerate() {
-                            if let Some(lb) = local(db) {
-                                j.add(la, lb, ke[(a, b)]);
-                            }
-                        }
-                    }
-                }
-            }
-            r
         };
-        // Active rows through the unknowns keep their gaps: the local KKT system
-        // [J C^T; C 0] with C their entries at the unknowns (C dx = 0 keeps each gap).
-        let constrained: Vec<(usize, Vec<(usize, f64)>)> = (0..step.rows.len())
-            .filter(|&i| step.active[i])
-            .filter_map(|i| {
-                let c: Vec<(usize, f64)> = step.rows[i]
-                    .entries
-                    .iter()
-                    .filter_map(|&(d, v)| local(d).map(|l| (l, v)))
-                    .collect();
-                (!c.is_empty()).then_some((i, c))
-            })
-            .collect();
-        let (nl, nc) = (dofs.len(), constrained.len());
+        let (nl, nc) = (local.dofs.len(), local.constrained.len());
         let mut multipliers = vec![0.0; nc];
-        let with_contact = |mut r: DVector<f64>, multipliers: &[f64]| {
-            for ((_, c), m) in constrained.iter().zip(multipliers) {
-                for &(l, v) in c {
-                    r[l] += v * m;
-                }
-            }
-            r
-        };
         let mut iterations = 0;
-        // The KKT matrix: the Jacobian's block (accumulated by `residual`) and the rows'.
-        let mut kkt = LocalMatrix::new(nl + nc, || {
-            let mut entries: Vec<(usize, usize)> = (0..nl + nc).map(|i| (i, i)).collect();
-            for &i in &patch {
-                let ed: Vec<usize> = model.elements[i]
-                    .dofs()
-                    .iter()
-                    .filter_map(|&d| local(d))
-                    .collect();
-                entries.extend(ed.iter().flat_map(|&a| ed.iter().map(move |&b| (a, b))));
-            }
-            for (j, (_, c)) in constrained.iter().enumerate() {
-                entries.extend(c.iter().flat_map(|&(l, _)| [(l, nl + j), (nl + j, l)]));
-            }
-            entries
-        });
-        let mut r = with_contact(residual(u, Some(&mut kkt)), &multipliers);
+        let mut kkt = local.kkt_matrix();
+        let mut r = local.with_contact(local.residual(u, Some(&mut kkt)), &multipliers);
         while r.amax() > tol && iterations < LOCAL_ITERATIONS {
-            for (j, (_, c)) in constrained.iter().enumerate() {
-                for &(l, v) in c {
-                    kkt.add(l, nl + j, v);
-                    kkt.add(nl + j, l, v);
-                }
-            }
+            local.add_rows(&mut kkt);
             let mut rhs = DVector::zeros(nl + nc);
             rhs.rows_mut(0, nl).copy_from(&(-&r));
             let Some(dx) = kkt.solve(rhs) else {
                 break;
             };
-            let start: Vec<f64> = dofs.iter().map(|&d| u[d]).collect();
-            let start_multipliers = multipliers.clone();
-            let reference = r.norm_squared();
-            let mut alpha = 1.0;
-            let mut accepted = false;
-            for _ in 0..30 {
-                for (l, &d) in dofs.iter().enumerate() {
-                    u[d] = start[l] + alpha * dx[l];
-                }
-                for (j, m) in multipliers.iter_mut().enumerate() {
-                    *m = start_multipliers[j] + alpha * dx[nl + j];
-                }
-                let trial = with_contact(residual(u, None), &multipliers);
-                if trial.norm_squared() <= (1.0 - 1e-4 * alpha) * reference {
-                    accepted = true;
-                    break;
-                }
-                alpha *= 0.5;
-            }
+            let accepted = local.line_search(u, &mut multipliers, &dx, r.norm_squared());
             iterations += 1;
             if !accepted {
-                for (l, &d) in dofs.iter().enumerate() {
-                    u[d] = start[l];
-                }
-                multipliers = start_multipliers;
                 break;
             }
             kkt.clear();
-            r = with_contact(residual(u, Some(&mut kkt)), &multipliers);
+            r = local.with_contact(local.residual(u, Some(&mut kkt)), &multipliers);
         }
-        for ((i, _), m) in constrained.iter().zip(&multipliers) {
+        for ((i, _), m) in local.constrained.iter().zip(&multipliers) {
             lambda[*i] += m;
         }
         Relaxed {
-            unknowns: dofs.len(),
+            unknowns: nl,
             iterations,
         }
     }
+}
+
+/// The local problem of one [`Elimination::relax`]: its unknowns, the triangles whose
+/// forces reach them, and the active contact rows through them.
+struct LocalProblem<'a> {
+    model: &'a Model,
+    step: &'a Increment<'a>,
+    /// The unknowns: global dofs, increasing.
+    dofs: Vec<usize>,
+    /// Every triangle touching the unknowns: the terms of their residual.
+    patch: Vec<usize>,
+    /// Active rows through the unknowns: (row, its entries (local unknown, coefficient)).
+    constrained: Vec<(usize, Vec<(usize, f64)>)>,
+}
+
+impl<'a> LocalProblem<'a> {
+    /// The local problem of `triangles`' nodes; None when they have no free dof.
+    fn new(
+        elimination: &Elimination,
+        model: &'a Model,
+        step: &'a Increment<'a>,
+        triangles: &[usize],
+    ) -> Option<Self> {
+        let dofs = unknowns(model, step, triangles);
+        if dofs.is_empty() {
+            return None;
+        }
+        // Every triangle touching them contributes to their residual.
+        let mut patch: Vec<usize> = dofs
+            .iter()
+            .flat_map(|&d| elimination.node_elements(model)[d / 2].iter().copied())
+            .collect();
+        patch.sort_unstable();
+        patch.dedup();
+        let mut local = LocalProblem {
+            model,
+            step,
+            dofs,
+            patch,
+            constrained: Vec::new(),
+        };
+        // Active rows through the unknowns keep their gaps: the local KKT system
+        // [J C^T; C 0] with C their entries at the unknowns (C dx = 0 keeps each gap).
+        local.constrained = (0..step.rows.len())
+            .filter(|&i| step.active[i])
+            .filter_map(|i| {
+                let c: Vec<(usize, f64)> = step.rows[i]
+                    .entries
+                    .iter()
+                    .filter_map(|&(d, v)| local.local(d).map(|l| (l, v)))
+                    .collect();
+                (!c.is_empty()).then_some((i, c))
+            })
+            .collect();
+        Some(local)
+    }
+
+    /// The local index of global dof `d`, if it is an unknown.
+    fn local(&self, d: usize) -> Option<usize> {
+        self.dofs.binary_search(&d).ok()
+    }
+
+    /// The residual `f_int - f_ext` at the unknowns for the displacements `u`, with the
+    /// Jacobian's block added into `jacobian` when given.
+    fn residual(&self, u: &[f64], mut jacobian: Option<&mut LocalMatrix>) -> DVector<f64> {
+        let (model, step) = (self.model, self.step);
+        let mut r =
+            DVector::from_iterator(self.dofs.len(), self.dofs.iter().map(|&d| -step.f_ext[d]));
+        for &i in &self.patch {
+            let e = &model.elements[i];
+            let (m, trial) =
+                model.trial_stress(i, u, step.strain_prev, step.sigma_prev, step.k, step.source);
+            let (s, d) = m.update(&trial, step.k);
+            let fe = e.internal_force(&s);
+            let ke = jacobian.as_ref().map(|_| e.stiffness(&d));
+            let ed = e.dofs();
+            for (a, &da) in ed.iter().enumerate() {
+                let Some(la) = self.local(da) else { continue };
+                r[la] += fe[a];
+                if let (Some(j), Some(ke)) = (jacobian.as_deref_mut(), ke.as_ref()) {
+                    for (b, &db) in ed.iter().enumerate() {
+                        if let Some(lb) = self.local(db) {
+                            j.add(la, lb, ke[(a, b)]);
+                        }
+                    }
+                }
+            }
+        }
+        r
+    }
+
+    /// `r` plus the contact forces `C^T multipliers` of the constrained rows.
+    fn with_contact(&self, mut r: DVector<f64>, multipliers: &[f64]) -> DVector<f64> {
+        for ((_, c), m) in self.constrained.iter().zip(multipliers) {
+            for &(l, v) in c {
+                r[l] += v * m;
+            }
+        }
+        r
+    }
+
+    /// The zero KKT matrix `[J C^T; C 0]`, with the entries the Jacobian's block
+    /// (accumulated by [`LocalProblem::residual`]) and the rows' can take.
+    fn kkt_matrix(&self) -> LocalMatrix {
+        let (nl, nc) = (self.dofs.len(), self.constrained.len());
+        LocalMatrix::new(nl + nc, || {
+            let mut entries: Vec<(usize, usize)> = (0..nl + nc).map(|i| (i, i)).collect();
+            for &i in &self.patch {
+                let ed: Vec<usize> = self.model.elements[i]
+                    .dofs()
+                    .iter()
+                    .filter_map(|&d| self.local(d))
+                    .collect();
+                entries.extend(ed.iter().flat_map(|&a| ed.iter().map(move |&b| (a, b))));
+            }
+            for (j, (_, c)) in self.constrained.iter().enumerate() {
+                entries.extend(c.iter().flat_map(|&(l, _)| [(l, nl + j), (nl + j, l)]));
+            }
+            entries
+        })
+    }
+
+    /// Add the constrained rows' blocks C^T and C to `kkt`.
+    fn add_rows(&self, kkt: &mut LocalMatrix) {
+        let nl = self.dofs.len();
+        for (j, (_, c)) in self.constrained.iter().enumerate() {
+            for &(l, v) in c {
+                kkt.add(l, nl + j, v);
+                kkt.add(nl + j, l, v);
+            }
+        }
+    }
+
+    /// Backtracking along the step `dx` of the unknowns and multipliers (Armijo on the
+    /// squared residual against `reference`, at most 30 halvings). Moves `u` and
+    /// `multipliers` to the accepted trial and returns true, or leaves them as they were
+    /// and returns false.
+    fn line_search(
+        &self,
+        u: &mut [f64],
+        multipliers: &mut Vec<f64>,
+        dx: &DVector<f64>,
+        reference: f64,
+    ) -> bool {
+        let nl = self.dofs.len();
+        let start: Vec<f64> = self.dofs.iter().map(|&d| u[d]).collect();
+        let start_multipliers = multipliers.clone();
+        let mut alpha = 1.0;
+        for _ in 0..30 {
+            for (l, &d) in self.dofs.iter().enumerate() {
+                u[d] = start[l] + alpha * dx[l];
+            }
+            for (j, m) in multipliers.iter_mut().enumerate() {
+                *m = start_multipliers[j] + alpha * dx[nl + j];
+            }
+            let trial = self.with_contact(self.residual(u, None), multipliers);
+            if trial.norm_squared() <= (1.0 - 1e-4 * alpha) * reference {
+                return true;
+            }
+            alpha *= 0.5;
+        }
+        for (l, &d) in self.dofs.iter().enumerate() {
+            u[d] = start[l];
+        }
+        *multipliers = start_multipliers;
+        false
+    }
+}
+
+/// The unknowns of the local solve of `triangles`, in increasing order: the free dofs of
+/// their nodes, and those of every active row through them (a row moves with its multiplier
+/// all its dofs).
+fn unknowns(model: &Model, step: &Increment, triangles: &[usize]) -> Vec<usize> {
+    let mut dofs: Vec<usize> = triangles
+        .iter()
+        .flat_map(|&i| model.elements[i].dofs())
+        .filter(|&d| model.equation[d] != FIXED)
+        .collect();
+    dofs.sort_unstable();
+    dofs.dedup();
+    // An active row through them moves with its multiplier all its dofs: they join.
+    let mut joined: Vec<usize> = (0..step.rows.len())
+        .filter(|&i| step.active[i])
+        .filter(|&i| {
+            step.rows[i]
+                .entries
+                .iter()
+                .any(|(d, _)| dofs.binary_search(d).is_ok())
+        })
+        .flat_map(|i| step.rows[i].entries.iter().map(|&(d, _)| d))
+        .filter(|&d| model.equation[d] != FIXED)
+        .collect();
+    dofs.append(&mut joined);
+    dofs.sort_unstable();
+    dofs.dedup();
+    dofs
 }

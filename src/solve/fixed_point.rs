@@ -265,27 +265,69 @@ impl<'a> FixedPoint<'a> {
     }
 }
 
-impl StepSolver for FixedPoint<'_> {
-    fn step(&mut self, prev: &State, guess: &State, t: f64, k: f64) -> Result<(State, StepReport)> {
-        let p = self.p;
-        let model = &p.model;
-        let f_ext = model.load(t)?;
-        // k s of a manufactured solution's constitutive source: added to sigma with k eta
-        // (zero, and nothing stored, for a scene without one).
-        let source = model.constitutive_source(t)?;
-        let k_source = |i: usize| source.as_ref().map_or(Stress::zeros(), |s| k * s[i]);
-        // Shift of (4.2): E eps(u^{n-1}) - sigma^{n-1} - k s per element.
-        let shift: Vec<Stress> = model
+/// What the outer iterations of one time step of the fixed point share: the step from
+/// `prev` to `t`, its load and a manufactured solution's constitutive source.
+struct StepData<'s> {
+    prev: &'s State,
+    t: f64,
+    k: f64,
+    f_ext: Vec<f64>,
+    /// The constitutive source per element at t_n, if any.
+    source: Option<Vec<Stress>>,
+}
+
+impl StepData<'_> {
+    /// k s of a manufactured solution's constitutive source on element `i`: added to sigma
+    /// with k eta (zero, and nothing stored, for a scene without one).
+    fn k_source(&self, i: usize) -> Stress {
+        self.source
+            .as_ref()
+            .map_or(Stress::zeros(), |s| self.k * s[i])
+    }
+}
+
+/// Where one outer iteration of the fixed point stands.
+struct Outer {
+    /// Its number, from 1.
+    outer: usize,
+    /// Inner iterations so far.
+    inner_total: usize,
+    /// The change of k eta, max over the elements (stress).
+    change: f64,
+    /// `change` relative to the largest stress.
+    rel: f64,
+}
+
+/// What a settled fixed point (the change of k eta at the tolerance) leads to.
+enum Settled {
+    /// The step is solved.
+    Solved(State, StepReport),
+    /// Not solved yet: iterate again from these displacements, the distance to the
+    /// solution now this.
+    Again(Vec<f64>, f64),
+}
+
+impl FixedPoint<'_> {
+    /// The shift of (4.2) per element: E eps(u^{n-1}) - sigma^{n-1} - k s.
+    fn shift(&self, data: &StepData) -> Vec<Stress> {
+        let model = &self.p.model;
+        let prev = data.prev;
+        model
             .elements
             .iter()
             .enumerate()
             .map(|(i, e)| {
                 model.materials[e.body].elastic.apply(&e.strain(&prev.u))
                     - prev.sigma[i]
-                    - k_source(i)
+                    - data.k_source(i)
             })
-            .collect();
-        let mut eta: Vec<Stress> = match &self.eta {
+            .collect()
+    }
+
+    /// The first eta of the step: the last step's, or G(sigma^{n-1}) at the first step.
+    fn initial_eta(&self, prev: &State) -> Vec<Stress> {
+        let model = &self.p.model;
+        match &self.eta {
             Some(e) => e.clone(),
             None => model
                 .elements
@@ -293,114 +335,188 @@ impl StepSolver for FixedPoint<'_> {
                 .zip(&prev.sigma)
                 .map(|(e, s)| model.materials[e.body].g(s))
                 .collect(),
+        }
+    }
+
+    /// The load of the contact subproblem (4.2) over the free dofs:
+    /// b = F + sum |T| B^T (E eps(u^{n-1}) - sigma^{n-1} - k eta).
+    fn subproblem_load(&self, data: &StepData, shift: &[Stress], eta: &[Stress]) -> Vec<f64> {
+        let model = &self.p.model;
+        let k = data.k;
+        let loads: Vec<Stress> = shift.iter().zip(eta).map(|(s, e)| s - k * e).collect();
+        let fb = model.internal_force(&loads);
+        model.restrict(
+            &data
+                .f_ext
+                .iter()
+                .zip(&fb)
+                .map(|(f, l)| f + l)
+                .collect::<Vec<_>>(),
+        )
+    }
+
+    /// (4.3): sigma_eta = sigma^{n-1} + E eps(u) - E eps(u^{n-1}) + k eta (+ k s), and the
+    /// next eta' = G(sigma_eta).
+    fn stress_and_eta(
+        &self,
+        data: &StepData,
+        u: &[f64],
+        eta: &[Stress],
+    ) -> (Vec<Stress>, Vec<Stress>) {
+        let model = &self.p.model;
+        let (prev, k) = (data.prev, data.k);
+        let sigma: Vec<Stress> = model
+            .elements
+            .iter()
+            .enumerate()
+            .map(|(i, e)| {
+                prev.sigma[i]
+                    + model.materials[e.body]
+                        .elastic
+                        .apply(&(e.strain(u) - e.strain(&prev.u)))
+                    + k * eta[i]
+                    + data.k_source(i)
+            })
+            .collect();
+        let eta_new: Vec<Stress> = model
+            .elements
+            .iter()
+            .zip(&sigma)
+            .map(|(e, s)| model.materials[e.body].g(s))
+            .collect();
+        (sigma, eta_new)
+    }
+
+    /// The fixed point settled at `state` (eta now `eta`): solved, or to iterate again while
+    /// the distance to the solution shrinks against `settled_distance` (the last settled
+    /// iterate's).
+    fn settled(
+        &mut self,
+        data: &StepData,
+        state: State,
+        eta: &[Stress],
+        it: &Outer,
+        settled_distance: Option<f64>,
+    ) -> Result<Settled> {
+        let (outer, change, rel) = (it.outer, it.change, it.rel);
+        // The change of k eta is the paper's criterion; the step is solved when the
+        // equations are: equilibrium and complementarity below the tolerance, the
+        // same test as newton's.
+        let (residual, complementarity) =
+            super::distance_to_solution(self.p, &state, &data.f_ext, self.c_scale);
+        let tol = self.settings.tol;
+        if residual <= tol && complementarity <= tol {
+            self.eta = Some(eta.to_vec());
+            let report = StepReport {
+                iterations: it.inner_total,
+                outer_iterations: outer,
+                residual,
+                active_set_changes: 0,
+                reason: format!(
+                    "fixed point converged: relative change of k*eta {rel:.2e}, residual {residual:.2e} and complementarity {complementarity:.2e} below {tol:.0e}"
+                ),
+            };
+            return Ok(Settled::Solved(state, report));
+        }
+        // Settled but not solved: go on while the distance shrinks (the next
+        // iterations sharpen eta); an exact fixed point, or one that stopped
+        // improving, has inaccurate contact subproblems.
+        let distance = residual.max(complementarity);
+        if self.inner == Inner::PenaltyDuality && self.inner_tol > INNER_TOL_FLOOR {
+            // The penalty-duality iteration stops on the change of its iterates:
+            // ask it for more digits and solve the subproblem again.
+            self.inner_tol = (self.inner_tol * 1e-2).max(INNER_TOL_FLOOR);
+        } else if change == 0.0 || settled_distance.is_some_and(|d| distance > 0.5 * d) {
+            return Err(Error::NotConverged(format!(
+                "the fixed point settled after {outer} iterations (relative change of k*eta {rel:.2e}) but the equilibrium residual {residual:.3e} and complementarity {complementarity:.3e} of (2.1) are not both below the tolerance {tol:.0e}: the contact subproblems were solved inaccurately"
+            )));
+        }
+        Ok(Settled::Again(state.u, distance))
+    }
+}
+
+/// The change of k eta from `eta` to `eta_new` (max over the elements), and that change
+/// relative to the largest stress of `sigma`.
+fn eta_change(eta_new: &[Stress], eta: &[Stress], sigma: &[Stress], k: f64) -> (f64, f64) {
+    let change = eta_new
+        .iter()
+        .zip(eta)
+        .map(|(a, b)| (a - b).amax())
+        .fold(0.0f64, f64::max)
+        * k;
+    let size = sigma
+        .iter()
+        .map(|s| s.amax())
+        .fold(0.0f64, f64::max)
+        .max(f64::MIN_POSITIVE);
+    (change, change / size)
+}
+
+/// Errs where the fixed point diverges: a relative change `rel` not finite, or after 5
+/// iterations above both the last one's and the first one's.
+fn check_divergence(outer: usize, rel: f64, last_change: f64, first_change: f64) -> Result<()> {
+    if !rel.is_finite() || (outer > 5 && rel > last_change && rel > first_change) {
+        let factor = if last_change.is_finite() {
+            rel / last_change
+        } else {
+            f64::INFINITY
         };
+        return Err(Error::NotConverged(format!(
+            "the fixed point (4.2)-(4.3) diverges after {outer} iterations (change ratio {factor:.3} > 1): k L is too large; take a smaller time step or use the newton solver"
+        )));
+    }
+    Ok(())
+}
+
+impl StepSolver for FixedPoint<'_> {
+    fn step(&mut self, prev: &State, guess: &State, t: f64, k: f64) -> Result<(State, StepReport)> {
+        let model = &self.p.model;
+        let data = StepData {
+            prev,
+            t,
+            k,
+            f_ext: model.load(t)?,
+            source: model.constitutive_source(t)?,
+        };
+        let shift = self.shift(&data);
+        let mut eta = self.initial_eta(prev);
         let mut u = guess.u.clone();
         let mut inner_total = 0;
         let mut first_change = None;
         let mut last_change = f64::INFINITY;
         let mut settled_distance: Option<f64> = None;
         for outer in 1..=self.settings.max_iterations.max(200) {
-            // b = F + sum |T| B^T (E eps(u^{n-1}) - sigma^{n-1} - k eta).
-            let loads: Vec<Stress> = shift.iter().zip(&eta).map(|(s, e)| s - k * e).collect();
-            let fb = model.internal_force(&loads);
-            let b: Vec<f64> = model.restrict(
-                &f_ext
-                    .iter()
-                    .zip(&fb)
-                    .map(|(f, l)| f + l)
-                    .collect::<Vec<_>>(),
-            );
+            let b = self.subproblem_load(&data, &shift, &eta);
             let (un, lambda, inner) = self.contact_subproblem(&b, &u)?;
             inner_total += inner;
             u = un;
-            // (4.3): sigma_eta = sigma^{n-1} + E eps(u) - E eps(u^{n-1}) + k eta (+ k s);
-            // eta' = G(sigma_eta).
-            let sigma: Vec<Stress> = model
-                .elements
-                .iter()
-                .enumerate()
-                .map(|(i, e)| {
-                    prev.sigma[i]
-                        + model.materials[e.body]
-                            .elastic
-                            .apply(&(e.strain(&u) - e.strain(&prev.u)))
-                        + k * eta[i]
-                        + k_source(i)
-                })
-                .collect();
-            let eta_new: Vec<Stress> = model
-                .elements
-                .iter()
-                .zip(&sigma)
-                .map(|(e, s)| model.materials[e.body].g(s))
-                .collect();
-            let change = eta_new
-                .iter()
-                .zip(&eta)
-                .map(|(a, b)| (a - b).amax())
-                .fold(0.0f64, f64::max)
-                * k;
-            let size = sigma
-                .iter()
-                .map(|s| s.amax())
-                .fold(0.0f64, f64::max)
-                .max(f64::MIN_POSITIVE);
-            let rel = change / size;
+            let (sigma, eta_new) = self.stress_and_eta(&data, &u, &eta);
+            let (change, rel) = eta_change(&eta_new, &eta, &sigma, k);
             first_change.get_or_insert(rel);
             eta = eta_new;
             if rel <= self.settings.tol || change == 0.0 {
                 let state = State {
-                    time: t,
+                    time: data.t,
                     u,
                     sigma,
                     lambda,
                 };
-                // The change of k eta is the paper's criterion; the step is solved when the
-                // equations are: equilibrium and complementarity below the tolerance, the
-                // same test as newton's.
-                let (residual, complementarity) =
-                    super::distance_to_solution(p, &state, &f_ext, self.c_scale);
-                let tol = self.settings.tol;
-                if residual <= tol && complementarity <= tol {
-                    self.eta = Some(eta.clone());
-                    let report = StepReport {
-                        iterations: inner_total,
-                        outer_iterations: outer,
-                        residual,
-                        active_set_changes: 0,
-                        reason: format!(
-                            "fixed point converged: relative change of k*eta {rel:.2e}, residual {residual:.2e} and complementarity {complementarity:.2e} below {tol:.0e}"
-                        ),
-                    };
-                    return Ok((state, report));
-                }
-                // Settled but not solved: go on while the distance shrinks (the next
-                // iterations sharpen eta); an exact fixed point, or one that stopped
-                // improving, has inaccurate contact subproblems.
-                let distance = residual.max(complementarity);
-                if self.inner == Inner::PenaltyDuality && self.inner_tol > INNER_TOL_FLOOR {
-                    // The penalty-duality iteration stops on the change of its iterates:
-                    // ask it for more digits and solve the subproblem again.
-                    self.inner_tol = (self.inner_tol * 1e-2).max(INNER_TOL_FLOOR);
-                } else if change == 0.0 || settled_distance.is_some_and(|d| distance > 0.5 * d) {
-                    return Err(Error::NotConverged(format!(
-                        "the fixed point settled after {outer} iterations (relative change of k*eta {rel:.2e}) but the equilibrium residual {residual:.3e} and complementarity {complementarity:.3e} of (2.1) are not both below the tolerance {tol:.0e}: the contact subproblems were solved inaccurately"
-                    )));
-                }
-                settled_distance = Some(distance);
-                u = state.u;
-                continue;
-            }
-            if !rel.is_finite() || (outer > 5 && rel > last_change && rel > first_change.unwrap()) {
-                let factor = if last_change.is_finite() {
-                    rel / last_change
-                } else {
-                    f64::INFINITY
+                let it = Outer {
+                    outer,
+                    inner_total,
+                    change,
+                    rel,
                 };
-                return Err(Error::NotConverged(format!(
-                    "the fixed point (4.2)-(4.3) diverges after {outer} iterations (change ratio {factor:.3} > 1): k L is too large; take a smaller time step or use the newton solver"
-                )));
+                match self.settled(&data, state, &eta, &it, settled_distance)? {
+                    Settled::Solved(state, report) => return Ok((state, report)),
+                    Settled::Again(back, distance) => {
+                        settled_distance = Some(distance);
+                        u = back;
+                        continue;
+                    }
+                }
             }
+            check_divergence(outer, rel, last_change, first_change.unwrap())?;
             last_change = rel;
         }
         Err(Error::NotConverged(format!(

@@ -355,35 +355,11 @@ fn run_steps(
     keep_history: bool,
     observer: &mut StepObserver,
 ) -> Result<Solution> {
-    if times.is_empty() || times[0] <= 0.0 || times.windows(2).any(|w| w[1] <= w[0]) {
-        return Err(Error::input(
-            &p.model.scene.file,
-            "time steps",
-            "time steps k must be positive: t_1 > 0 and the times increasing",
-        ));
-    }
+    check_times(p, times)?;
     let steps = times.len();
     let start = Instant::now();
-    let n_el = p.model.elements.len();
-    let initial = State {
-        time: 0.0,
-        u: vec![0.0; 2 * p.model.n_nodes],
-        sigma: vec![Stress::zeros(); n_el],
-        lambda: vec![0.0; p.rows.len()],
-    };
-    let mut solver: Box<dyn StepSolver> = match settings.kind {
-        SolverKind::Newton => Box::new(newton::Newton::new(p, settings)?),
-        SolverKind::Paper => Box::new(fixed_point::FixedPoint::new(
-            p,
-            settings,
-            fixed_point::Inner::PenaltyDuality,
-        )?),
-        SolverKind::Qp => Box::new(fixed_point::FixedPoint::new(
-            p,
-            settings,
-            fixed_point::Inner::Clarabel,
-        )?),
-    };
+    let initial = initial_state(p);
+    let mut solver = step_solver(p, settings)?;
     // t_0 for a run that keeps only t_0 and t_N (a run keeping every state moves them).
     let first = (!keep_history).then(|| initial.clone());
     let mut states = Vec::new();
@@ -396,40 +372,7 @@ fn run_steps(
         let t = times[n - 1];
         let prev = window.last().expect("the window holds prev");
         let k = t - prev.time;
-        // Warm start: the Lagrange extrapolation through the last three states (two at the
-        // second step; at the first, the initial state itself): the steps' Newton
-        // iterations start closer to the solution.
-        let guess = {
-            let points: Vec<&State> = window.iter().rev().collect();
-            let weights: Vec<f64> = (0..points.len())
-                .map(|i| {
-                    (0..points.len())
-                        .filter(|&j| j != i)
-                        .map(|j| (t - points[j].time) / (points[i].time - points[j].time))
-                        .product()
-                })
-                .collect();
-            // sum_i w_i field(point i), the terms of each entry in the order of the points.
-            let mix = |field: &dyn Fn(&State) -> &[f64]| -> Vec<f64> {
-                let mut sum: Vec<f64> = field(points[0]).iter().map(|v| weights[0] * v).collect();
-                for (s, w) in points.iter().zip(&weights).skip(1) {
-                    for (total, v) in sum.iter_mut().zip(field(s)) {
-                        *total += w * v;
-                    }
-                }
-                sum
-            };
-            State {
-                time: t,
-                u: mix(&|s: &State| s.u.as_slice()),
-                // The solvers read the guess's displacements and multipliers only.
-                sigma: Vec::new(),
-                lambda: mix(&|s: &State| s.lambda.as_slice())
-                    .into_iter()
-                    .map(|l| l.max(0.0))
-                    .collect(),
-            }
-        };
+        let guess = predictor(&window, t);
         let (state, report) = solver.step(prev, &guess, t, k).map_err(|e| match e {
             Error::NotConverged(m) => Error::NotConverged(format!(
                 "{} solver, {} cone, step {n} of {steps} (t = {t}): {m}",
@@ -464,4 +407,79 @@ fn run_steps(
         wall_s: start.elapsed().as_secs_f64() - timings.setup_s - observer_s,
         timings,
     })
+}
+
+/// Errs unless `times` are positive and increasing (t_0 = 0 before them).
+fn check_times(p: &Problem, times: &[f64]) -> Result<()> {
+    if times.is_empty() || times[0] <= 0.0 || times.windows(2).any(|w| w[1] <= w[0]) {
+        return Err(Error::input(
+            &p.model.scene.file,
+            "time steps",
+            "time steps k must be positive: t_1 > 0 and the times increasing",
+        ));
+    }
+    Ok(())
+}
+
+/// The zero state at t_0 = 0.
+fn initial_state(p: &Problem) -> State {
+    State {
+        time: 0.0,
+        u: vec![0.0; 2 * p.model.n_nodes],
+        sigma: vec![Stress::zeros(); p.model.elements.len()],
+        lambda: vec![0.0; p.rows.len()],
+    }
+}
+
+/// The solver of `settings.kind` for `p`, set up (pattern, factorization).
+fn step_solver<'p>(p: &'p Problem, settings: &Settings) -> Result<Box<dyn StepSolver + 'p>> {
+    Ok(match settings.kind {
+        SolverKind::Newton => Box::new(newton::Newton::new(p, settings)?),
+        SolverKind::Paper => Box::new(fixed_point::FixedPoint::new(
+            p,
+            settings,
+            fixed_point::Inner::PenaltyDuality,
+        )?),
+        SolverKind::Qp => Box::new(fixed_point::FixedPoint::new(
+            p,
+            settings,
+            fixed_point::Inner::Clarabel,
+        )?),
+    })
+}
+
+/// The warm start of the step to `t`: the Lagrange extrapolation through the states of
+/// `window` (the last three; two at the second step; at the first, the initial state
+/// itself): the steps' Newton iterations start closer to the solution. It has the
+/// displacements and multipliers only, the multipliers clipped at 0.
+fn predictor(window: &[State], t: f64) -> State {
+    let points: Vec<&State> = window.iter().rev().collect();
+    let weights: Vec<f64> = (0..points.len())
+        .map(|i| {
+            (0..points.len())
+                .filter(|&j| j != i)
+                .map(|j| (t - points[j].time) / (points[i].time - points[j].time))
+                .product()
+        })
+        .collect();
+    // sum_i w_i field(point i), the terms of each entry in the order of the points.
+    let mix = |field: &dyn Fn(&State) -> &[f64]| -> Vec<f64> {
+        let mut sum: Vec<f64> = field(points[0]).iter().map(|v| weights[0] * v).collect();
+        for (s, w) in points.iter().zip(&weights).skip(1) {
+            for (total, v) in sum.iter_mut().zip(field(s)) {
+                *total += w * v;
+            }
+        }
+        sum
+    };
+    State {
+        time: t,
+        u: mix(&|s: &State| s.u.as_slice()),
+        // The solvers read the guess's displacements and multipliers only.
+        sigma: Vec::new(),
+        lambda: mix(&|s: &State| s.lambda.as_slice())
+            .into_iter()
+            .map(|l| l.max(0.0))
+            .collect(),
+    }
 }

@@ -897,38 +897,192 @@ impl Newton<'_> {
     }
 }
 
-impl StepSolver for Newton<'_> {
-    fn step(&mut self, prev: &State, guess: &State, t: f64, k: f64) -> Result<(State, StepReport)> {
+/// What one time step's iterations counted so far.
+struct Counts {
+    iterations: usize,
+    factorizations: usize,
+    /// Active-set changes between iterations (the predictions' are counted apart, in
+    /// [`Newton::predicted_changes`]).
+    changes: usize,
+    /// [`Newton::predicted_changes`] when the step began.
+    predicted_before: usize,
+}
+
+impl Newton<'_> {
+    /// What the iterations of the step to time `t` (from `prev`, step `k`) share: the
+    /// load, the constitutive source and the strains at t_{n-1}.
+    fn step_data<'s>(&self, prev: &'s State, t: f64, k: f64) -> Result<StepData<'s>> {
         let model = &self.p.model;
-        let (n, m, c) = (self.n, self.p.rows.len(), self.c_scale);
         let f_ext = model.load(t)?;
         let source = timed(&self.clock.constitutive, || model.constitutive_source(t))?;
         let strain_prev = timed(&self.clock.constitutive, || model.strains(&prev.u));
-        let data = StepData {
+        Ok(StepData {
             prev,
             strain_prev,
             k,
             source,
             f_free: model.restrict(&f_ext),
             f_ext,
+        })
+    }
+
+    /// The distance of the iterate evaluated in `ev`, with multipliers `lambda`.
+    fn distance(&self, ev: &Evaluation, lambda: &[f64]) -> Distance {
+        Distance {
+            residual: inf_norm(&ev.residual) / ev.scale,
+            complementarity: super::complementarity(lambda, &ev.gaps, self.c_scale) / ev.scale,
+        }
+    }
+
+    /// The converged step to `t` from its last iterate (u, sigma, lambda) with the active
+    /// set `active`: the state and its report.
+    fn converged(
+        &self,
+        t: f64,
+        (u, sigma, mut lambda): (Vec<f64>, Vec<Stress>, Vec<f64>),
+        active: &[bool],
+        distance: &Distance,
+        counts: &Counts,
+    ) -> (State, StepReport) {
+        // Inactive rows carry no force; GMRES leaves round-off there.
+        for i in 0..lambda.len() {
+            if !active[i] {
+                lambda[i] = 0.0;
+            }
+        }
+        let (res, compl) = (distance.residual, distance.complementarity);
+        let (iterations, factorizations) = (counts.iterations, counts.factorizations);
+        let reason = match iterations {
+            0 => format!(
+                "the predictor's residual {res:.2e} and complementarity {compl:.2e} below {:.0e}: no iteration needed",
+                self.settings.tol
+            ),
+            _ => format!(
+                "residual {res:.2e} and complementarity {compl:.2e} below {:.0e}, active set settled ({factorizations} factorizations)",
+                self.settings.tol
+            ),
         };
+        let report = StepReport {
+            iterations,
+            outer_iterations: iterations,
+            residual: res,
+            active_set_changes: counts.changes + self.predicted_changes - counts.predicted_before,
+            reason,
+        };
+        let state = State {
+            time: t,
+            u,
+            sigma,
+            lambda,
+        };
+        (state, report)
+    }
+
+    /// Errs where the iterate is not finite or the iterations ran out.
+    fn check_progress(&self, distance: &Distance, iterations: usize) -> Result<()> {
+        let (res, compl) = (distance.residual, distance.complementarity);
+        if !res.is_finite() {
+            return Err(Error::NotConverged(format!(
+                "Newton iterate became non-finite after {iterations} iterations"
+            )));
+        }
+        if iterations >= self.settings.max_iterations {
+            return Err(Error::NotConverged(format!(
+                "Newton reached {iterations} iterations with residual {res:.3e}, complementarity {compl:.3e} (tolerance {:.0e})",
+                self.settings.tol
+            )));
+        }
+        Ok(())
+    }
+
+    /// The trace line of the linear solve: the relative residual of `step` in the Newton
+    /// system of the active set `set`, the solves it took since `solves_before`, and its
+    /// size against the iterate `u`.
+    fn trace_linear_solve(
+        &self,
+        ev: &Evaluation,
+        (u, lambda): (&[f64], &[f64]),
+        set: &[bool],
+        step: &[f64],
+        solves_before: usize,
+    ) {
+        let n = self.n;
+        let rhs = self.right_hand_side(ev, lambda, set);
+        let mut y = vec![0.0; step.len()];
+        self.kkt_product(set, step, &mut y);
+        let lin = y
+            .iter()
+            .zip(&rhs)
+            .map(|(a, b)| (a - b).powi(2))
+            .sum::<f64>()
+            .sqrt()
+            / rhs.iter().map(|b| b * b).sum::<f64>().sqrt();
+        eprintln!(
+            "    linear residual {lin:.2e} ({} solves with a factorization), |du|/|u| = {:.3e}",
+            self.solves() - solves_before,
+            inf_norm(&step[..n]) / inf_norm(u).max(1e-300)
+        );
+    }
+
+    /// The trace line of iteration `iterations` of the step to `t`: the distance, the
+    /// active set `set` and its flips against `last_active`, the plastic triangles and how
+    /// many switched from the tangents `before` to `after`, the step length `alpha` and
+    /// whether the iteration factorized.
+    fn trace_iteration(
+        &self,
+        (t, iterations): (f64, usize),
+        distance: &Distance,
+        (set, last_active): (&[bool], Option<&[bool]>),
+        (before, after): (&[Matrix3<f64>], &[Matrix3<f64>]),
+        (alpha, factorized): (f64, bool),
+    ) {
+        let model = &self.p.model;
+        let (res, compl) = (distance.residual, distance.complementarity);
+        // A triangle is plastic where its tangent is not the elastic one.
+        let plastic = |tangents: &[Matrix3<f64>]| -> Vec<bool> {
+            tangents
+                .iter()
+                .zip(&model.elements)
+                .map(|(d, e)| *d != model.materials[e.body].elastic.matrix())
+                .collect()
+        };
+        let (before, after) = (plastic(before), plastic(after));
+        let switched = before.iter().zip(&after).filter(|(a, b)| a != b).count();
+        let flips = set
+            .iter()
+            .zip(last_active.unwrap_or(set))
+            .filter(|(a, b)| a != b)
+            .count();
+        eprintln!(
+            "trace t={t:.4} it={iterations} res={res:.3e} compl={compl:.3e} active={} flips={flips} plastic={} switched={switched} alpha={alpha} factorized={factorized}",
+            set.iter().filter(|&&a| a).count(),
+            after.iter().filter(|&&a| a).count(),
+        );
+    }
+}
+
+impl StepSolver for Newton<'_> {
+    fn step(&mut self, prev: &State, guess: &State, t: f64, k: f64) -> Result<(State, StepReport)> {
+        let (n, m, c) = (self.n, self.p.rows.len(), self.c_scale);
+        let data = self.step_data(prev, t, k)?;
         let mut u = guess.u.clone();
         let mut lambda = guess.lambda.clone();
         let mut last_active: Option<Vec<bool>> = None;
-        let (mut changes, mut iterations, mut factorizations) = (0, 0, 0);
-        let predicted_before = self.predicted_changes;
+        let mut counts = Counts {
+            iterations: 0,
+            factorizations: 0,
+            changes: 0,
+            predicted_before: self.predicted_changes,
+        };
         let mut evaluation = self.evaluate(&data, &u, &lambda);
         loop {
             let ev = &evaluation;
             let active: Vec<bool> = (0..m).map(|i| lambda[i] + c * ev.gaps[i] >= 0.0).collect();
-            let distance = Distance {
-                residual: inf_norm(&ev.residual) / ev.scale,
-                complementarity: super::complementarity(&lambda, &ev.gaps, c) / ev.scale,
-            };
+            let distance = self.distance(ev, &lambda);
             let (res, compl) = (distance.residual, distance.complementarity);
             let same_set = last_active.as_ref().is_some_and(|a| *a == active);
             if let Some(a) = &last_active {
-                changes += a.iter().zip(&active).filter(|(x, y)| x != y).count();
+                counts.changes += a.iter().zip(&active).filter(|(x, y)| x != y).count();
             }
             // Converged: residual and complementarity within the tolerance, and the active
             // set the one the last step was computed with. A predictor (the extrapolation of
@@ -938,73 +1092,21 @@ impl StepSolver for Newton<'_> {
             // starts steps 2-4 at residuals 9e-14 to 1.1e-13, where a Newton iteration
             // cost a preconditioner solve, a product and a return map each (5 iterations
             // to 2).
-            let settled = same_set || iterations == 0;
+            let settled = same_set || counts.iterations == 0;
             if res <= self.settings.tol && compl <= self.settings.tol && settled {
-                // Inactive rows carry no force; GMRES leaves round-off there.
-                for i in 0..m {
-                    if !active[i] {
-                        lambda[i] = 0.0;
-                    }
-                }
-                let reason = match iterations {
-                    0 => format!(
-                        "the predictor's residual {res:.2e} and complementarity {compl:.2e} below {:.0e}: no iteration needed",
-                        self.settings.tol
-                    ),
-                    _ => format!(
-                        "residual {res:.2e} and complementarity {compl:.2e} below {:.0e}, active set settled ({factorizations} factorizations)",
-                        self.settings.tol
-                    ),
-                };
-                let state = State {
-                    time: t,
-                    u,
-                    sigma: evaluation.sigma,
-                    lambda,
-                };
-                let report = StepReport {
-                    iterations,
-                    outer_iterations: iterations,
-                    residual: res,
-                    active_set_changes: changes + self.predicted_changes - predicted_before,
-                    reason,
-                };
-                return Ok((state, report));
+                let iterate = (u, evaluation.sigma, lambda);
+                return Ok(self.converged(t, iterate, &active, &distance, &counts));
             }
-            if !res.is_finite() {
-                return Err(Error::NotConverged(format!(
-                    "Newton iterate became non-finite after {iterations} iterations"
-                )));
-            }
-            if iterations >= self.settings.max_iterations {
-                return Err(Error::NotConverged(format!(
-                    "Newton reached {iterations} iterations with residual {res:.3e}, complementarity {compl:.3e} (tolerance {:.0e})",
-                    self.settings.tol
-                )));
-            }
+            self.check_progress(&distance, counts.iterations)?;
             let reference = self.merit(ev, &lambda);
             let tangents_before = self.trace.then(|| ev.tangents.clone());
             let solves_before = self.solves();
             let (step, set, factorized) = self.newton_step(ev, &lambda, active, &distance)?;
             debug_assert_eq!(step.len(), n + m);
             if self.trace {
-                let rhs = self.right_hand_side(ev, &lambda, &set);
-                let mut y = vec![0.0; n + m];
-                self.kkt_product(&set, &step, &mut y);
-                let lin = y
-                    .iter()
-                    .zip(&rhs)
-                    .map(|(a, b)| (a - b).powi(2))
-                    .sum::<f64>()
-                    .sqrt()
-                    / rhs.iter().map(|b| b * b).sum::<f64>().sqrt();
-                eprintln!(
-                    "    linear residual {lin:.2e} ({} solves with a factorization), |du|/|u| = {:.3e}",
-                    self.solves() - solves_before,
-                    inf_norm(&step[..n]) / inf_norm(&u).max(1e-300)
-                );
+                self.trace_linear_solve(ev, (&u, &lambda), &set, &step, solves_before);
             }
-            factorizations += factorized as usize;
+            counts.factorizations += factorized as usize;
             let (alpha, decreased);
             (u, lambda, evaluation, alpha, decreased) =
                 self.line_search(&data, &u, &lambda, &evaluation, &step, reference);
@@ -1016,33 +1118,17 @@ impl StepSolver for Newton<'_> {
             if !decreased {
                 self.stale = true;
             }
-            if self.trace {
-                // A triangle is plastic where its tangent is not the elastic one.
-                let plastic = |tangents: &[Matrix3<f64>]| -> Vec<bool> {
-                    tangents
-                        .iter()
-                        .zip(&model.elements)
-                        .map(|(d, e)| *d != model.materials[e.body].elastic.matrix())
-                        .collect()
-                };
-                let (before, after) = (
-                    plastic(tangents_before.as_deref().unwrap()),
-                    plastic(&evaluation.tangents),
-                );
-                let switched = before.iter().zip(&after).filter(|(a, b)| a != b).count();
-                let flips = set
-                    .iter()
-                    .zip(last_active.as_deref().unwrap_or(&set))
-                    .filter(|(a, b)| a != b)
-                    .count();
-                eprintln!(
-                    "trace t={t:.4} it={iterations} res={res:.3e} compl={compl:.3e} active={} flips={flips} plastic={} switched={switched} alpha={alpha} factorized={factorized}",
-                    set.iter().filter(|&&a| a).count(),
-                    after.iter().filter(|&&a| a).count(),
+            if let Some(before) = &tangents_before {
+                self.trace_iteration(
+                    (t, counts.iterations),
+                    &distance,
+                    (&set, last_active.as_deref()),
+                    (before, &evaluation.tangents),
+                    (alpha, factorized),
                 );
             }
             last_active = Some(set);
-            iterations += 1;
+            counts.iterations += 1;
         }
     }
 

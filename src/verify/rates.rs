@@ -290,46 +290,8 @@ fn rate_between(a: &LevelError, b: &LevelError) -> f64 {
 /// disagrees with the fit over every level or with the last successive rates. Errs on two
 /// levels with the same h.
 pub fn assess(levels: &[LevelError], truth_error: f64) -> Result<Assessment, EqualH> {
-    for (i, a) in levels.iter().enumerate() {
-        for b in &levels[i + 1..] {
-            if (a.h - b.h).abs() <= 1e-12 * a.h.abs().max(b.h.abs()) {
-                return Err(EqualH {
-                    levels: (a.level, b.level),
-                });
-            }
-        }
-    }
-    let at_roundoff = |e: &LevelError| e.error <= ROUNDOFF;
-    let roundoff: Vec<usize> = levels
-        .iter()
-        .filter(|e| at_roundoff(e))
-        .map(|e| e.level)
-        .collect();
-    let near_truth: Vec<usize> = levels
-        .iter()
-        .filter(|e| !at_roundoff(e) && e.error < TRUTH_MARGIN * truth_error)
-        .map(|e| e.level)
-        .collect();
-    let successive_rates: Vec<Option<f64>> = levels
-        .windows(2)
-        .map(|w| (!at_roundoff(&w[0]) && !at_roundoff(&w[1])).then(|| rate_between(&w[0], &w[1])))
-        .collect();
-    let usable: Vec<&LevelError> = levels
-        .iter()
-        .filter(|e| !at_roundoff(e) && !near_truth.contains(&e.level))
-        .collect();
-    let mut out = Assessment {
-        verdict: Verdict::TooFewLevels,
-        fit: None,
-        fit_dofs: None,
-        used: Vec::new(),
-        fit_all: None,
-        roundoff,
-        near_truth,
-        successive: successive_rates,
-        celik: None,
-        asymptotic_ratio: None,
-    };
+    check_distinct_h(levels)?;
+    let (mut out, usable) = classify(levels, truth_error);
     if usable.is_empty() && !out.roundoff.is_empty() {
         out.verdict = Verdict::RoundOff;
         return Ok(out);
@@ -357,14 +319,87 @@ pub fn assess(levels: &[LevelError], truth_error: f64) -> Result<Assessment, Equ
             usable[n - 3].error,
         ],
     );
-    let fit_over = |window: &[&LevelError]| {
-        let h: Vec<f64> = window.iter().map(|e| e.h).collect();
-        let d: Vec<f64> = window.iter().map(|e| e.dofs).collect();
-        let e: Vec<f64> = window.iter().map(|e| e.error).collect();
-        (fit(&h, &e), fit(&d, &e))
-    };
     out.fit_all = fit_over(&usable).0;
-    // The longest trailing window whose successive rates lie within WINDOW_SPREAD.
+    let start = trailing_window(&rates, n);
+    let window: &[&LevelError] = match start {
+        Some(first) => &usable[first..],
+        None => &usable,
+    };
+    (out.fit, out.fit_dofs) = fit_over(window);
+    out.used = window.iter().map(|e| e.level).collect();
+    out.verdict = verdict(start.is_some(), out.fit, out.fit_all, mean_last);
+    out.asymptotic_ratio = match (out.celik, out.fit) {
+        (Some(c), Some(f)) if f.rate > 0.0 => Some(c.asymptotic_ratio(f.rate)),
+        _ => None,
+    };
+    Ok(out)
+}
+
+/// Errs on two levels with the same h (to 1e-12 relative).
+fn check_distinct_h(levels: &[LevelError]) -> Result<(), EqualH> {
+    for (i, a) in levels.iter().enumerate() {
+        for b in &levels[i + 1..] {
+            if (a.h - b.h).abs() <= 1e-12 * a.h.abs().max(b.h.abs()) {
+                return Err(EqualH {
+                    levels: (a.level, b.level),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The levels sorted out: at round-off, near the truth (within [`TRUTH_MARGIN`] of its
+/// error `truth_error`), and the usable rest; with the successive rates between
+/// neighbouring levels. The assessment so far (too few levels, nothing fitted) and the
+/// usable levels.
+fn classify(levels: &[LevelError], truth_error: f64) -> (Assessment, Vec<&LevelError>) {
+    let at_roundoff = |e: &LevelError| e.error <= ROUNDOFF;
+    let roundoff: Vec<usize> = levels
+        .iter()
+        .filter(|e| at_roundoff(e))
+        .map(|e| e.level)
+        .collect();
+    let near_truth: Vec<usize> = levels
+        .iter()
+        .filter(|e| !at_roundoff(e) && e.error < TRUTH_MARGIN * truth_error)
+        .map(|e| e.level)
+        .collect();
+    let successive_rates: Vec<Option<f64>> = levels
+        .windows(2)
+        .map(|w| (!at_roundoff(&w[0]) && !at_roundoff(&w[1])).then(|| rate_between(&w[0], &w[1])))
+        .collect();
+    let usable: Vec<&LevelError> = levels
+        .iter()
+        .filter(|e| !at_roundoff(e) && !near_truth.contains(&e.level))
+        .collect();
+    let out = Assessment {
+        verdict: Verdict::TooFewLevels,
+        fit: None,
+        fit_dofs: None,
+        used: Vec::new(),
+        fit_all: None,
+        roundoff,
+        near_truth,
+        successive: successive_rates,
+        celik: None,
+        asymptotic_ratio: None,
+    };
+    (out, usable)
+}
+
+/// The fits in h and in dofs over `window`.
+fn fit_over(window: &[&LevelError]) -> (Option<Fit>, Option<Fit>) {
+    let h: Vec<f64> = window.iter().map(|e| e.h).collect();
+    let d: Vec<f64> = window.iter().map(|e| e.dofs).collect();
+    let e: Vec<f64> = window.iter().map(|e| e.error).collect();
+    (fit(&h, &e), fit(&d, &e))
+}
+
+/// The first of `n` usable levels (successive rates `rates`) of the longest trailing window
+/// of at least [`MIN_FIT_LEVELS`] whose successive rates lie within [`WINDOW_SPREAD`]; None
+/// where even the last two spread more.
+fn trailing_window(rates: &[f64], n: usize) -> Option<usize> {
     let mut start = None;
     for first in (0..=n - MIN_FIT_LEVELS).rev() {
         let r = &rates[first..];
@@ -375,14 +410,15 @@ pub fn assess(levels: &[LevelError], truth_error: f64) -> Result<Assessment, Equ
         }
         start = Some(first);
     }
-    let window: &[&LevelError] = match start {
-        Some(first) => &usable[first..],
-        None => &usable,
-    };
-    (out.fit, out.fit_dofs) = fit_over(window);
-    out.used = window.iter().map(|e| e.level).collect();
-    out.verdict = match (start, out.fit, out.fit_all) {
-        (Some(_), Some(w), Some(all)) => {
+    start
+}
+
+/// The verdict on a window's fit `fit` (`windowed`: a trailing window agreed), against the
+/// fit over every usable level `fit_all` and the mean of the last two successive rates
+/// `mean_last`.
+fn verdict(windowed: bool, fit: Option<Fit>, fit_all: Option<Fit>, mean_last: f64) -> Verdict {
+    match (windowed, fit, fit_all) {
+        (true, Some(w), Some(all)) => {
             let tolerance = DRIFT.max(2.0 * w.stderr);
             if (all.rate - w.rate).abs() > tolerance || (mean_last - w.rate).abs() > tolerance {
                 Verdict::Drifting
@@ -391,12 +427,7 @@ pub fn assess(levels: &[LevelError], truth_error: f64) -> Result<Assessment, Equ
             }
         }
         _ => Verdict::PreAsymptotic,
-    };
-    out.asymptotic_ratio = match (out.celik, out.fit) {
-        (Some(c), Some(f)) if f.rate > 0.0 => Some(c.asymptotic_ratio(f.rate)),
-        _ => None,
-    };
-    Ok(out)
+    }
 }
 
 /// The standard error sqrt(v) of a parameter of variance `v` from an inverted J^T J; a

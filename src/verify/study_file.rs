@@ -228,190 +228,261 @@ impl StudyFile {
         Self::from_toml(&text, path)
     }
 
-    /// Parse and validate the text of a study file; `path` names it in errors.
+    /// Parse and validate the text of a study file; `path` names it in errors. One check
+    /// per table, in a fixed order (the first error found is the one reported).
     pub fn from_toml(text: &str, path: &Path) -> Result<Self> {
         let s: StudyFile = crate::error::parse_toml(text, path, "study file")?;
-        let bad = |field: &str, msg: String| Err(Error::input(path, field, msg));
-        if s.methods.is_empty() {
-            return bad("methods", "list at least one method".into());
+        s.check_top_level(path)?;
+        s.mesh.check(path)?;
+        s.reference.check(path)?;
+        s.thresholds.check(path)?;
+        if let Some(two) = &s.two_size {
+            two.check(&s, path)?;
         }
-        if !s.quantities.contains(&s.thresholds.quantity) {
+        if let Some(ts) = &s.time {
+            ts.check(s.reference.exact, path)?;
+        }
+        Ok(s)
+    }
+
+    /// The keys outside the tables: methods, quantities (which must hold the thresholds'
+    /// quantity) and steps.
+    fn check_top_level(&self, path: &Path) -> Result<()> {
+        if self.methods.is_empty() {
+            return bad(path, "methods", "list at least one method".into());
+        }
+        if !self.quantities.contains(&self.thresholds.quantity) {
             return bad(
+                path,
                 "quantities",
                 format!(
                     "the thresholds apply to '{}': include it",
-                    s.thresholds.quantity
+                    self.thresholds.quantity
                 ),
             );
         }
-        if s.steps == 0 {
+        if self.steps == 0 {
             return bad(
+                path,
                 "steps",
                 "steps must be at least 1 (the time step k must be positive)".into(),
             );
         }
-        if s.mesh.levels.len() < 3 {
+        Ok(())
+    }
+}
+
+/// The error of `field` in the study file `path`.
+fn bad(path: &Path, field: &str, msg: String) -> Result<()> {
+    Err(Error::input(path, field, msg))
+}
+
+impl MeshSpec {
+    /// The `[mesh]` table: at least 3 increasing levels, positive sizes, and a ratio h1/h2
+    /// that is no ratio of small integers.
+    fn check(&self, path: &Path) -> Result<()> {
+        if self.levels.len() < 3 {
             return bad(
+                path,
                 "mesh.levels",
-                format!(
-                    "a rate needs at least 3 levels, got {}",
-                    s.mesh.levels.len()
-                ),
+                format!("a rate needs at least 3 levels, got {}", self.levels.len()),
             );
         }
-        if s.mesh.levels.windows(2).any(|w| w[1] <= w[0]) {
+        if self.levels.windows(2).any(|w| w[1] <= w[0]) {
             return bad(
+                path,
                 "mesh.levels",
                 "levels must increase: a repeated level has the same h as its twin, and no rate between them; list each level once, in increasing order".into(),
             );
         }
-        if !(s.mesh.coarsest > 0.0 && s.mesh.coarsest.is_finite()) {
+        if !(self.coarsest > 0.0 && self.coarsest.is_finite()) {
             return bad(
+                path,
                 "mesh.coarsest",
-                format!("the mesh size must be positive, got {}", s.mesh.coarsest),
+                format!("the mesh size must be positive, got {}", self.coarsest),
             );
         }
-        if let Some(v) = s
-            .mesh
+        if let Some(v) = self
             .variants
             .iter()
-            .find(|&&v| !(v > 0.0 && v.is_finite()) || v == s.mesh.coarsest)
+            .find(|&&v| !(v > 0.0 && v.is_finite()) || v == self.coarsest)
         {
             return bad(
+                path,
                 "mesh.variants",
                 format!("{v} is not a positive size other than mesh.coarsest; fix the value"),
             );
         }
-        if !(s.mesh.ratio > 0.0 && s.mesh.ratio.is_finite()) {
+        if !(self.ratio > 0.0 && self.ratio.is_finite()) {
             return bad(
+                path,
                 "mesh.ratio",
-                format!("the ratio h1/h2 must be positive, got {}", s.mesh.ratio),
+                format!("the ratio h1/h2 must be positive, got {}", self.ratio),
             );
         }
         for q in 1..=6u32 {
             for p in 1..=12u32 {
-                if (s.mesh.ratio - p as f64 / q as f64).abs() < 1e-9 {
+                if (self.ratio - p as f64 / q as f64).abs() < 1e-9 {
                     return bad(
+                        path,
                         "mesh.ratio",
                         format!(
                             "h1/h2 = {} = {p}/{q} is a ratio of small integers: the meshes would match at many nodes; use e.g. 1.4142",
-                            s.mesh.ratio
+                            self.ratio
                         ),
                     );
                 }
             }
         }
-        if !s.reference.exact && s.reference.levels_above < 2 {
+        Ok(())
+    }
+}
+
+impl ReferenceSpec {
+    /// The `[reference]` table: a solved reference at least 2 levels above the study's, an
+    /// exact one with nothing to solve, and a quadrature of 1 to 32 points.
+    fn check(&self, path: &Path) -> Result<()> {
+        if !self.exact && self.levels_above < 2 {
             return bad(
+                path,
                 "reference.levels_above",
                 "the reference must be at least 2 levels finer than the finest study level".into(),
             );
         }
-        if s.reference.exact
-            && (s.reference.levels_above != 0 || !s.reference.parameters.is_empty())
-        {
+        if self.exact && (self.levels_above != 0 || !self.parameters.is_empty()) {
             return bad(
+                path,
                 "reference",
                 "an exact reference is not solved: remove levels_above and parameters".into(),
             );
         }
-        if !(1..=32).contains(&s.reference.quadrature) {
+        if !(1..=32).contains(&self.quadrature) {
             return bad(
+                path,
                 "reference.quadrature",
                 format!(
                     "give 1 to 32 Gauss points per direction, got {}",
-                    s.reference.quadrature
+                    self.quadrature
                 ),
             );
         }
-        let t = &s.thresholds;
-        if !(t.tolerance >= 0.0 && t.tolerance <= 0.05) {
+        Ok(())
+    }
+}
+
+impl ThresholdSpec {
+    /// The `[thresholds]` table: a tolerance in [0, 0.05].
+    fn check(&self, path: &Path) -> Result<()> {
+        if !(self.tolerance >= 0.0 && self.tolerance <= 0.05) {
             return bad(
+                path,
                 "thresholds.tolerance",
-                format!("the tolerance must lie in [0, 0.05], got {}", t.tolerance),
+                format!(
+                    "the tolerance must lie in [0, 0.05], got {}",
+                    self.tolerance
+                ),
             );
         }
-        if let Some(two) = &s.two_size {
-            let finest = *s.mesh.levels.last().expect("at least 3 levels");
-            if two.fixed < finest + 2 {
-                return bad(
-                    "two_size.fixed",
-                    format!(
-                        "the fixed level must be at least 2 above the finest grid level {finest} (its own error must be small against the swept body's), got {}",
-                        two.fixed
-                    ),
-                );
-            }
-            if !s.reference.exact
-                && s.mesh.levels.last().unwrap() + s.reference.levels_above <= two.fixed
-            {
-                return bad(
-                    "reference.levels_above",
-                    format!(
-                        "the reference must be finer than the fixed level {}: give levels_above >= {}",
-                        two.fixed,
-                        two.fixed + 1 - finest
-                    ),
-                );
-            }
-            if s.time.is_some() || !s.mesh.variants.is_empty() {
-                return bad(
-                    "two_size",
-                    "a two-size study has no [time] table and no mesh.variants; run those in a diagonal study".into(),
-                );
-            }
-        }
-        if let Some(ts) = &s.time {
-            if ts.steps.len() < super::rates::MIN_FIT_LEVELS || ts.steps.iter().any(|&n| n == 0) {
-                return bad(
-                    "time.steps",
-                    format!(
-                        "give at least {} positive step counts (a rate in k is fitted on 3 or more)",
-                        super::rates::MIN_FIT_LEVELS
-                    ),
-                );
-            }
-            if ts.steps.windows(2).any(|w| w[1] <= w[0]) {
-                return bad(
-                    "time.steps",
-                    "step counts must increase: a repeated count has the same k as its twin, and no rate between them".into(),
-                );
-            }
-            match (ts.reference_steps, s.reference.exact) {
-                (Some(_), true) => {
-                    return bad(
-                        "time.reference_steps",
-                        "the study measures against the exact solution, which is also the truth in time: remove reference_steps".into(),
-                    );
-                }
-                (None, false) => {
-                    return bad(
-                        "time.reference_steps",
-                        "missing: give the steps of the reference in time (a multiple of every step count), or measure against an exact solution (reference.exact = true)".into(),
-                    );
-                }
-                (Some(r), false) => {
-                    if r <= *ts.steps.iter().max().unwrap() {
-                        return bad(
-                            "time.reference_steps",
-                            "reference_steps must be larger than every step count".into(),
-                        );
-                    }
-                    if let Some(n) = ts.steps.iter().find(|&&n| r % n != 0) {
-                        return bad(
-                            "time.reference_steps",
-                            format!(
-                                "reference_steps must be a multiple of every step count ({r} is not a multiple of {n})"
-                            ),
-                        );
-                    }
-                }
-                (None, true) => {}
-            }
-        }
-        Ok(s)
+        Ok(())
     }
+}
 
+impl TwoSizeSpec {
+    /// The `[two_size]` table of `study`: a fixed level at least 2 above the grid's finest,
+    /// below the reference, and no time study or mesh variants beside it.
+    fn check(&self, study: &StudyFile, path: &Path) -> Result<()> {
+        let (mesh, reference) = (&study.mesh, &study.reference);
+        let finest = *mesh.levels.last().expect("at least 3 levels");
+        if self.fixed < finest + 2 {
+            return bad(
+                path,
+                "two_size.fixed",
+                format!(
+                    "the fixed level must be at least 2 above the finest grid level {finest} (its own error must be small against the swept body's), got {}",
+                    self.fixed
+                ),
+            );
+        }
+        if !reference.exact && mesh.levels.last().unwrap() + reference.levels_above <= self.fixed {
+            return bad(
+                path,
+                "reference.levels_above",
+                format!(
+                    "the reference must be finer than the fixed level {}: give levels_above >= {}",
+                    self.fixed,
+                    self.fixed + 1 - finest
+                ),
+            );
+        }
+        if study.time.is_some() || !mesh.variants.is_empty() {
+            return bad(
+                path,
+                "two_size",
+                "a two-size study has no [time] table and no mesh.variants; run those in a diagonal study".into(),
+            );
+        }
+        Ok(())
+    }
+}
+
+impl TimeSpec {
+    /// The `[time]` table: at least [`super::rates::MIN_FIT_LEVELS`] increasing positive
+    /// step counts, and a reference in time exactly when the study's reference is not the
+    /// exact solution (`exact`).
+    fn check(&self, exact: bool, path: &Path) -> Result<()> {
+        if self.steps.len() < super::rates::MIN_FIT_LEVELS || self.steps.contains(&0) {
+            return bad(
+                path,
+                "time.steps",
+                format!(
+                    "give at least {} positive step counts (a rate in k is fitted on 3 or more)",
+                    super::rates::MIN_FIT_LEVELS
+                ),
+            );
+        }
+        if self.steps.windows(2).any(|w| w[1] <= w[0]) {
+            return bad(
+                path,
+                "time.steps",
+                "step counts must increase: a repeated count has the same k as its twin, and no rate between them".into(),
+            );
+        }
+        match (self.reference_steps, exact) {
+            (Some(_), true) => bad(
+                path,
+                "time.reference_steps",
+                "the study measures against the exact solution, which is also the truth in time: remove reference_steps".into(),
+            ),
+            (None, false) => bad(
+                path,
+                "time.reference_steps",
+                "missing: give the steps of the reference in time (a multiple of every step count), or measure against an exact solution (reference.exact = true)".into(),
+            ),
+            (Some(r), false) => {
+                if r <= *self.steps.iter().max().unwrap() {
+                    return bad(
+                        path,
+                        "time.reference_steps",
+                        "reference_steps must be larger than every step count".into(),
+                    );
+                }
+                if let Some(n) = self.steps.iter().find(|&&n| r % n != 0) {
+                    return bad(
+                        path,
+                        "time.reference_steps",
+                        format!(
+                            "reference_steps must be a multiple of every step count ({r} is not a multiple of {n})"
+                        ),
+                    );
+                }
+                Ok(())
+            }
+            (None, true) => Ok(()),
+        }
+    }
+}
+
+impl StudyFile {
     /// gmsh parameters of the study family.
     pub fn family_parameters(&self) -> Vec<(String, f64)> {
         self.variant_parameters(self.mesh.coarsest)
