@@ -20,7 +20,10 @@ use std::io::Write;
 /// Solve `contact-mms` at `level` with both cones and write what each measured to `out`.
 pub fn run(level: usize, out: &mut impl Write) -> contact_rates::Result<()> {
     let scene = Scene::load("contact-mms")?;
-    let exact = scene.exact.as_deref().expect("contact-mms has an exact solution");
+    let exact = scene
+        .exact
+        .as_deref()
+        .expect("contact-mms has an exact solution");
     let rule = ExactComparison::new(exact, 4);
     for method in [Method::Mortar, Method::Nts] {
         // The meshes of both bodies (gmsh, split `level` times) and the discrete problem.
@@ -42,7 +45,10 @@ pub fn run(level: usize, out: &mut impl Write) -> contact_rates::Result<()> {
             error / norm
         );
         // The contact pressure at T along Gamma_C beside the exact one, at a few nodes.
-        let last = solution.states.last().expect("the history has the final state");
+        let last = solution
+            .states
+            .last()
+            .expect("the history has the final state");
         let nodes = contact_nodes(&case.problem, last);
         let _ = writeln!(out, "  x         pressure  exact     normal jump");
         for node in nodes.iter().step_by(nodes.len().div_ceil(6)) {

@@ -18,7 +18,8 @@ fn the_teaching_example_prints_the_reports_errors() {
     let mut out = Vec::new();
     example::run(1, &mut out).unwrap();
     let text = String::from_utf8(out).unwrap();
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("reports/rates-exact/errors.csv");
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("reports/rates-exact/errors.csv");
     let report: Vec<ErrorRecord> = read(&path).unwrap();
     for method in ["mortar", "nts"] {
         let line = text
@@ -52,5 +53,8 @@ fn the_teaching_example_prints_the_reports_errors() {
         .map(|l| l.split_whitespace().nth(1).unwrap().parse().unwrap())
         .collect();
     assert!(pressures.len() >= 8, "{text}");
-    assert!(pressures.iter().all(|p| p.is_finite() && *p >= 0.0), "{text}");
+    assert!(
+        pressures.iter().all(|p| p.is_finite() && *p >= 0.0),
+        "{text}"
+    );
 }

@@ -8,8 +8,9 @@
 //! within max(0.15, 2 stderr) of the mean of its last two successive rates.
 //! Data: README.md, docs/results.md and reports/*/rates.csv, errors.csv as committed.
 
-use contact_rates::results::{HEADLINE, RateLine, STUDIES, headline, section};
+use contact_rates::results::{HEADLINE, STUDIES, headline, section};
 use contact_rates::verify::rates::Verdict;
+use contact_rates::verify::table::{RateRecord, read};
 use std::path::Path;
 
 fn root() -> &'static Path {
@@ -71,11 +72,7 @@ fn headline_prints_only_rates_the_verdicts_support() {
             .find(|l| l.starts_with(&format!("| [`{name}`]")))
             .unwrap_or_else(|| panic!("no headline row for {name}"));
         let path = root().join("reports").join(name).join("rates.csv");
-        let rows: Vec<RateLine> = csv::Reader::from_path(&path)
-            .unwrap()
-            .deserialize()
-            .map(|r| r.unwrap())
-            .collect();
+        let rows: Vec<RateRecord> = read(&path).unwrap();
         let mut allowed = Vec::new();
         for r in rows
             .iter()
@@ -109,9 +106,7 @@ fn every_fitted_rate_agrees_with_its_last_successive_rates() {
     let mut checked = 0;
     for (name, _) in STUDIES {
         let path = root().join("reports").join(name).join("rates.csv");
-        let mut reader = csv::Reader::from_path(&path).unwrap();
-        for row in reader.deserialize::<RateLine>() {
-            let r = row.unwrap();
+        for r in read::<RateRecord>(&path).unwrap() {
             if r.verdict != Verdict::Fitted {
                 continue;
             }
