@@ -9,26 +9,24 @@
 //! - [`speed`]: what each accuracy costs, against the floor;
 //! - [`stability`]: hard cases with every solver.
 
-pub mod convergence;
-pub mod paper;
-pub mod speed;
-pub mod stability;
-pub mod two_size;
-
 use crate::error::{Error, Result};
 use crate::verify::jobs::Mode;
 use crate::verify::kind::{Found, Kind, Outcome};
 use crate::verify::study_file::{self, StudyFile};
 use std::path::PathBuf;
 
-/// Every study kind.
-pub const KINDS: &[&Kind] = &[
-    &convergence::KIND,
-    &two_size::KIND,
-    &paper::KIND,
-    &speed::KIND,
-    &stability::KIND,
-];
+/// Declares each kind's folder as a module and lists its `KIND` in [`KINDS`], so that a
+/// kind is named once.
+macro_rules! kinds {
+    ($($kind:ident),* $(,)?) => {
+        $(pub mod $kind;)*
+        /// Every study kind, in the order `study NAME` tries them.
+        pub const KINDS: &[&Kind] = &[$(&$kind::KIND),*];
+    };
+}
+
+// The table of study kinds: one folder under src/studies/ each.
+kinds![convergence, two_size, paper, speed, stability];
 
 /// A study to run: its kind and, for a kind found in files, the study file.
 pub struct Study {
