@@ -169,6 +169,9 @@ pub struct SceneBody {
     pub material: Material,
     /// Body force, if any.
     pub body_force: Option<VectorExpr>,
+    /// Its place in the scene file's `[[bodies]]`: errors name the field
+    /// `bodies[file_index]`.
+    pub file_index: usize,
 }
 
 /// A roller condition: curve and held component (0 = x, 1 = y).
@@ -328,12 +331,12 @@ impl Scene {
             .unwrap_or_default();
         let dir = file.parent().unwrap_or(Path::new("."));
         let geo = dir.join(&sf.geo);
-        if !geo.exists() {
+        if !geo.is_file() {
             return Err(Error::input(
                 file,
                 "geo",
                 format!(
-                    "the .geo file {} does not exist; give its path relative to the scene file",
+                    "the .geo file {} does not exist or is not a file; give its path relative to the scene file",
                     geo.display()
                 ),
             ));
@@ -410,6 +413,7 @@ impl Scene {
                     viscoplastic,
                 },
                 body_force,
+                file_index: i,
             });
         }
         let slave = bodies
