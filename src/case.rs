@@ -142,6 +142,29 @@ impl Case {
         Self::from_mesh(scene, top, method, generated, raw, t0)
     }
 
+    /// The level-`level` mesh of `scene` (gmsh parameters from the scene, overridden by
+    /// `params`), generated or fetched from the cache, and read: what [`Case::build`] meshes,
+    /// without its memory check. Errors name the scene file.
+    pub fn mesh(
+        scene: &Scene,
+        level: usize,
+        params: &[(String, f64)],
+    ) -> Result<(gmsh::GeneratedMesh, msh::RawMesh)> {
+        mesh_healed(scene, &checked_parameters(scene, params)?, level)
+    }
+
+    /// The case of `scene` on a mesh [`Case::mesh`] gave, at `level`, for `method`: every
+    /// check of the scene against its mesh, its exact solution and the problem's set-up.
+    pub fn on_mesh(
+        scene: &Scene,
+        level: usize,
+        method: Method,
+        generated: gmsh::GeneratedMesh,
+        raw: msh::RawMesh,
+    ) -> Result<Self> {
+        Self::from_mesh(scene, level, method, generated, raw, Instant::now())
+    }
+
     /// The case of `scene` on the read mesh `raw` (generated as `generated`, from `t0`).
     fn from_mesh(
         scene: &Scene,
@@ -175,7 +198,7 @@ impl Case {
 /// finite, and a size (a parameter named h...) positive.
 fn check_parameters(scene: &Scene, params: &[(String, f64)]) -> Result<()> {
     for (name, value) in params {
-        let field = format!("parameter {name}");
+        let field = format!("parameters.{name}");
         if !value.is_finite() {
             return Err(Error::input(
                 &scene.file,
@@ -246,8 +269,50 @@ fn check_memory(scene: &Scene, params: &[(String, f64)], level: usize) -> Result
 
 /// The mesh of `scene` at `level` and its contents. A cached file that does not parse (a
 /// run killed while writing it, a disk that filled up) is deleted and regenerated, with a
-/// one-line warning.
+/// one-line warning. Errors about the .geo or the mesh name the scene file and its field
+/// `geo` (the .geo meshed with the scene's parameters).
 fn mesh_healed(
+    scene: &Scene,
+    params: &[(String, f64)],
+    level: usize,
+) -> Result<(gmsh::GeneratedMesh, msh::RawMesh)> {
+    mesh_or_regenerated(scene, params, level).map_err(|e| match e {
+        Error::Input {
+            file,
+            field,
+            message,
+        } if file != scene.file => Error::input(
+            &scene.file,
+            "geo",
+            format!(
+                "{}: {field}: {message} (the .geo meshed with {})",
+                file.display(),
+                parameter_list(params)
+            ),
+        ),
+        Error::Io { path, source } if path == scene.geo => Error::input(
+            &scene.file,
+            "geo",
+            format!("{}: {source}; fix the path or the file", path.display()),
+        ),
+        other => other,
+    })
+}
+
+/// `name = value, ...`, or "no parameters".
+fn parameter_list(params: &[(String, f64)]) -> String {
+    if params.is_empty() {
+        return "no parameters".into();
+    }
+    params
+        .iter()
+        .map(|(k, v)| format!("{k} = {v}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// [`mesh_healed`] before its errors are put on the scene file.
+fn mesh_or_regenerated(
     scene: &Scene,
     params: &[(String, f64)],
     level: usize,

@@ -7,7 +7,7 @@
 
 use crate::error::{Error, Result};
 use crate::fe::{FIXED, Model};
-use crate::mesh::RawMesh;
+use crate::mesh::{MeshSource, RawMesh};
 
 /// Which discrete cone. Written as its [`Method::name`] in files; read from it with an
 /// error that lists the names.
@@ -204,10 +204,13 @@ impl Interface {
 
     /// Build Gamma_C from the scene's slave and master curves.
     pub fn new(model: &Model, raw: &RawMesh) -> Result<Self> {
-        let file = &model.mesh_file;
         let sc = &model.scene;
-        raw.require_curve(&sc.slave_curve, file, "contact.slave_curve")?;
-        raw.require_curve(&sc.master_curve, file, "contact.master_curve")?;
+        let source = MeshSource {
+            scene: &sc.file,
+            geo: &sc.geo,
+        };
+        raw.require_curve(&sc.slave_curve, &source, "contact.slave_curve")?;
+        raw.require_curve(&sc.master_curve, &source, "contact.master_curve")?;
         // Body b's edges on its contact curve, in global node numbers.
         let edges_on =
             |b: usize, curve: &str, field: &str, role: &str| -> Result<Vec<[usize; 2]>> {

@@ -58,39 +58,79 @@ impl Error {
 }
 
 /// Deserialize TOML `text` read from `file`; a syntax error, unknown key or missing field
-/// becomes one error naming the file, the line and the fix (`what` names the kind of file).
+/// becomes one error naming the file, the line, the key (as a path: `bodies[0].young`) and
+/// the fix (`what` names the kind of file).
 pub fn parse_toml<T: serde::de::DeserializeOwned>(
     text: &str,
     file: &std::path::Path,
     what: &str,
 ) -> Result<T> {
-    toml::from_str(text).map_err(|e| {
-        let start = e.span().map(|s| s.start.min(text.len()));
-        let line = start
-            .map(|s| format!(" (line {})", text[..s].lines().count().max(1)))
-            .unwrap_or_default();
-        // The key the error sits on, with its table: `key = ...` on the error's line and
-        // the last `[table]` header above it.
-        let key = start.and_then(|s| {
-            let line_start = text[..s].rfind('\n').map_or(0, |i| i + 1);
-            let (k, _) = text[line_start..].lines().next()?.split_once('=')?;
-            let k = k.trim();
-            let table = text[..line_start]
-                .lines()
-                .rev()
-                .map(str::trim)
-                .find(|l| l.starts_with('[') && l.ends_with(']'))
-                .map(|l| l.trim_matches(|c| c == '[' || c == ']').to_string());
-            (!k.is_empty()).then(|| match table {
-                Some(t) => format!(" key {t}.{k}"),
-                None => format!(" key {k}"),
-            })
-        });
-        let line = format!("{line}{}", key.unwrap_or_default());
-        Error::input(
-            file,
-            format!("toml{line}"),
-            format!("{}; fix the {what}", e.message()),
-        )
+    let document = toml::Deserializer::parse(text).map_err(|e| {
+        let key = syntax_error_key(text, e.span());
+        toml_error(text, file, what, &e, key)
+    })?;
+    // serde_path_to_error tracks where the deserializer stood: the key of a bad value, or
+    // the table of a missing or unknown field (whose name the message gives).
+    serde_path_to_error::deserialize(document).map_err(|e| {
+        let table = e.path().to_string();
+        let table = if table == "." { String::new() } else { table };
+        let named = ["missing field `", "unknown field `"]
+            .iter()
+            .find_map(|p| e.inner().message().strip_prefix(p))
+            .and_then(|rest| rest.split_once('`'))
+            .map(|(name, _)| name.to_string());
+        // An unknown field's path ends with it already; a missing one's is its table.
+        let key = match named {
+            Some(name) if table.is_empty() => Some(name),
+            Some(name) if table != name && !table.ends_with(&format!(".{name}")) => {
+                Some(format!("{table}.{name}"))
+            }
+            _ => (!table.is_empty()).then_some(table),
+        };
+        toml_error(text, file, what, e.inner(), key)
     })
+}
+
+/// The key a TOML syntax error sits on, with its table: `key = ...` on the error's line
+/// and the last `[table]` header above it.
+fn syntax_error_key(text: &str, span: Option<std::ops::Range<usize>>) -> Option<String> {
+    let s = span?.start.min(text.len());
+    let line_start = text[..s].rfind('\n').map_or(0, |i| i + 1);
+    let (k, _) = text[line_start..].lines().next()?.split_once('=')?;
+    let k = k.trim();
+    let table = text[..line_start]
+        .lines()
+        .rev()
+        .map(str::trim)
+        .find(|l| l.starts_with('[') && l.ends_with(']'))
+        .map(|l| l.trim_matches(|c| c == '[' || c == ']').to_string());
+    (!k.is_empty()).then(|| match table {
+        Some(t) => format!("{t}.{k}"),
+        None => k.to_string(),
+    })
+}
+
+/// The error of a TOML file: field `toml (line N) key KEY`, the parser's message and the fix.
+fn toml_error(
+    text: &str,
+    file: &std::path::Path,
+    what: &str,
+    e: &toml::de::Error,
+    key: Option<String>,
+) -> Error {
+    let line = e
+        .span()
+        .map(|s| {
+            format!(
+                " (line {})",
+                1 + text[..s.start.min(text.len())].matches('\n').count()
+            )
+        })
+        .unwrap_or_default();
+    let key = key.map(|k| format!(" key {k}")).unwrap_or_default();
+    Error::input(
+        file,
+        format!("toml{line}{key}"),
+        format!("{}; fix the {what}", e.message()),
+    )
 }

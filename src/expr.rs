@@ -156,13 +156,30 @@ impl Expr {
 }
 
 /// `text` with every number in exponent notation (as exmex unparses very small or large
-/// constants, e.g. `7.5e-19`) written out in full, which exmex's parser reads back.
+/// constants, e.g. `7.5e-19`) written out in full, and the non-finite constants `inf` and
+/// `NaN` (a constant 1/0 or 0/0 folded at parse) as `(1/0)` and `(0/0)`: what exmex's
+/// parser reads back as numbers, not as variables.
 fn plain_numbers(text: &str) -> String {
     let chars: Vec<char> = text.chars().collect();
+    let identifier = |c: char| c.is_alphanumeric() || c == '_';
     let mut out = String::with_capacity(text.len());
     let mut i = 0;
     while i < chars.len() {
         let c = chars[i];
+        let word_start = i == 0 || !(identifier(chars[i - 1]) || chars[i - 1] == '.');
+        let non_finite = [("inf", "(1/0)"), ("NaN", "(0/0)")]
+            .into_iter()
+            .find(|(word, _)| {
+                let n = word.len();
+                word_start
+                    && chars[i..].iter().take(n).copied().eq(word.chars())
+                    && chars.get(i + n).is_none_or(|&c| !identifier(c))
+            });
+        if let Some((word, number)) = non_finite {
+            out.push_str(number);
+            i += word.len();
+            continue;
+        }
         let starts_number = c.is_ascii_digit()
             && (i == 0
                 || !(chars[i - 1].is_alphanumeric() || chars[i - 1] == '_' || chars[i - 1] == '.'));

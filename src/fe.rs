@@ -5,7 +5,7 @@
 use crate::error::{Error, Result};
 use crate::expr::{distinct_kinks, kink_functions};
 use crate::material::{LANES, Material, Strain, Stress};
-use crate::mesh::{BodyMesh, RawMesh};
+use crate::mesh::{BodyMesh, MeshSource, RawMesh};
 use crate::quadrature;
 use crate::scene::Scene;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
@@ -271,22 +271,21 @@ fn outward_normals(
         .collect()
 }
 
-/// The physical curves of the two body meshes read from `mesh_file`, in the model's global
-/// node numbering (body b's nodes start at `offsets[b]`).
+/// The physical curves of the two body meshes, in the model's global node numbering (body
+/// b's nodes start at `offsets[b]`); errors name the scene file's field that names a curve.
 struct Curves<'a> {
     raw: &'a RawMesh,
     meshes: &'a [BodyMesh; 2],
     offsets: [usize; 2],
-    mesh_file: &'a Path,
+    source: &'a MeshSource<'a>,
 }
 
 impl Curves<'_> {
     /// The edges of `curve` on either body as (body, global node pair); errs where the mesh
-    /// has no such curve (named by the scene's `scene_key`) or it has no edge.
-    fn edges(&self, curve: &str, scene_key: &str) -> Result<Vec<(usize, [usize; 2])>> {
-        let (raw, meshes, offsets, mesh_file) =
-            (self.raw, self.meshes, self.offsets, self.mesh_file);
-        raw.require_curve(curve, mesh_file, scene_key)?;
+    /// has no such curve or it has no edge, naming the scene's field `field`.
+    fn edges(&self, curve: &str, field: &str) -> Result<Vec<(usize, [usize; 2])>> {
+        let (raw, meshes, offsets, source) = (self.raw, self.meshes, self.offsets, self.source);
+        raw.require_curve(curve, source, field)?;
         let mut out = Vec::new();
         for b in 0..2 {
             for e in meshes[b].curve_edges(raw, curve) {
@@ -294,10 +293,14 @@ impl Curves<'_> {
             }
         }
         if out.is_empty() {
-            return Err(Error::input(
-                mesh_file,
-                curve,
-                format!("physical curve '{curve}' has no edge on either body; check the .geo"),
+            return Err(source.error(
+                field,
+                format!(
+                    "physical curve '{curve}' of the mesh of {} has no edge on either body ('{}', '{}'); fix: name a curve on a body's boundary in {field}, or check the .geo",
+                    source.geo.display(),
+                    meshes[0].name,
+                    meshes[1].name
+                ),
             ));
         }
         Ok(out)
@@ -335,16 +338,17 @@ fn body_elements(meshes: &[BodyMesh; 2], node_offset: [usize; 2]) -> Vec<Element
 /// roller's component on each roller curve (which must be straight along the other axis).
 fn fixed_dofs(scene: &Scene, curves: &Curves, n_nodes: usize) -> Result<Vec<bool>> {
     let mut fixed = vec![false; 2 * n_nodes];
-    for c in &scene.clamps {
-        for (_, e) in curves.edges(c, "clamp.curve")? {
+    for (i, c) in scene.clamps.iter().enumerate() {
+        for (_, e) in curves.edges(c, &format!("clamp[{i}].curve"))? {
             for n in e {
                 fixed[2 * n] = true;
                 fixed[2 * n + 1] = true;
             }
         }
     }
-    for r in &scene.rollers {
-        for (_, e) in curves.edges(&r.curve, "roller.curve")? {
+    for (i, r) in scene.rollers.iter().enumerate() {
+        let field = format!("roller[{i}].curve");
+        for (_, e) in curves.edges(&r.curve, &field)? {
             let (a, b) = (curves.position(e[0]), curves.position(e[1]));
             let d = [b[0] - a[0], b[1] - a[1]];
             let len = d[0].hypot(d[1]);
@@ -352,11 +356,12 @@ fn fixed_dofs(scene: &Scene, curves: &Curves, n_nodes: usize) -> Result<Vec<bool
             if d[r.component].abs() > 1e-9 * len {
                 return Err(Error::input(
                     &scene.file,
-                    format!("roller '{}'", r.curve),
+                    field,
                     format!(
-                        "a roller holding u_{} needs a {} curve, but an edge runs from {a:?} to {b:?}; use a clamp or fix the geometry",
+                        "a roller holding u_{} needs a {} curve, but an edge of '{}' runs from {a:?} to {b:?}; use a clamp or fix the geometry",
                         ["x", "y"][r.component],
-                        ["vertical", "horizontal"][r.component]
+                        ["vertical", "horizontal"][r.component],
+                        r.curve
                     ),
                 ));
             }
@@ -383,11 +388,19 @@ fn number_equations(fixed: &[bool]) -> (Vec<usize>, usize) {
 }
 
 impl Model {
-    /// Build the model of `scene` on the mesh `raw` read from `mesh_file`.
+    /// Build the model of `scene` on the mesh `raw` read from `mesh_file`. Errors about the
+    /// mesh's physical groups name the scene file and its field.
     pub fn new(scene: &Scene, raw: &RawMesh, mesh_file: &Path) -> Result<Self> {
-        let m0 = BodyMesh::from_raw(raw, &scene.bodies[0].surface, mesh_file)?;
-        let m1 = BodyMesh::from_raw(raw, &scene.bodies[1].surface, mesh_file)?;
-        let meshes = [m0, m1];
+        let source = MeshSource {
+            scene: &scene.file,
+            geo: &scene.geo,
+        };
+        let body_mesh = |b: usize| {
+            let body = &scene.bodies[b];
+            let field = format!("bodies[{}].surface", body.file_index);
+            BodyMesh::from_raw(raw, &body.surface, &source, &field)
+        };
+        let meshes = [body_mesh(0)?, body_mesh(1)?];
         let node_offset = [0, meshes[0].nodes.len()];
         let n_nodes = node_offset[1] + meshes[1].nodes.len();
         let elements = body_elements(&meshes, node_offset);
@@ -395,13 +408,13 @@ impl Model {
             raw,
             meshes: &meshes,
             offsets: node_offset,
-            mesh_file,
+            source: &source,
         };
         let fixed = fixed_dofs(scene, &curves, n_nodes)?;
         let (equation, n_free) = number_equations(&fixed);
         let mut traction_edges = Vec::new();
         for (i, t) in scene.tractions.iter().enumerate() {
-            for (_, e) in curves.edges(&t.curve, "traction.curve")? {
+            for (_, e) in curves.edges(&t.curve, &format!("traction[{i}].curve"))? {
                 traction_edges.push((i, e));
             }
         }
@@ -426,8 +439,9 @@ impl Model {
         })
     }
 
-    /// The traction sigma(u) n of the manufactured solution on traction edge `e`.
-    fn derived_traction(&self, e: usize, x: f64, y: f64, t: f64, field: &str) -> Result<[f64; 2]> {
+    /// The traction sigma(u) n of the manufactured solution on traction edge `e`, of the
+    /// scene's `traction[i]`.
+    fn derived_traction(&self, e: usize, i: usize, x: f64, y: f64, t: f64) -> Result<[f64; 2]> {
         let (body, n) = self.traction_normals[e];
         let s = self
             .scene
@@ -439,9 +453,10 @@ impl Model {
         if g.iter().any(|v| !v.is_finite()) {
             return Err(Error::input(
                 &self.scene.file,
-                field,
+                "exact",
                 format!(
-                    "the traction derived from exact.displacement is not finite at x = {x}, y = {y}, t = {t}; fix the displacement"
+                    "the traction on traction[{i}] (curve '{}') derived from the exact fields is not finite at x = {x}, y = {y}, t = {t}; fix the displacement (or the stress)",
+                    self.scene.tractions[i].curve
                 ),
             ));
         }
@@ -647,10 +662,9 @@ impl Model {
             for &(s, w) in quadrature::segment_rule(pa, pb, kinks, &segment).iter() {
                 let x = pa[0] + s * (pb[0] - pa[0]);
                 let y = pa[1] + s * (pb[1] - pa[1]);
-                let field = || format!("traction '{}'.g", self.scene.tractions[i].curve);
                 let g = match &self.scene.tractions[i].g {
-                    Some(g) => g.eval(x, y, t, &self.scene.file, &field())?,
-                    None => self.derived_traction(e, x, y, t, &field())?,
+                    Some(g) => g.eval(x, y, t, &self.scene.file, &format!("traction[{i}].g"))?,
+                    None => self.derived_traction(e, i, x, y, t)?,
                 };
                 let w = w * len;
                 for c in 0..2 {
@@ -664,14 +678,31 @@ impl Model {
                 continue;
             };
             let kinks = kink_functions(&distinct_kinks(&bf.0), t);
-            let field = format!("bodies '{}'.body_force", self.scene.bodies[body].surface);
+            // A manufactured scene derives the body force from its exact fields.
+            let derived = exact.is_some_and(|e| e.body_force.is_some());
+            let field = format!("bodies[{}].body_force", self.scene.bodies[body].file_index);
             for e in self.elements.iter().filter(|e| e.body == body) {
                 let p = e.nodes.map(|n| self.position(n));
                 for &(l1, l2, w) in quadrature::triangle_rule(p, &kinks, &triangle).iter() {
                     let lam = [1.0 - l1 - l2, l1, l2];
                     let x = lam[0] * p[0][0] + lam[1] * p[1][0] + lam[2] * p[2][0];
                     let y = lam[0] * p[0][1] + lam[1] * p[1][1] + lam[2] * p[2][1];
-                    let v = bf.eval(x, y, t, &self.scene.file, &field)?;
+                    let v = if derived {
+                        let v = [bf.0[0].eval(x, y, t), bf.0[1].eval(x, y, t)];
+                        if v.iter().any(|c| !c.is_finite()) {
+                            return Err(Error::input(
+                                &self.scene.file,
+                                "exact",
+                                format!(
+                                    "the body force -div sigma of body '{}' derived from the exact fields is not finite at x = {x}, y = {y}, t = {t}; fix the displacement (or the stress)",
+                                    self.scene.bodies[body].surface
+                                ),
+                            ));
+                        }
+                        v
+                    } else {
+                        bf.eval(x, y, t, &self.scene.file, &field)?
+                    };
                     for a in 0..3 {
                         for c in 0..2 {
                             f[2 * e.nodes[a] + c] += w * e.area * lam[a] * v[c];

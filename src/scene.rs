@@ -169,6 +169,9 @@ pub struct SceneBody {
     pub material: Material,
     /// Body force, if any.
     pub body_force: Option<VectorExpr>,
+    /// Its place in the scene file's `[[bodies]]`: errors name the field
+    /// `bodies[file_index]`.
+    pub file_index: usize,
 }
 
 /// A roller condition: curve and held component (0 = x, 1 = y).
@@ -376,12 +379,12 @@ impl Scene {
 fn geo_path(geo: &Path, file: &Path) -> Result<PathBuf> {
     let dir = file.parent().unwrap_or(Path::new("."));
     let geo = dir.join(geo);
-    if !geo.exists() {
+    if !geo.is_file() {
         return Err(Error::input(
             file,
             "geo",
             format!(
-                "the .geo file {} does not exist; give its path relative to the scene file",
+                "the .geo file {} does not exist or is not a file; give its path relative to the scene file",
                 geo.display()
             ),
         ));
@@ -474,6 +477,7 @@ fn body(i: usize, b: &BodySpec, file: &Path) -> Result<SceneBody> {
             viscoplastic,
         },
         body_force,
+        file_index: i,
     })
 }
 

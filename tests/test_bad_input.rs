@@ -129,7 +129,7 @@ fn expression_that_is_not_finite_is_reported_with_its_place() {
     });
     fails_with(
         &solve_scene(&f, &dir.path().join("o"), &[]),
-        &["traction 'top'.g[1]", "1/(x-x)", "not finite"],
+        &["traction[0].g[1]", "1/(x-x)", "not finite"],
     );
 }
 
@@ -145,7 +145,7 @@ fn mesh_lacking_a_physical_group_lists_what_it_has() {
     fails_with(
         &solve_scene(&f, &dir.path().join("o"), &[]),
         &[
-            "interface",
+            "scene.toml: contact.master_curve: the mesh of",
             "no physical curve named 'interface'",
             "contact_lower",
         ],
@@ -155,7 +155,11 @@ fn mesh_lacking_a_physical_group_lists_what_it_has() {
     });
     fails_with(
         &solve_scene(&f, &dir.path().join("o"), &[]),
-        &["no physical surface named 'base'", "lower, upper"],
+        &[
+            "scene.toml: bodies[1].surface: the mesh of",
+            "no physical surface named 'base'",
+            "lower, upper",
+        ],
     );
 }
 

@@ -180,7 +180,7 @@ fn sizes_that_are_not_finite_or_not_positive_are_refused_before_meshing() {
         let dir = tempfile::tempdir().unwrap();
         let set = format!("h_upper={value}");
         let o = solve("rates", &["--set", &set], &dir.path().join("o"), &[]);
-        fails_short(&o, &["rates.toml", "parameter h_upper", needle]);
+        fails_short(&o, &["rates.toml", "parameters.h_upper", needle]);
     }
 }
 

@@ -4,9 +4,8 @@
 pub mod gmsh;
 pub mod msh;
 
-use crate::error::{Error, Result};
-pub use msh::RawMesh;
-use std::path::Path;
+use crate::error::Result;
+pub use msh::{MeshSource, RawMesh};
 
 /// Marker for a raw node that is not part of a body.
 const ABSENT: usize = usize::MAX;
@@ -34,14 +33,20 @@ fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
 }
 
 impl BodyMesh {
-    /// Extract the body meshed as physical surface `surface` from `raw` (read from `file`).
-    pub fn from_raw(raw: &RawMesh, surface: &str, file: &Path) -> Result<Self> {
+    /// Extract the body meshed as physical surface `surface` from `raw`; errors name the
+    /// scene file of `source` and its field `field` that names the surface.
+    pub fn from_raw(
+        raw: &RawMesh,
+        surface: &str,
+        source: &MeshSource,
+        field: &str,
+    ) -> Result<Self> {
         let tag = raw.physical_tag(2, surface).ok_or_else(|| {
-            Error::input(
-                file,
-                surface,
+            source.error(
+                field,
                 format!(
-                    "the mesh has no physical surface named '{surface}' (it has: {}); name the body after one of them or add `Physical Surface(\"{surface}\")` to the .geo",
+                    "the mesh of {} has no physical surface named '{surface}'; its surfaces are {}; fix: name one of them in {field}, or add `Physical Surface(\"{surface}\")` to the .geo",
+                    source.geo.display(),
                     raw.names_of_dim(2).join(", ")
                 ),
             )
@@ -68,11 +73,11 @@ impl BodyMesh {
                         .powi(2)
                         .max(f64::MIN_POSITIVE)
             {
-                return Err(Error::input(
-                    file,
-                    surface,
+                return Err(source.error(
+                    "geo",
                     format!(
-                        "degenerate triangle with nodes at {:?}; fix the mesh sizes in the .geo",
+                        "the mesh of {} has a degenerate triangle in body '{surface}' with nodes at {:?}; fix the mesh sizes in the .geo or the scene's [parameters]",
+                        source.geo.display(),
                         t.map(|i| nodes[i])
                     ),
                 ));

@@ -8,6 +8,23 @@ use crate::error::{Error, Result};
 use std::collections::HashMap;
 use std::path::Path;
 
+/// Where a mesh's physical groups are named, for errors: the scene file whose fields name
+/// them, and the .geo that defines them.
+#[derive(Debug, Clone, Copy)]
+pub struct MeshSource<'a> {
+    /// The scene file.
+    pub scene: &'a Path,
+    /// The .geo meshed.
+    pub geo: &'a Path,
+}
+
+impl MeshSource<'_> {
+    /// Bad input at the scene file's `field`.
+    pub fn error(&self, field: &str, message: String) -> Error {
+        Error::input(self.scene, field, message)
+    }
+}
+
 /// A mesh as gmsh wrote it: all nodes, and the elements that belong to physical groups.
 #[derive(Debug, Clone, Default)]
 pub struct RawMesh {
@@ -30,16 +47,15 @@ impl RawMesh {
             .map(|((_, t), _)| *t)
     }
 
-    /// The tag of the physical curve `name`, or an error naming the mesh file, the curves
-    /// the mesh has, and the fix: `scene_key` (the scene's field that names the curve) or
-    /// the .geo.
-    pub fn require_curve(&self, name: &str, mesh_file: &Path, scene_key: &str) -> Result<i32> {
+    /// The tag of the physical curve `name`, or an error naming the scene file and its
+    /// field `field` that names the curve, the .geo, the curves the mesh has, and the fix.
+    pub fn require_curve(&self, name: &str, source: &MeshSource, field: &str) -> Result<i32> {
         self.physical_tag(1, name).ok_or_else(|| {
-            Error::input(
-                mesh_file,
-                name,
+            source.error(
+                field,
                 format!(
-                    "the mesh has no physical curve named '{name}' (it has: {}); fix {scene_key} in the scene or add `Physical Curve(\"{name}\")` to the .geo",
+                    "the mesh of {} has no physical curve named '{name}'; its curves are {}; fix: name one of them in {field}, or add `Physical Curve(\"{name}\")` to the .geo",
+                    source.geo.display(),
                     self.names_of_dim(1).join(", ")
                 ),
             )
