@@ -73,6 +73,13 @@ pub fn empty_as_nan<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Resu
     Ok(v.unwrap_or(f64::NAN))
 }
 
+/// A number that may be NaN or infinite in a CSV cell: written by [`finite_or_empty`], read
+/// back by [`empty_as_nan`] (`#[serde(with = "crate::io::finite")]`).
+pub mod finite {
+    pub use super::empty_as_nan as deserialize;
+    pub use super::finite_or_empty as serialize;
+}
+
 /// `{:.3}` of a finite number, "n/a" otherwise.
 pub fn fmt3(v: f64) -> String {
     if v.is_finite() {

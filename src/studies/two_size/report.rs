@@ -28,30 +28,71 @@ const MAPPED: [Quantity; 4] = [
 /// E = C1 h1^a1 + C2 h2^a2 and the one-sided sweeps.
 #[derive(Debug, Serialize, serde::Deserialize)]
 pub struct FitRecord {
+    /// The body carrying the constraint.
     pub slave: String,
+    /// Cone.
     pub method: Method,
+    /// Quantity.
     pub quantity: Quantity,
+    /// Exponent of h1 (the slave) in E = C1 h1^a1 + C2 h2^a2 (empty without a fit).
+    #[serde(with = "crate::io::finite")]
     pub a1: f64,
+    /// Its standard error.
+    #[serde(with = "crate::io::finite")]
     pub se_a1: f64,
+    /// Exponent of h2 (the master).
+    #[serde(with = "crate::io::finite")]
     pub a2: f64,
+    /// Its standard error.
+    #[serde(with = "crate::io::finite")]
     pub se_a2: f64,
+    /// C1.
+    #[serde(with = "crate::io::finite")]
     pub c1: f64,
+    /// C2.
+    #[serde(with = "crate::io::finite")]
     pub c2: f64,
+    /// Root mean square of the fit's residuals in log(error).
+    #[serde(with = "crate::io::finite")]
     pub rms_log_residual: f64,
+    /// Lemma 3.1's exponent of h1.
     pub lemma_a1: f64,
+    /// Lemma 3.1's exponent of h2.
     pub lemma_a2: f64,
+    /// Rate in h1 with the master fixed (empty without a fit).
+    #[serde(with = "crate::io::finite")]
     pub rate_h1: f64,
+    /// Its standard error.
+    #[serde(with = "crate::io::finite")]
     pub stderr_h1: f64,
+    /// Slave levels in that fit, space separated.
     pub levels_h1: String,
+    /// Its verdict.
     pub verdict_h1: Verdict,
+    /// Rate in h2 with the slave fixed (empty without a fit).
+    #[serde(with = "crate::io::finite")]
     pub rate_h2: f64,
+    /// Its standard error.
+    #[serde(with = "crate::io::finite")]
     pub stderr_h2: f64,
+    /// Master levels in that fit, space separated.
     pub levels_h2: String,
+    /// Its verdict.
     pub verdict_h2: Verdict,
+    /// The error with both bodies at the fixed level.
+    #[serde(with = "crate::io::finite")]
     pub floor: f64,
+    /// C1 h1^a1 at the finest diagonal point.
+    #[serde(with = "crate::io::finite")]
     pub term1: f64,
+    /// C2 h2^a2 there.
+    #[serde(with = "crate::io::finite")]
     pub term2: f64,
+    /// Error removed per added dof, refining the slave from the finest diagonal point.
+    #[serde(with = "crate::io::finite")]
     pub gain1_per_dof: f64,
+    /// The same, refining the master.
+    #[serde(with = "crate::io::finite")]
     pub gain2_per_dof: f64,
 }
 
