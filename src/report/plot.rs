@@ -1,8 +1,17 @@
 //! PNG plots with plotters, text rendered with the committed DejaVu Sans font (no system
 //! font needed).
+//!
+//! Axis ticks are chosen here, not by plotters: [`log_ticks`] and [`linear_ticks`] measure
+//! every label with the font's glyph advances ([`text_size`], the metric plotters lays text
+//! out with) and keep only tick sets whose labels leave a gap between them along the axis's
+//! length in pixels. Legends and slope triangles go to the corner that hides the fewest data.
 
 use crate::error::{Error, Result};
+use plotters::coord::Shift;
+use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 use std::sync::Once;
 
@@ -26,6 +35,750 @@ pub const COLORS: [RGBColor; 4] = [
     RGBColor(0, 0, 0),
     RGBColor(0, 158, 115),
 ];
+
+/// Font size of the tick labels of [`loglog`] and [`lines`] (pixels).
+pub const TICK_FONT_PX: f64 = 15.0;
+
+// ---------------------------------------------------------------------------------------
+// Text size and axis ticks
+
+/// Width and height in pixels of `text` drawn `font_px` high in the committed font, as
+/// plotters lays it out (and so places it): the sum of the glyphs' advance widths and
+/// kerning, and `font_px / 1.24`.
+pub fn text_size(text: &str, font_px: f64) -> (f64, f64) {
+    register();
+    let (w, h) = ("sans-serif", font_px)
+        .into_font()
+        .box_size(text)
+        .unwrap_or((0, 0));
+    (f64::from(w), f64::from(h))
+}
+
+/// The direction of an axis: the labels of a horizontal axis sit side by side (their widths
+/// must not overlap), those of a vertical axis are stacked (their heights must not).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    /// An x axis.
+    Horizontal,
+    /// A y axis or a colour bar.
+    Vertical,
+}
+
+/// The ticks of one axis.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Ticks {
+    /// Labelled ticks: value (data units) and label, in increasing order.
+    pub major: Vec<(f64, String)>,
+    /// Unlabelled ticks (light grid lines), values in data units.
+    pub minor: Vec<f64>,
+}
+
+impl Ticks {
+    /// The label of the major tick nearest `v` (plotters hands its formatter back the values
+    /// it was given).
+    fn label(&self, v: f64) -> String {
+        self.major
+            .iter()
+            .min_by(|a, b| (a.0 - v).abs().total_cmp(&(b.0 - v).abs()))
+            .map(|t| t.1.clone())
+            .unwrap_or_default()
+    }
+
+    fn values(&self) -> Vec<f64> {
+        self.major.iter().map(|t| t.0).collect()
+    }
+}
+
+/// A decimal number `m` × 10^`e`: tick labels are written from it exactly.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Dec {
+    m: i64,
+    e: i32,
+}
+
+impl Dec {
+    fn value(self) -> f64 {
+        if self.e >= 0 {
+            self.m as f64 * 10f64.powi(self.e)
+        } else {
+            self.m as f64 / 10f64.powi(-self.e)
+        }
+    }
+
+    /// The same number with the trailing zeros of `m` moved into `e`.
+    fn normalized(self) -> Dec {
+        let mut d = self;
+        while d.m != 0 && d.m % 10 == 0 {
+            d.m /= 10;
+            d.e += 1;
+        }
+        if d.m == 0 {
+            d.e = 0;
+        }
+        d
+    }
+}
+
+fn superscript(n: i32) -> String {
+    const DIGITS: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+    let mut s = String::new();
+    if n < 0 {
+        s.push('⁻');
+    }
+    for c in n.unsigned_abs().to_string().bytes() {
+        s.push(DIGITS[(c - b'0') as usize]);
+    }
+    s
+}
+
+/// `d` with at least `decimals` digits after the point (more if `d` has them).
+fn decimal_text(d: Dec, decimals: usize) -> String {
+    let d = d.normalized();
+    if d.m == 0 {
+        return "0".into();
+    }
+    let decimals = decimals.max((-d.e).max(0) as usize);
+    let shift = (decimals as i32 + d.e) as u32;
+    let digits = (u128::from(d.m.unsigned_abs()) * 10u128.pow(shift)).to_string();
+    let digits = format!("{digits:0>width$}", width = decimals + 1);
+    let (int, frac) = digits.split_at(digits.len() - decimals);
+    let sign = if d.m < 0 { "-" } else { "" };
+    match decimals {
+        0 => format!("{sign}{int}"),
+        _ => format!("{sign}{int}.{frac}"),
+    }
+}
+
+/// `d` in scientific notation: `10⁻³`, `2×10⁵`, `2.5×10⁻²`.
+fn sci_text(d: Dec) -> String {
+    let d = d.normalized();
+    if d.m == 0 {
+        return "0".into();
+    }
+    let digits = d.m.unsigned_abs().to_string();
+    let exp = d.e + digits.len() as i32 - 1;
+    let sign = if d.m < 0 { "-" } else { "" };
+    match digits.len() {
+        1 if digits == "1" => format!("{sign}10{}", superscript(exp)),
+        1 => format!("{sign}{digits}×10{}", superscript(exp)),
+        _ => format!(
+            "{sign}{}.{}×10{}",
+            &digits[..1],
+            &digits[1..],
+            superscript(exp)
+        ),
+    }
+}
+
+/// Labels of tick values: plain decimals (`uniform` digits after the point, at least) while
+/// the values are moderate, else scientific. A log axis is moderate when every value is in
+/// [1e-3, 1e5), a linear one when its largest magnitude is.
+fn tick_labels(vals: &[Dec], uniform: usize, log: bool) -> Vec<String> {
+    let mags = vals.iter().map(|d| d.value().abs()).filter(|v| *v > 0.0);
+    let big = mags.clone().fold(0.0, f64::max);
+    let small = mags.fold(f64::INFINITY, f64::min);
+    let sci = big >= 1e5
+        || if log {
+            small < 1e-3
+        } else {
+            big < 1e-3 && big > 0.0
+        };
+    vals.iter()
+        .map(|&d| match sci {
+            true => sci_text(d),
+            false => decimal_text(d, uniform),
+        })
+        .collect()
+}
+
+/// An axis the ticks are fitted on: data range, scale, length, label font and the widest a
+/// label may be, in pixels.
+struct Axis {
+    lo: f64,
+    hi: f64,
+    log: bool,
+    pixels: f64,
+    font_px: f64,
+    side: Side,
+    max_width: f64,
+}
+
+type Kept = Vec<(Dec, String)>;
+
+impl Axis {
+    /// Pixels from the axis's start to `v`.
+    fn pos(&self, v: f64) -> f64 {
+        let f = match self.log {
+            true => (v.ln() - self.lo.ln()) / (self.hi.ln() - self.lo.ln()),
+            false => (v - self.lo) / (self.hi - self.lo),
+        };
+        f * self.pixels
+    }
+
+    /// The label's extent along the axis: its width on a horizontal axis, height on a vertical.
+    fn extent(&self, label: &str) -> f64 {
+        let (w, h) = text_size(label, self.font_px);
+        match self.side {
+            Side::Horizontal => w,
+            Side::Vertical => h,
+        }
+    }
+
+    /// The least gap between two labels (pixels).
+    fn gap(&self) -> f64 {
+        match self.side {
+            Side::Horizontal => 0.6 * self.font_px,
+            Side::Vertical => 0.4 * self.font_px,
+        }
+    }
+
+    /// The ticks on the axis (those whose label, centred on the tick, is at most `max_width`
+    /// wide and stays within the ends of a vertical axis, within half a font size of those
+    /// of a horizontal one) with their labels by position, and whether none was too wide and
+    /// every two neighbouring labels are at least [`Axis::gap`] apart.
+    fn place(&self, vals: &[Dec], labels: &[String]) -> (Vec<(f64, f64, Dec, String)>, bool) {
+        // A y label half past the bottom would sit on the x axis.
+        let slack = match self.side {
+            Side::Horizontal => 0.5 * self.font_px,
+            Side::Vertical => 0.0,
+        };
+        let mut narrow = true;
+        let mut on: Vec<(f64, f64, Dec, String)> = vals
+            .iter()
+            .zip(labels)
+            .filter_map(|(d, l)| {
+                let p = self.pos(d.value());
+                let inside = p >= -1e-6 * self.pixels && p <= self.pixels * (1.0 + 1e-6);
+                if !inside {
+                    return None;
+                }
+                if text_size(l, self.font_px).0 > self.max_width {
+                    narrow = false;
+                    return None;
+                }
+                let half = 0.5 * self.extent(l);
+                (p - half >= -slack && p + half <= self.pixels + slack)
+                    .then(|| (p - half, p + half, *d, l.clone()))
+            })
+            .collect();
+        on.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let clear = narrow && on.windows(2).all(|w| w[1].0 - w[0].1 >= self.gap());
+        (on, clear)
+    }
+
+    /// The share of the axis between the first and the last of `kept`.
+    fn coverage(&self, kept: &Kept) -> f64 {
+        match (kept.first(), kept.last()) {
+            (Some(a), Some(b)) => (self.pos(b.0.value()) - self.pos(a.0.value())) / self.pixels,
+            _ => 0.0,
+        }
+    }
+
+    /// The ticks of `vals` and their labels if no two labels come closer than the gap.
+    fn fit(&self, vals: &[Dec], labels: &[String]) -> Option<Kept> {
+        let (on, clear) = self.place(vals, labels);
+        clear.then(|| on.into_iter().map(|t| (t.2, t.3)).collect())
+    }
+
+    /// The ticks of `vals` kept one by one from the start, each one whose label clears the
+    /// last kept (the fallback when no tick set fits whole).
+    fn thin(&self, vals: &[Dec], labels: &[String]) -> Kept {
+        let (on, _) = self.place(vals, labels);
+        let mut kept: Vec<(f64, f64, Dec, String)> = Vec::new();
+        for t in on {
+            if kept.last().is_none_or(|k| t.0 - k.1 >= self.gap()) {
+                kept.push(t);
+            }
+        }
+        kept.into_iter().map(|t| (t.2, t.3)).collect()
+    }
+
+    /// The number of labels aimed at: one per 100 pixels across, per 60 pixels up, 3 to 10.
+    fn target(&self) -> f64 {
+        let per = match self.side {
+            Side::Horizontal => 100.0,
+            Side::Vertical => 60.0,
+        };
+        (self.pixels / per).clamp(3.0, 10.0)
+    }
+
+    fn finish(&self, major: Kept, minor: &[Dec]) -> Ticks {
+        let on =
+            |v: f64| self.pos(v) >= -1e-6 * self.pixels && self.pos(v) <= self.pixels * 1.000001;
+        let majors: Vec<Dec> = major.iter().map(|t| t.0.normalized()).collect();
+        Ticks {
+            minor: minor
+                .iter()
+                .filter(|d| !majors.contains(&d.normalized()) && on(d.value()))
+                .map(|d| d.value())
+                .collect(),
+            major: major.into_iter().map(|(d, l)| (d.value(), l)).collect(),
+        }
+    }
+}
+
+/// Evenly spaced tick sets on [lo, hi]: for each step 1, 2 or 5 × 10^j giving 2 to 40 ticks,
+/// the multiples of the step, the minor ticks (a fifth of the step, a quarter for 2) and
+/// the digits after the point the step needs.
+fn even_candidates(lo: f64, hi: f64) -> Vec<(Vec<Dec>, Vec<Dec>, usize)> {
+    let multiples = |m: i64, e: i32| -> Vec<Dec> {
+        let step = Dec { m, e }.value();
+        let (i0, i1) = ((lo / step - 1e-9).ceil(), (hi / step + 1e-9).floor());
+        // Too many ticks, or multiples too large for exact integers (a span tiny beside
+        // its values).
+        if (i1 - i0).is_nan() || i1 - i0 >= 400.0 || i0.abs().max(i1.abs()) > 1e15 {
+            return Vec::new();
+        }
+        (i0 as i64..=i1 as i64)
+            .map(|i| Dec { m: i * m, e })
+            .collect()
+    };
+    let j1 = (hi - lo).log10().floor() as i32;
+    let mut out = Vec::new();
+    for j in j1 - 2..=j1 {
+        for m in [1, 2, 5] {
+            let major = multiples(m, j);
+            if !(2..=40).contains(&major.len()) {
+                continue;
+            }
+            let minor = match m {
+                1 => multiples(2, j - 1),
+                2 => multiples(5, j - 1),
+                _ => multiples(1, j),
+            };
+            out.push((major, minor, (-j).max(0) as usize));
+        }
+    }
+    out
+}
+
+/// The evenly spaced tick set whose labels fit with the count nearest the target (fewer
+/// among equals), at least `min` labels.
+fn best_even(ax: &Axis, min: usize) -> Option<(Kept, Vec<Dec>)> {
+    let mut best: Option<(f64, Kept, Vec<Dec>)> = None;
+    for (major, minor, decimals) in even_candidates(ax.lo, ax.hi) {
+        let labels = tick_labels(&major, decimals, ax.log);
+        if let Some(kept) = ax.fit(&major, &labels).filter(|k| k.len() >= min) {
+            let score = (kept.len() as f64 - ax.target()).abs() + 1e-3 * kept.len() as f64;
+            if best.as_ref().is_none_or(|b| score < b.0) {
+                best = Some((score, kept, minor));
+            }
+        }
+    }
+    best.map(|b| (b.1, b.2))
+}
+
+/// Ticks of a log axis over [lo, hi] (lo > 0) `pixels` long, labels `font_px` high and at
+/// most `max_width` pixels wide, no two labels closer than 0.6 font size across (0.4 up).
+/// Across a decade or more: whole decades when three or more are on the axis (every second,
+/// third... decade if all do not fit; the others minor), else 1-2-5 or 1..9 per decade when
+/// three labels fit (the other integer mantissas minor), else evenly spaced values. Within
+/// a decade: whichever of 1-2-5, 1..9 and evenly spaced values has three labels or more
+/// spread widest and nearest the target count. Failing all, the set with the most labels.
+pub fn log_ticks(lo: f64, hi: f64, pixels: f64, font_px: f64, side: Side, max_width: f64) -> Ticks {
+    if !(lo > 0.0 && hi > lo && hi.is_finite() && pixels > 0.0) {
+        return Ticks::default();
+    }
+    let ax = Axis {
+        lo,
+        hi,
+        log: true,
+        pixels,
+        font_px,
+        side,
+        max_width,
+    };
+    let (k0, k1) = (lo.log10().floor() as i32 - 1, hi.log10().ceil() as i32 + 1);
+    let on_axis = |d: &Dec| d.value() >= lo * (1.0 - 1e-9) && d.value() <= hi * (1.0 + 1e-9);
+    let per_decade = |set: &[i64]| -> Vec<Dec> {
+        (k0..=k1)
+            .flat_map(|e| set.iter().map(move |&m| Dec { m, e }))
+            .filter(on_axis)
+            .collect()
+    };
+    let decades = |step: i32| -> Vec<Dec> {
+        (k0..=k1)
+            .filter(|e| e.rem_euclid(step) == 0)
+            .map(|e| Dec { m: 1, e })
+            .filter(on_axis)
+            .collect()
+    };
+    let attempt = |vals: &[Dec]| ax.fit(vals, &tick_labels(vals, 0, true));
+    let mantissas = per_decade(&[1, 2, 3, 4, 5, 6, 7, 8, 9]);
+    let decade_px = pixels / (hi / lo).log10();
+
+    if hi / lo < 10.0 {
+        // Within a decade 1-2-5 or 1..9 may label one end only: score the spread too.
+        let mut sets: Vec<(Kept, Vec<Dec>)> = [per_decade(&[1, 2, 5]), mantissas.clone()]
+            .iter()
+            .filter_map(|v| attempt(v).map(|k| (k, mantissas.clone())))
+            .collect();
+        for (major, minor, decimals) in even_candidates(lo, hi) {
+            if let Some(k) = ax.fit(&major, &tick_labels(&major, decimals, true)) {
+                sets.push((k, minor));
+            }
+        }
+        let score = |k: &Kept| (k.len() as f64 - ax.target()).abs() + 4.0 * (1.0 - ax.coverage(k));
+        let best = sets
+            .into_iter()
+            .filter(|s| s.0.len() >= 3)
+            .min_by(|a, b| score(&a.0).total_cmp(&score(&b.0)));
+        if let Some((major, minor)) = best {
+            return ax.finish(major, &minor);
+        }
+    }
+
+    if decades(1).len() >= 3 {
+        for step in [1, 2, 3, 5, 10, 20, 50, 100] {
+            let Some(major) = attempt(&decades(step)).filter(|m| (2..=12).contains(&m.len()))
+            else {
+                continue;
+            };
+            let minor = match step {
+                // Light lines at 2..9 only where a decade is wide enough not to turn grey.
+                1 if decade_px >= 60.0 => mantissas.clone(),
+                1 => Vec::new(),
+                _ => decades(1),
+            };
+            return ax.finish(major, &minor);
+        }
+    }
+    for set in [&[1, 2, 5][..], &[1, 2, 3, 4, 5, 6, 7, 8, 9][..]] {
+        if let Some(major) = attempt(&per_decade(set)).filter(|m| m.len() >= 3) {
+            return ax.finish(major, &mantissas);
+        }
+    }
+    if let Some((major, minor)) = best_even(&ax, 3) {
+        return ax.finish(major, &minor);
+    }
+    // Fewer than three labels fit: the set with the most.
+    let mut sets: Vec<(Kept, Vec<Dec>)> = [decades(1), per_decade(&[1, 2, 5]), mantissas.clone()]
+        .into_iter()
+        .filter_map(|v| attempt(&v).map(|k| (k, mantissas.clone())))
+        .collect();
+    sets.extend(best_even(&ax, 2));
+    match sets.into_iter().max_by_key(|s| s.0.len()) {
+        Some((major, minor)) if !major.is_empty() => ax.finish(major, &minor),
+        _ => {
+            let labels = tick_labels(&mantissas, 0, true);
+            ax.finish(ax.thin(&mantissas, &labels), &[])
+        }
+    }
+}
+
+/// Ticks of a linear axis over [lo, hi] `pixels` long, labels `font_px` high and at most
+/// `max_width` pixels wide: the step 1, 2 or 5 × 10^j whose labels fit (no two closer than
+/// 0.6 font size across, 0.4 up) with the count nearest one label per 100 pixels across (60
+/// up, 3 to 10), every label with the step's digits after the point.
+pub fn linear_ticks(
+    lo: f64,
+    hi: f64,
+    pixels: f64,
+    font_px: f64,
+    side: Side,
+    max_width: f64,
+) -> Ticks {
+    if !(hi > lo && lo.is_finite() && hi.is_finite() && pixels > 0.0) {
+        return Ticks::default();
+    }
+    let ax = Axis {
+        lo,
+        hi,
+        log: false,
+        pixels,
+        font_px,
+        side,
+        max_width,
+    };
+    if let Some((major, minor)) = best_even(&ax, 2) {
+        return ax.finish(major, &minor);
+    }
+    // Not even two labels fit whole: the coarsest set thinned.
+    match even_candidates(lo, hi).into_iter().next() {
+        Some((major, _, decimals)) => {
+            let labels = tick_labels(&major, decimals, false);
+            ax.finish(ax.thin(&major, &labels), &[])
+        }
+        None => Ticks::default(),
+    }
+}
+
+/// A linear f64 axis with given ticks (plotters' own linear axes choose theirs).
+#[derive(Clone)]
+struct LinearAxis {
+    inner: RangedCoordf64,
+    major: Vec<f64>,
+    minor: Vec<f64>,
+}
+
+impl LinearAxis {
+    fn new(lo: f64, hi: f64, ticks: &Ticks) -> Self {
+        LinearAxis {
+            inner: (lo..hi).into(),
+            major: ticks.values(),
+            minor: ticks.minor.clone(),
+        }
+    }
+}
+
+impl Ranged for LinearAxis {
+    type FormatOption = DefaultFormatting;
+    type ValueType = f64;
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        self.inner.map(value, limit)
+    }
+
+    fn key_points<H: KeyPointHint>(&self, hint: H) -> Vec<f64> {
+        match hint.weight().allow_light_points() {
+            true => self.minor.clone(),
+            false => self.major.clone(),
+        }
+    }
+
+    fn range(&self) -> std::ops::Range<f64> {
+        self.inner.range()
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Layout
+
+/// Where a chart sits in its drawing area: margins (top, bottom, left, right), the title's
+/// font size (0 for no title) and the label areas (below, left, right), all pixels.
+#[derive(Clone, Copy)]
+struct Layout {
+    margin: [u32; 4],
+    title_px: f64,
+    x_label_px: u32,
+    y_label_px: u32,
+    right_label_px: u32,
+}
+
+impl Layout {
+    /// The widest a left (or right) axis's tick label may be: the label area less the gap
+    /// to the axis (plotters: twice the 5-pixel tick) and the rotated axis description (a
+    /// line of `font_px`) with a 6-pixel gap.
+    fn label_room(&self, area_px: u32, font_px: f64) -> f64 {
+        f64::from(area_px) - 10.0 - text_size("x", font_px).1 - 6.0
+    }
+
+    fn builder<'a, 'b, DB: DrawingBackend>(
+        &self,
+        area: &'a DrawingArea<DB, Shift>,
+        title: &str,
+    ) -> ChartBuilder<'a, 'b, DB> {
+        let mut b = ChartBuilder::on(area);
+        b.margin_top(self.margin[0])
+            .margin_bottom(self.margin[1])
+            .margin_left(self.margin[2])
+            .margin_right(self.margin[3])
+            .x_label_area_size(self.x_label_px)
+            .y_label_area_size(self.y_label_px)
+            .right_y_label_area_size(self.right_label_px);
+        if self.title_px > 0.0 {
+            b.caption(title, ("sans-serif", self.title_px));
+        }
+        b
+    }
+
+    /// The plotting area's size (pixels) on a drawing area of `dim` pixels: the same chart
+    /// built on a scratch image (the title's height does not depend on its text).
+    fn plot_dim(&self, dim: (u32, u32)) -> (u32, u32) {
+        register();
+        let mut buf = vec![0u8; 3 * dim.0 as usize * dim.1 as usize];
+        let root = BitMapBackend::with_buffer(&mut buf, dim).into_drawing_area();
+        self.builder(&root, "x")
+            .build_cartesian_2d(0f64..1f64, 0f64..1f64)
+            .map(|c| c.plotting_area().dim_in_pixel())
+            .unwrap_or((1, 1))
+    }
+}
+
+const LOGLOG_SIZE: (u32, u32) = (900, 650);
+const LOGLOG: Layout = Layout {
+    margin: [15; 4],
+    title_px: 22.0,
+    x_label_px: 50,
+    y_label_px: 95,
+    right_label_px: 0,
+};
+const LINES_SIZE: (u32, u32) = (900, 550);
+const LINES: Layout = Layout {
+    margin: [15; 4],
+    title_px: 20.0,
+    x_label_px: 50,
+    y_label_px: 90,
+    right_label_px: 0,
+};
+
+/// The plotting area (width, height) of a [`loglog`] figure in pixels: the lengths its x and
+/// y tick labels are fitted on.
+pub fn loglog_plot_area() -> (u32, u32) {
+    LOGLOG.plot_dim(LOGLOG_SIZE)
+}
+
+/// The plotting area (width, height) of a [`lines`] figure in pixels.
+pub fn lines_plot_area() -> (u32, u32) {
+    LINES.plot_dim(LINES_SIZE)
+}
+
+/// A rectangle in pixels, (x0, y0) its upper left corner.
+#[derive(Clone, Copy, Debug)]
+struct Rect {
+    x0: f64,
+    y0: f64,
+    x1: f64,
+    y1: f64,
+}
+
+impl Rect {
+    fn contains(&self, p: (f64, f64), pad: f64) -> bool {
+        p.0 >= self.x0 - pad && p.0 <= self.x1 + pad && p.1 >= self.y0 - pad && p.1 <= self.y1 + pad
+    }
+
+    fn area(&self) -> f64 {
+        (self.x1 - self.x0) * (self.y1 - self.y0)
+    }
+
+    fn overlap(&self, o: &Rect) -> f64 {
+        let w = self.x1.min(o.x1) - self.x0.max(o.x0);
+        let h = self.y1.min(o.y1) - self.y0.max(o.y0);
+        w.max(0.0) * h.max(0.0)
+    }
+}
+
+/// Where plotters puts a box of `size` at `pos` inside an area of `dim` pixels, `inset`
+/// from its edges (plotters' legend uses 5).
+fn corner_rect(pos: &SeriesLabelPosition, size: (f64, f64), dim: (f64, f64), inset: f64) -> Rect {
+    use SeriesLabelPosition::*;
+    let x = match pos {
+        UpperLeft | MiddleLeft | LowerLeft => inset,
+        UpperMiddle | MiddleMiddle | LowerMiddle => ((dim.0 - size.0) / 2.0).floor(),
+        UpperRight | MiddleRight | LowerRight => dim.0 - size.0 - inset,
+        Coordinate(x, _) => f64::from(*x),
+    };
+    let y = match pos {
+        UpperLeft | UpperMiddle | UpperRight => inset,
+        MiddleLeft | MiddleMiddle | MiddleRight => ((dim.1 - size.1) / 2.0).floor(),
+        LowerLeft | LowerMiddle | LowerRight => dim.1 - size.1 - inset,
+        Coordinate(_, y) => f64::from(*y),
+    };
+    Rect {
+        x0: x,
+        y0: y,
+        x1: x + size.0,
+        y1: y + size.1,
+    }
+}
+
+const LEGEND_ORDER: [SeriesLabelPosition; 8] = [
+    SeriesLabelPosition::UpperLeft,
+    SeriesLabelPosition::UpperRight,
+    SeriesLabelPosition::LowerLeft,
+    SeriesLabelPosition::LowerRight,
+    SeriesLabelPosition::MiddleLeft,
+    SeriesLabelPosition::MiddleRight,
+    SeriesLabelPosition::UpperMiddle,
+    SeriesLabelPosition::LowerMiddle,
+];
+
+const SLOPE_ORDER: [SeriesLabelPosition; 8] = [
+    SeriesLabelPosition::LowerRight,
+    SeriesLabelPosition::UpperLeft,
+    SeriesLabelPosition::LowerLeft,
+    SeriesLabelPosition::UpperRight,
+    SeriesLabelPosition::MiddleRight,
+    SeriesLabelPosition::MiddleLeft,
+    SeriesLabelPosition::LowerMiddle,
+    SeriesLabelPosition::UpperMiddle,
+];
+
+/// Of the positions in `order`, the one where a box of `size` covers the least weight of
+/// `samples` (pixel position, weight) and no `taken` box; the first among equals.
+fn place_box(
+    size: (f64, f64),
+    dim: (f64, f64),
+    samples: &[((f64, f64), f64)],
+    taken: &[Rect],
+    inset: f64,
+    order: &[SeriesLabelPosition],
+) -> (SeriesLabelPosition, Rect) {
+    let mut best: Option<(f64, SeriesLabelPosition, Rect)> = None;
+    for pos in order {
+        let r = corner_rect(pos, size, dim, inset);
+        let covered: f64 = samples
+            .iter()
+            .filter(|s| r.contains(s.0, 4.0))
+            .map(|s| s.1)
+            .sum();
+        let clash: f64 = taken.iter().map(|t| t.overlap(&r)).sum();
+        let score = covered + 1e3 * clash;
+        if best.as_ref().is_none_or(|b| score < b.0) {
+            best = Some((score, pos.clone(), r));
+        }
+    }
+    let b = best.expect("positions to choose from");
+    (b.1, b.2)
+}
+
+/// Pixel positions (relative to the plotting area) along every series: its points and,
+/// where a line joins them, a sample every 4 pixels along each segment; weight 1 each.
+fn data_samples<DB: DrawingBackend, CT: CoordTranslate<From = (f64, f64)>>(
+    chart: &ChartContext<'_, DB, CT>,
+    series: &[Series],
+    log: bool,
+) -> Vec<((f64, f64), f64)> {
+    let area = chart.plotting_area();
+    let base = area.get_base_pixel();
+    let px = |p: &(f64, f64)| {
+        let q = area.map_coordinate(p);
+        (f64::from(q.0 - base.0), f64::from(q.1 - base.1))
+    };
+    let mut out = Vec::new();
+    for s in series {
+        let pts: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .filter(|p| p.0.is_finite() && p.1.is_finite() && (!log || (p.0 > 0.0 && p.1 > 0.0)))
+            .map(px)
+            .collect();
+        out.extend(pts.iter().map(|&p| (p, 1.0)));
+        if s.line {
+            for w in pts.windows(2) {
+                let n = ((w[1].0 - w[0].0).hypot(w[1].1 - w[0].1) / 4.0)
+                    .ceil()
+                    .min(2000.0);
+                for k in 1..n as usize {
+                    let t = k as f64 / n;
+                    let p = (
+                        w[0].0 + t * (w[1].0 - w[0].0),
+                        w[0].1 + t * (w[1].1 - w[0].1),
+                    );
+                    out.push((p, 1.0));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The size of plotters' legend box for these entries: the widest label plus 30 pixels of
+/// symbol and 10 of margin each side; lines 1.25 font sizes apart.
+fn legend_size(labels: &[&str], font_px: f64) -> (f64, f64) {
+    let w = labels
+        .iter()
+        .map(|l| text_size(l, font_px).0)
+        .fold(0.0, f64::max);
+    let h = text_size("x", font_px).1;
+    (
+        w + 30.0 + 20.0,
+        ((labels.len().max(1) - 1) as f64 * font_px * 1.25).round() + h + 20.0,
+    )
+}
+
+// ---------------------------------------------------------------------------------------
+// Line charts
 
 /// One series of a plot.
 pub struct Series {
@@ -74,8 +827,19 @@ fn bounds(series: &[Series], log: bool) -> ((f64, f64), (f64, f64)) {
     )
 }
 
+/// The legend labels of `series`, in the order [`draw_series`] registers them.
+fn legend_labels(series: &[Series]) -> Vec<&str> {
+    series
+        .iter()
+        .filter(|s| s.line || s.markers)
+        .map(|s| s.label.as_str())
+        .collect()
+}
+
 /// Draw every series (lines with their legend entry, markers of `radius` pixels, a marker
-/// legend entry for marker-only series) on a chart with (f64, f64) data coordinates.
+/// legend entry for marker-only series) on a chart with (f64, f64) data coordinates. A
+/// series whose every marker lands within 2 pixels of an earlier series' markers (equal
+/// data) gets open rings 3 pixels wider instead of dots, so that both show.
 fn draw_series<'b, CT>(
     chart: &mut ChartContext<'_, BitMapBackend<'b>, CT>,
     series: &[Series],
@@ -85,7 +849,28 @@ fn draw_series<'b, CT>(
 where
     CT: CoordTranslate<From = (f64, f64)>,
 {
-    for s in series {
+    let pixels: Vec<Vec<(i32, i32)>> = series
+        .iter()
+        .map(|s| {
+            s.points
+                .iter()
+                .map(|p| chart.plotting_area().map_coordinate(p))
+                .collect()
+        })
+        .collect();
+    let covered = |i: usize| {
+        let near =
+            |p: &(i32, i32), q: &(i32, i32)| (p.0 - q.0).abs() <= 2 && (p.1 - q.1).abs() <= 2;
+        series[i].markers
+            && !pixels[i].is_empty()
+            && (0..i).any(|j| {
+                series[j].markers
+                    && pixels[i]
+                        .iter()
+                        .all(|p| pixels[j].iter().any(|q| near(p, q)))
+            })
+    };
+    for (i, s) in series.iter().enumerate() {
         let c = COLORS[s.color % COLORS.len()];
         let style = if s.thin {
             c.stroke_width(1)
@@ -100,16 +885,36 @@ where
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
         }
         if s.markers {
+            let (r, mark) = match covered(i) {
+                true => (radius + 3, c.stroke_width(2)),
+                false => (radius, c.filled()),
+            };
             let a = chart
-                .draw_series(s.points.iter().map(|&p| Circle::new(p, radius, c.filled())))
+                .draw_series(s.points.iter().map(|&p| Circle::new(p, r, mark)))
                 .map_err(err(path))?;
             if !s.line {
                 a.label(s.label.clone())
-                    .legend(move |(x, y)| Circle::new((x + 10, y), radius, c.filled()));
+                    .legend(move |(x, y)| Circle::new((x + 10, y), r, mark));
             }
         }
     }
     Ok(())
+}
+
+/// The legend at `pos`, in the style of [`loglog`] and [`lines`].
+fn draw_legend<'b, CT: CoordTranslate>(
+    chart: &mut ChartContext<'b, BitMapBackend<'b>, CT>,
+    pos: SeriesLabelPosition,
+    path: &Path,
+) -> Result<()> {
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", TICK_FONT_PX))
+        .position(pos)
+        .draw()
+        .map_err(err(path))
 }
 
 /// A log-log plot with optional reference slope triangles (slopes given with labels).
@@ -122,56 +927,118 @@ pub fn loglog(
     slopes: &[(f64, &str)],
 ) -> Result<()> {
     register();
-    let root = BitMapBackend::new(path, (900, 650)).into_drawing_area();
+    let root = BitMapBackend::new(path, LOGLOG_SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(err(path))?;
     let ((x0, x1), (y0, y1)) = bounds(series, true);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 22))
-        .margin(15)
-        .x_label_area_size(50)
-        .y_label_area_size(80)
-        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+    let (pw, ph) = LOGLOG.plot_dim(LOGLOG_SIZE);
+    let (pw, ph) = (f64::from(pw), f64::from(ph));
+    let room = LOGLOG.label_room(LOGLOG.y_label_px, TICK_FONT_PX);
+    let xt = log_ticks(x0, x1, pw, TICK_FONT_PX, Side::Horizontal, f64::INFINITY);
+    let yt = log_ticks(y0, y1, ph, TICK_FONT_PX, Side::Vertical, room);
+    let mut chart = LOGLOG
+        .builder(&root, title)
+        .build_cartesian_2d(
+            (x0..x1)
+                .log_scale()
+                .with_key_points(xt.values())
+                .with_light_points(xt.minor.clone()),
+            (y0..y1)
+                .log_scale()
+                .with_key_points(yt.values())
+                .with_light_points(yt.minor.clone()),
+        )
         .map_err(err(path))?;
     chart
         .configure_mesh()
         .x_desc(xlabel)
         .y_desc(ylabel)
-        .label_style(("sans-serif", 15))
-        .x_label_formatter(&|v| format!("{v:.3}"))
-        .y_label_formatter(&|v| format!("{v:.1e}"))
+        .label_style(("sans-serif", TICK_FONT_PX))
+        .x_label_formatter(&|v| xt.label(*v))
+        .y_label_formatter(&|v| yt.label(*v))
         .draw()
         .map_err(err(path))?;
     draw_series(&mut chart, series, 5, path)?;
-    // Reference slope triangles in the lower right corner, stacked.
-    let lx1 = x1 / 2.2;
-    let lx0 = lx1 / 1.5;
-    for (i, (slope, label)) in slopes.iter().enumerate() {
-        let base = y0 * 1.15 * (y1 / y0).powf(0.09 * i as f64);
-        let top = base * (lx1 / lx0).powf(*slope);
-        let tri = vec![(lx0, base), (lx1, base), (lx1, top), (lx0, base)];
-        chart
-            .draw_series(std::iter::once(PathElement::new(
-                tri,
-                BLACK.stroke_width(1),
-            )))
-            .map_err(err(path))?;
-        chart
-            .draw_series(std::iter::once(Text::new(
-                format!("slope {label}"),
-                (lx1 * 1.05, (base * top).sqrt()),
-                ("sans-serif", 14),
-            )))
-            .map_err(err(path))?;
+    let samples = data_samples(&chart, series, true);
+    let labels = legend_labels(series);
+    let (dw, dh) = chart.plotting_area().dim_in_pixel();
+    let legend = (!labels.is_empty()).then(|| {
+        place_box(
+            legend_size(&labels, TICK_FONT_PX),
+            (f64::from(dw), f64::from(dh)),
+            &samples,
+            &[],
+            5.0,
+            &LEGEND_ORDER,
+        )
+    });
+    if !slopes.is_empty() {
+        let taken: Vec<Rect> = legend.iter().map(|l| l.1).collect();
+        slope_triangles(&chart, ((x0, x1), (y0, y1)), &samples, &taken, slopes, path)?;
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 15))
-        .position(SeriesLabelPosition::UpperLeft)
-        .draw()
-        .map_err(err(path))?;
+    if let Some((pos, _)) = legend {
+        draw_legend(&mut chart, pos, path)?;
+    }
     root.present().map_err(err(path))?;
+    Ok(())
+}
+
+/// Reference slope triangles on a log-log chart, stacked bottom-up (legs of equal width,
+/// each height the slope's rise on screen) with "slope LABEL" right of each, in the corner
+/// that covers the fewest `samples` and no `taken` box.
+fn slope_triangles<'b, CT: CoordTranslate<From = (f64, f64)>>(
+    chart: &ChartContext<'_, BitMapBackend<'b>, CT>,
+    ((x0, x1), (y0, y1)): ((f64, f64), (f64, f64)),
+    samples: &[((f64, f64), f64)],
+    taken: &[Rect],
+    slopes: &[(f64, &str)],
+    path: &Path,
+) -> Result<()> {
+    const FONT_PX: f64 = 14.0;
+    let area = chart.plotting_area();
+    let (pw, ph) = area.dim_in_pixel();
+    let (pw, ph) = (f64::from(pw), f64::from(ph));
+    // Pixels per y decade over pixels per x decade: a slope s rises s * ratio pixels per pixel.
+    let ratio = (ph / (y1 / y0).log10()) / (pw / (x1 / x0).log10());
+    let steepest = slopes.iter().map(|s| s.0.abs()).fold(0.0, f64::max);
+    let dx = (70.0f64)
+        .min(70.0 / (steepest * ratio).max(1e-12))
+        .max(20.0);
+    let heights: Vec<f64> = slopes.iter().map(|s| s.0.abs() * dx * ratio).collect();
+    let labels: Vec<String> = slopes.iter().map(|s| format!("slope {}", s.1)).collect();
+    let label_w = labels
+        .iter()
+        .map(|l| text_size(l, FONT_PX).0)
+        .fold(0.0, f64::max);
+    let rows: Vec<f64> = heights.iter().map(|h| h.max(FONT_PX + 2.0)).collect();
+    let gap = 10.0;
+    let size = (
+        dx + 6.0 + label_w,
+        rows.iter().sum::<f64>() + gap * (rows.len() as f64 - 1.0),
+    );
+    let (_, r) = place_box(size, (pw, ph), samples, taken, 12.0, &SLOPE_ORDER);
+    let to_data = |px: f64, py: f64| (x0 * (x1 / x0).powf(px / pw), y1 * (y0 / y1).powf(py / ph));
+    let style = TextStyle::from(("sans-serif", FONT_PX).into_font())
+        .pos(Pos::new(HPos::Left, VPos::Center));
+    let mut bottom = r.y1;
+    for ((h, row), label) in heights.iter().zip(&rows).zip(&labels) {
+        let base = bottom - 0.5 * (row - h);
+        let (left, right) = (r.x0, r.x0 + dx);
+        let tri = vec![
+            to_data(left, base),
+            to_data(right, base),
+            to_data(right, base - h),
+            to_data(left, base),
+        ];
+        area.draw(&PathElement::new(tri, BLACK.stroke_width(1)))
+            .map_err(err(path))?;
+        area.draw(&Text::new(
+            label.clone(),
+            to_data(right + 6.0, base - 0.5 * h),
+            style.clone(),
+        ))
+        .map_err(err(path))?;
+        bottom -= row + gap;
+    }
     Ok(())
 }
 
@@ -184,35 +1051,43 @@ pub fn lines(
     series: &[Series],
 ) -> Result<()> {
     register();
-    let root = BitMapBackend::new(path, (900, 550)).into_drawing_area();
+    let root = BitMapBackend::new(path, LINES_SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(err(path))?;
     let ((x0, x1), (y0, y1)) = bounds(series, false);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 20))
-        .margin(15)
-        .x_label_area_size(50)
-        .y_label_area_size(90)
-        .build_cartesian_2d(x0..x1, y0..y1)
+    let (pw, ph) = LINES.plot_dim(LINES_SIZE);
+    let (pw, ph) = (f64::from(pw), f64::from(ph));
+    let room = LINES.label_room(LINES.y_label_px, TICK_FONT_PX);
+    let xt = linear_ticks(x0, x1, pw, TICK_FONT_PX, Side::Horizontal, f64::INFINITY);
+    let yt = linear_ticks(y0, y1, ph, TICK_FONT_PX, Side::Vertical, room);
+    let mut chart = LINES
+        .builder(&root, title)
+        .build_cartesian_2d(LinearAxis::new(x0, x1, &xt), LinearAxis::new(y0, y1, &yt))
         .map_err(err(path))?;
     chart
         .configure_mesh()
         .x_desc(xlabel)
         .y_desc(ylabel)
-        .label_style(("sans-serif", 15))
-        .y_label_formatter(&|v| format!("{v:.2e}"))
+        .label_style(("sans-serif", TICK_FONT_PX))
+        .x_label_formatter(&|v| xt.label(*v))
+        .y_label_formatter(&|v| yt.label(*v))
         .draw()
         .map_err(err(path))?;
     draw_series(&mut chart, series, 3, path)?;
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 15))
-        .draw()
-        .map_err(err(path))?;
+    let labels = legend_labels(series);
+    if !labels.is_empty() {
+        let samples = data_samples(&chart, series, false);
+        let size = legend_size(&labels, TICK_FONT_PX);
+        let (dw, dh) = chart.plotting_area().dim_in_pixel();
+        let dim = (f64::from(dw), f64::from(dh));
+        let (pos, _) = place_box(size, dim, &samples, &[], 5.0, &LEGEND_ORDER);
+        draw_legend(&mut chart, pos, path)?;
+    }
     root.present().map_err(err(path))?;
     Ok(())
 }
+
+// ---------------------------------------------------------------------------------------
+// Field, mesh and grid maps
 
 /// Viridis-like colour map on [0, 1].
 pub fn colormap(t: f64) -> RGBColor {
@@ -235,35 +1110,69 @@ pub fn colormap(t: f64) -> RGBColor {
     RGBColor(c(0), c(1), c(2))
 }
 
-type Square<'a, 'b> = ChartContext<
-    'a,
-    BitMapBackend<'b>,
-    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
->;
+type Square<'a, 'b> = ChartContext<'a, BitMapBackend<'b>, Cartesian2d<LinearAxis, LinearAxis>>;
 
-/// A chart with equal aspect ratio around the triangles (the shorter range padded).
+/// A chart with equal aspect ratio around the triangles (the shorter range padded), its
+/// ticks fitted to its plotting area.
 fn square_chart<'a, 'b>(
-    area: &'a DrawingArea<BitMapBackend<'b>, plotters::coord::Shift>,
+    area: &'a DrawingArea<BitMapBackend<'b>, Shift>,
     title: &str,
     size: u32,
     triangles: &[[[f64; 2]; 3]],
     path: &Path,
 ) -> Result<Square<'a, 'b>> {
+    const FONT_PX: f64 = 12.0;
+    let layout = Layout {
+        margin: [10; 4],
+        title_px: f64::from(size),
+        x_label_px: 30,
+        y_label_px: 40,
+        right_label_px: 0,
+    };
     let (x0, x1) = range(triangles.iter().flat_map(|t| t.iter().map(|v| v[0])), false);
     let (y0, y1) = range(triangles.iter().flat_map(|t| t.iter().map(|v| v[1])), false);
     let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
     let half = 0.5 * (x1 - x0).max(y1 - y0);
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, ("sans-serif", size))
-        .margin(10)
-        .x_label_area_size(30)
-        .y_label_area_size(40)
-        .build_cartesian_2d(cx - half..cx + half, cy - half..cy + half)
+    let (xr, yr) = ((cx - half, cx + half), (cy - half, cy + half));
+    let (pw, ph) = layout.plot_dim(area.dim_in_pixel());
+    // No axis description on the left: the label area less the gap to the axis.
+    let room = f64::from(layout.y_label_px) - 10.0;
+    let xt = linear_ticks(
+        xr.0,
+        xr.1,
+        f64::from(pw),
+        FONT_PX,
+        Side::Horizontal,
+        f64::INFINITY,
+    );
+    let yt = linear_ticks(yr.0, yr.1, f64::from(ph), FONT_PX, Side::Vertical, room);
+    let mut chart = layout
+        .builder(area, title)
+        .build_cartesian_2d(
+            LinearAxis::new(
+                xr.0,
+                xr.1,
+                &Ticks {
+                    minor: Vec::new(),
+                    ..xt.clone()
+                },
+            ),
+            LinearAxis::new(
+                yr.0,
+                yr.1,
+                &Ticks {
+                    minor: Vec::new(),
+                    ..yt.clone()
+                },
+            ),
+        )
         .map_err(err(path))?;
     chart
         .configure_mesh()
         .disable_mesh()
-        .label_style(("sans-serif", 12))
+        .label_style(("sans-serif", FONT_PX))
+        .x_label_formatter(&|v| xt.label(*v))
+        .y_label_formatter(&|v| yt.label(*v))
         .draw()
         .map_err(err(path))?;
     Ok(chart)
@@ -283,31 +1192,53 @@ pub struct Panel {
     pub highlight: Vec<[[f64; 2]; 2]>,
 }
 
-/// Panels side by side sharing one colour bar.
+/// Panels side by side sharing one colour bar, which spans the values' range exactly.
 pub fn field_panels(path: &Path, title: &str, bar_label: &str, panels: &[Panel]) -> Result<()> {
     register();
+    const BAR_FONT_PX: f64 = 13.0;
     let w = (560 * panels.len() as u32 + 140).max(1000);
     let root = BitMapBackend::new(path, (w, 640)).into_drawing_area();
     root.fill(&WHITE).map_err(err(path))?;
     let root = root.titled(title, ("sans-serif", 20)).map_err(err(path))?;
-    let (vmin, vmax) = range(panels.iter().flat_map(|p| p.values.iter().copied()), false);
+    let (mut vmin, mut vmax) = panels
+        .iter()
+        .flat_map(|p| p.values.iter().copied())
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    if vmin > vmax {
+        (vmin, vmax) = (0.0, 1.0);
+    }
+    if vmax - vmin <= 1e-9 * vmax.abs().max(vmin.abs()) {
+        // One value: a bar 2% wide around it.
+        let d = if vmax == 0.0 { 1.0 } else { 0.01 * vmax.abs() };
+        (vmin, vmax) = (vmin - d, vmax + d);
+    }
     let (main, bar) = root.split_horizontally(w - 140);
     let areas = main.split_evenly((1, panels.len()));
     for (p, area) in panels.iter().zip(areas.iter()) {
         let mut chart = square_chart(area, &p.title, 17, &p.triangles, path)?;
         for (i, t) in p.triangles.iter().enumerate() {
-            let c = colormap((p.values[i] - vmin) / (vmax - vmin).max(f64::MIN_POSITIVE));
+            let c = colormap((p.values[i] - vmin) / (vmax - vmin));
             let pts: Vec<(f64, f64)> = t.iter().map(|v| (v[0], v[1])).collect();
+            let mut closed = pts.clone();
+            closed.push(closed[0]);
             chart
-                .draw_series(std::iter::once(Polygon::new(pts.clone(), c.filled())))
+                .draw_series(std::iter::once(Polygon::new(pts, c.filled())))
+                .map_err(err(path))?;
+            // The fill leaves some boundary pixels out: outline in the fill's colour first.
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    closed.clone(),
+                    c.stroke_width(1),
+                )))
                 .map_err(err(path))?;
             let edge = if p.body[i] == 1 {
                 BLACK.mix(0.35)
             } else {
                 RGBColor(90, 90, 90).mix(0.35)
             };
-            let mut closed = pts;
-            closed.push(closed[0]);
             chart
                 .draw_series(std::iter::once(PathElement::new(
                     closed,
@@ -325,20 +1256,35 @@ pub fn field_panels(path: &Path, title: &str, bar_label: &str, panels: &[Panel])
         }
     }
     // Colour bar.
-    let mut cb = ChartBuilder::on(&bar)
-        .margin_top(60)
-        .margin_bottom(60)
-        .margin_right(70)
-        .y_label_area_size(0)
-        .right_y_label_area_size(60)
-        .build_cartesian_2d(0.0..1.0, vmin..vmax)
+    let layout = Layout {
+        margin: [60, 60, 0, 40],
+        title_px: 0.0,
+        x_label_px: 0,
+        y_label_px: 0,
+        right_label_px: 90,
+    };
+    let (_, bar_px) = layout.plot_dim(bar.dim_in_pixel());
+    let room = layout.label_room(layout.right_label_px, BAR_FONT_PX);
+    let ticks = linear_ticks(
+        vmin,
+        vmax,
+        f64::from(bar_px),
+        BAR_FONT_PX,
+        Side::Vertical,
+        room,
+    );
+    let mut cb = layout
+        .builder(&bar, "")
+        .build_cartesian_2d(0.0..1.0, LinearAxis::new(vmin, vmax, &ticks))
         .map_err(err(path))?;
     cb.configure_mesh()
         .disable_mesh()
         .disable_x_axis()
         .y_desc(bar_label)
-        .label_style(("sans-serif", 13))
-        .y_label_formatter(&|v| format!("{v:.2}"))
+        // The bar is narrower than plotters' 5% tick default can see: ticks 5 pixels long.
+        .set_tick_mark_size(LabelAreaPosition::Right, 5)
+        .label_style(("sans-serif", BAR_FONT_PX))
+        .y_label_formatter(&|v| ticks.label(*v))
         .draw()
         .map_err(err(path))?;
     let n = 100;
@@ -372,9 +1318,11 @@ pub struct MeshPanel {
     pub outline: Vec<[[f64; 2]; 2]>,
 }
 
-/// Mesh panels side by side.
+/// Mesh panels side by side; each legend where it covers the least mesh (the contact line
+/// and interface nodes counting most).
 pub fn mesh_panels(path: &Path, title: &str, panels: &[MeshPanel]) -> Result<()> {
     register();
+    const LEGEND_FONT_PX: f64 = 13.0;
     let w = 600 * panels.len() as u32;
     let root = BitMapBackend::new(path, (w, 640)).into_drawing_area();
     root.fill(&WHITE).map_err(err(path))?;
@@ -432,12 +1380,47 @@ pub fn mesh_panels(path: &Path, title: &str, panels: &[MeshPanel]) -> Result<()>
             .map_err(err(path))?
             .label("body 2 interface nodes")
             .legend(|(x, y)| Cross::new((x + 8, y), 4, COLORS[1].stroke_width(2)));
+        let plot = chart.plotting_area();
+        let base = plot.get_base_pixel();
+        let px = |x: f64, y: f64| {
+            let q = plot.map_coordinate(&(x, y));
+            (f64::from(q.0 - base.0), f64::from(q.1 - base.1))
+        };
+        let mut samples: Vec<((f64, f64), f64)> = p
+            .triangles
+            .iter()
+            .flat_map(|t| t.iter().map(|v| (px(v[0], v[1]), 1.0)))
+            .collect();
+        for s in &p.highlight {
+            for k in 0..=8 {
+                let t = f64::from(k) / 8.0;
+                let q = px(
+                    s[0][0] + t * (s[1][0] - s[0][0]),
+                    s[0][1] + t * (s[1][1] - s[0][1]),
+                );
+                samples.push((q, 50.0));
+            }
+        }
+        samples.extend(p.nodes.iter().flatten().map(|v| (px(v[0], v[1]), 50.0)));
+        let dim = plot.dim_in_pixel();
+        let size = legend_size(
+            &["body 1 interface nodes", "body 2 interface nodes"],
+            LEGEND_FONT_PX,
+        );
+        let order = [
+            SeriesLabelPosition::LowerRight,
+            SeriesLabelPosition::LowerLeft,
+            SeriesLabelPosition::UpperRight,
+            SeriesLabelPosition::UpperLeft,
+        ];
+        let (dw, dh) = (f64::from(dim.0), f64::from(dim.1));
+        let (pos, _) = place_box(size, (dw, dh), &samples, &[], 5.0, &order);
         chart
             .configure_series_labels()
             .background_style(WHITE.mix(0.9))
             .border_style(BLACK)
-            .label_font(("sans-serif", 13))
-            .position(SeriesLabelPosition::LowerRight)
+            .label_font(("sans-serif", LEGEND_FONT_PX))
+            .position(pos)
             .draw()
             .map_err(err(path))?;
     }
@@ -453,10 +1436,54 @@ pub struct GridPanel {
     pub cells: Vec<(f64, f64, f64)>,
     /// Polylines to draw over the cells (e.g. the iso-dofs lines), with a label each.
     pub lines: Vec<(String, Vec<(f64, f64)>)>,
+    /// Values at or below this (zero, round-off) stay off the log colour scale: their cells
+    /// are hatched grey and the panel notes "0 / round-off" (same units as the values).
+    pub roundoff: f64,
 }
 
-/// Maps side by side (two per row), each with its own colour scale on log10 of the values,
-/// the value written in every cell.
+/// Where each cell of `panel` falls on [`colormap`]: its log10 value's place between the
+/// smallest and largest (padded 5%) of the cells above the round-off level; `None` for a
+/// cell at zero or round-off, which stays off the scale.
+pub fn cell_shades(panel: &GridPanel) -> Vec<Option<f64>> {
+    let above = |v: f64| v > panel.roundoff || v.is_nan();
+    let (v0, v1) = range(
+        panel
+            .cells
+            .iter()
+            .filter(|c| above(c.2))
+            .map(|c| c.2.log10()),
+        false,
+    );
+    panel
+        .cells
+        .iter()
+        .map(|c| above(c.2).then(|| (c.2.log10() - v0) / (v1 - v0).max(f64::MIN_POSITIVE)))
+        .collect()
+}
+
+/// Hatched grey: the cells of a [`GridPanel`] at zero or round-off.
+const ROUNDOFF_FILL: RGBColor = RGBColor(215, 215, 215);
+const ROUNDOFF_HATCH: RGBColor = RGBColor(150, 150, 150);
+
+/// Diagonal hatching of the box [x0, x1] × [y0, y1] (pixels or data units alike): segments
+/// of the lines y - y0 = (x - x0) + c, c a multiple of `pitch`, inside the box.
+fn hatch(x0: f64, x1: f64, y0: f64, y1: f64, pitch: f64) -> Vec<[(f64, f64); 2]> {
+    let (w, h) = (x1 - x0, y1 - y0);
+    let n = ((w + h) / pitch).ceil() as i64;
+    (-n..=n)
+        .filter_map(|k| {
+            // Along u = x - x0 in [0, w]: v = u + c must be in [0, h].
+            let c = k as f64 * pitch;
+            let (u0, u1) = ((-c).max(0.0), (h - c).min(w));
+            (u1 > u0).then_some([(x0 + u0, y0 + u0 + c), (x0 + u1, y0 + u1 + c)])
+        })
+        .collect()
+}
+
+/// Maps side by side (two per row), each with its own colour scale on log10 of the values
+/// above the panel's round-off level, the value written in every cell; cells at zero or
+/// round-off hatched grey (noted above the panel), the lines labelled where the label
+/// covers no cell's value.
 pub fn grid_panels(
     path: &Path,
     title: &str,
@@ -465,21 +1492,27 @@ pub fn grid_panels(
     panels: &[GridPanel],
 ) -> Result<()> {
     register();
+    const CELL_FONT_PX: f64 = 12.0;
+    const LINE_FONT_PX: f64 = 11.0;
     let rows = panels.len().div_ceil(2) as u32;
     let root = BitMapBackend::new(path, (1100, 520 * rows + 40)).into_drawing_area();
     root.fill(&WHITE).map_err(err(path))?;
     let root = root.titled(title, ("sans-serif", 20)).map_err(err(path))?;
     let areas = root.split_evenly((rows as usize, 2));
+    let layout = Layout {
+        margin: [10; 4],
+        title_px: 16.0,
+        x_label_px: 35,
+        y_label_px: 45,
+        right_label_px: 0,
+    };
     for (p, area) in panels.iter().zip(areas.iter()) {
         let (x0, x1) = range(p.cells.iter().map(|c| c.0), false);
         let (y0, y1) = range(p.cells.iter().map(|c| c.1), false);
-        let logs: Vec<f64> = p.cells.iter().map(|c| c.2.max(1e-300).log10()).collect();
-        let (v0, v1) = range(logs.iter().copied(), false);
-        let mut chart = ChartBuilder::on(area)
-            .caption(&p.title, ("sans-serif", 16))
-            .margin(10)
-            .x_label_area_size(35)
-            .y_label_area_size(45)
+        let marked = |v: f64| v <= p.roundoff;
+        let shades = cell_shades(p);
+        let mut chart = layout
+            .builder(area, &p.title)
             .build_cartesian_2d(x0 - 0.5..x1 + 0.5, y0 - 0.5..y1 + 0.5)
             .map_err(err(path))?;
         chart
@@ -494,41 +1527,145 @@ pub fn grid_panels(
             .label_style(("sans-serif", 12))
             .draw()
             .map_err(err(path))?;
-        for (c, l) in p.cells.iter().zip(&logs) {
-            let t = (l - v0) / (v1 - v0).max(f64::MIN_POSITIVE);
-            chart
-                .draw_series(std::iter::once(Rectangle::new(
-                    [(c.0 - 0.5, c.1 - 0.5), (c.0 + 0.5, c.1 + 0.5)],
-                    colormap(t).filled(),
-                )))
+        let data = chart.plotting_area().clone();
+        let plot = data.strip_coord_spec();
+        let base = data.get_base_pixel();
+        let px = |x: f64, y: f64| {
+            let q = data.map_coordinate(&(x, y));
+            (f64::from(q.0 - base.0), f64::from(q.1 - base.1))
+        };
+        let centred = |size: f64| {
+            TextStyle::from(("sans-serif", size).into_font())
+                .pos(Pos::new(HPos::Center, VPos::Center))
+        };
+        let as_i = |p: (f64, f64)| (p.0.round() as i32, p.1.round() as i32);
+        // The cells and the boxes of their values (pixels), which line labels must not cover.
+        // The cells first, then the lines, then each value on a patch of its cell's colour
+        // (the lines pass under the numbers), then the lines' labels.
+        let mut values = Vec::new();
+        for (c, shade) in p.cells.iter().zip(&shades) {
+            let (a, b) = (px(c.0 - 0.5, c.1 + 0.5), px(c.0 + 0.5, c.1 - 0.5));
+            let text = match c.2 {
+                0.0 => "0".to_string(),
+                v => format!("{v:.2e}"),
+            };
+            let (tw, th) = text_size(&text, CELL_FONT_PX);
+            let centre = px(c.0, c.1);
+            let text_box = Rect {
+                x0: centre.0 - 0.5 * tw - 2.0,
+                y0: centre.1 - 0.5 * th - 2.0,
+                x1: centre.0 + 0.5 * tw + 2.0,
+                y1: centre.1 + 0.5 * th + 2.0,
+            };
+            let (fill, ink) = match *shade {
+                Some(t) => (colormap(t), if t > 0.6 { BLACK } else { WHITE }),
+                None => (ROUNDOFF_FILL, BLACK),
+            };
+            plot.draw(&Rectangle::new([as_i(a), as_i(b)], fill.filled()))
                 .map_err(err(path))?;
-            let ink = if t > 0.6 { BLACK } else { WHITE };
-            chart
-                .draw_series(std::iter::once(Text::new(
-                    format!("{:.2e}", c.2),
-                    (c.0 - 0.38, c.1 + 0.08),
-                    ("sans-serif", 12).into_font().color(&ink),
-                )))
-                .map_err(err(path))?;
-        }
-        for (label, pts) in &p.lines {
-            let style = ShapeStyle::from(&RED).stroke_width(2);
-            chart
-                .draw_series(LineSeries::new(pts.iter().copied(), style))
-                .map_err(err(path))?;
-            if let Some(&last) = pts
-                .iter()
-                .filter(|q| q.1 <= y1 + 0.5 && q.0 <= x1 + 0.5)
-                .last()
-            {
-                chart
-                    .draw_series(std::iter::once(Text::new(
-                        label.clone(),
-                        (last.0 - 0.45, last.1 - 0.1),
-                        ("sans-serif", 11).into_font().color(&RED),
-                    )))
+            if shade.is_none() {
+                for s in hatch(a.0, b.0, a.1, b.1, 12.0) {
+                    plot.draw(&PathElement::new(
+                        vec![as_i(s[0]), as_i(s[1])],
+                        ROUNDOFF_HATCH.stroke_width(1),
+                    ))
                     .map_err(err(path))?;
+                }
             }
+            values.push((text, centre, text_box, fill, ink));
+        }
+        for (_, pts) in &p.lines {
+            data.draw(&PathElement::new(
+                pts.clone(),
+                ShapeStyle::from(&RED).stroke_width(2),
+            ))
+            .map_err(err(path))?;
+        }
+        let mut taken: Vec<Rect> = Vec::new();
+        for (text, centre, r, fill, ink) in values {
+            plot.draw(&Rectangle::new(
+                [as_i((r.x0, r.y0)), as_i((r.x1, r.y1))],
+                fill.filled(),
+            ))
+            .map_err(err(path))?;
+            plot.draw(&Text::new(
+                text,
+                as_i(centre),
+                centred(CELL_FONT_PX).color(&ink),
+            ))
+            .map_err(err(path))?;
+            taken.push(r);
+        }
+        let (dw, dh) = plot.dim_in_pixel();
+        let inside = Rect {
+            x0: 0.0,
+            y0: 0.0,
+            x1: f64::from(dw),
+            y1: f64::from(dh),
+        };
+        for (label, pts) in &p.lines {
+            // On the line, nearest its end, where it covers no cell's value, no other label
+            // and stays inside the plot.
+            let (tw, th) = text_size(label, LINE_FONT_PX);
+            let (hw, hh) = (0.5 * tw + 3.0, 0.5 * th + 2.0);
+            let best = pts
+                .iter()
+                .map(|q| px(q.0, q.1))
+                .map(|c| {
+                    let r = Rect {
+                        x0: c.0 - hw,
+                        y0: c.1 - hh,
+                        x1: c.0 + hw,
+                        y1: c.1 + hh,
+                    };
+                    let out = r.area() - r.overlap(&inside);
+                    let covered: f64 = taken.iter().map(|t| t.overlap(&r)).sum();
+                    (covered + 1e3 * out, c, r)
+                })
+                .rev()
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            if let Some((_, c, r)) = best {
+                plot.draw(&Rectangle::new(
+                    [as_i((r.x0, r.y0)), as_i((r.x1, r.y1))],
+                    WHITE.mix(0.85).filled(),
+                ))
+                .map_err(err(path))?;
+                plot.draw(&Text::new(
+                    label.clone(),
+                    as_i(c),
+                    centred(LINE_FONT_PX).color(&RED),
+                ))
+                .map_err(err(path))?;
+                taken.push(r);
+            }
+        }
+        if p.cells.iter().any(|c| marked(c.2)) {
+            // The note in the panel's title row, right-aligned: a hatched swatch and its meaning.
+            let note = format!("0 / round-off (≤ {:.0e})", p.roundoff);
+            let (tw, th) = text_size(&note, CELL_FONT_PX);
+            let (aw, _) = area.dim_in_pixel();
+            let x = f64::from(aw) - tw - 14.0;
+            let (s0, s1) = ((x - 22.0, 8.0), (x - 6.0, 8.0 + 16.0));
+            area.draw(&Rectangle::new(
+                [as_i(s0), as_i(s1)],
+                ROUNDOFF_FILL.filled(),
+            ))
+            .map_err(err(path))?;
+            for s in hatch(s0.0, s1.0, s0.1, s1.1, 6.0) {
+                area.draw(&PathElement::new(
+                    vec![as_i(s[0]), as_i(s[1])],
+                    ROUNDOFF_HATCH.stroke_width(1),
+                ))
+                .map_err(err(path))?;
+            }
+            area.draw(&Rectangle::new([as_i(s0), as_i(s1)], BLACK.stroke_width(1)))
+                .map_err(err(path))?;
+            area.draw(&Text::new(
+                note,
+                as_i((x, 8.0 + 8.0 - 0.5 * th)),
+                ("sans-serif", CELL_FONT_PX).into_font(),
+            ))
+            .map_err(err(path))?;
         }
     }
     root.present().map_err(err(path))?;
