@@ -218,7 +218,7 @@ fn maps(res: &TwoSizeResult, slave: &str, method: Method, d: &Path) -> Result<()
                 .map(|p| (p.slave_level as f64, p.master_level as f64, p.error))
                 .collect(),
             lines: lines.clone(),
-            roundoff: crate::study::rates::ROUNDOFF,
+            roundoff: crate::verify::rates::ROUNDOFF,
         })
         .collect();
     plot::grid_panels(
