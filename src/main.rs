@@ -58,45 +58,49 @@ enum Command {
     },
     /// Solve one scene on one mesh level and write its time series (binary VTU), contact.csv
     /// and summary.csv into --out, all or nothing.
-    Solve {
-        /// Built-in scene name (`scene list` lists them) or path to a scene .toml.
-        #[arg(long)]
-        scene: String,
-        /// Contact condition: mortar (K_h^pi) or nts (K_h^I).
-        #[arg(long, default_value = "mortar")]
-        method: String,
-        /// Solver: newton, paper or qp.
-        #[arg(long, default_value = "newton")]
-        solver: String,
-        /// Mesh refinement level (0 = the .geo's own mesh; each level splits every triangle in 4).
-        #[arg(long, default_value_t = 0)]
-        level: usize,
-        /// Number of time steps (default: the scene's).
-        #[arg(long)]
-        steps: Option<usize>,
-        /// Output folder.
-        #[arg(long, default_value = "out")]
-        out: PathBuf,
-        /// Penalty parameter omega of the paper solver (default: automatic).
-        #[arg(long)]
-        omega: Option<f64>,
-        /// Relaxation rho of the paper solver, in (0, 1] (0.5: rho = 1 can cycle forever on a body held only by contact).
-        #[arg(long, default_value_t = 0.5)]
-        rho: f64,
-        /// Relative tolerance of the solvers.
-        #[arg(long, default_value_t = 1e-10)]
-        tol: f64,
-        /// gmsh parameter overrides, NAME=VALUE (repeatable).
-        #[arg(long = "set", value_name = "NAME=VALUE")]
-        set: Vec<String>,
-        /// Also measure the floor (one sparse Cholesky of the stiffness and a solve per
-        /// step, from scratch) and report the solver's cost as a multiple of it.
-        #[arg(long)]
-        floor: bool,
-        /// Write every K-th time step (and the last) to the time series.
-        #[arg(long, value_name = "K", default_value_t = 1)]
-        every: usize,
-    },
+    Solve(SolveArgs),
+}
+
+/// The arguments of `solve`.
+#[derive(clap::Args)]
+struct SolveArgs {
+    /// Built-in scene name (`scene list` lists them) or path to a scene .toml.
+    #[arg(long)]
+    scene: String,
+    /// Contact condition: mortar (K_h^pi) or nts (K_h^I).
+    #[arg(long, default_value = "mortar")]
+    method: String,
+    /// Solver: newton, paper or qp.
+    #[arg(long, default_value = "newton")]
+    solver: String,
+    /// Mesh refinement level (0 = the .geo's own mesh; each level splits every triangle in 4).
+    #[arg(long, default_value_t = 0)]
+    level: usize,
+    /// Number of time steps (default: the scene's).
+    #[arg(long)]
+    steps: Option<usize>,
+    /// Output folder.
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
+    /// Penalty parameter omega of the paper solver (default: automatic).
+    #[arg(long)]
+    omega: Option<f64>,
+    /// Relaxation rho of the paper solver, in (0, 1] (0.5: rho = 1 can cycle forever on a body held only by contact).
+    #[arg(long, default_value_t = 0.5)]
+    rho: f64,
+    /// Relative tolerance of the solvers.
+    #[arg(long, default_value_t = 1e-10)]
+    tol: f64,
+    /// gmsh parameter overrides, NAME=VALUE (repeatable).
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    set: Vec<String>,
+    /// Also measure the floor (one sparse Cholesky of the stiffness and a solve per
+    /// step, from scratch) and report the solver's cost as a multiple of it.
+    #[arg(long)]
+    floor: bool,
+    /// Write every K-th time step (and the last) to the time series.
+    #[arg(long, value_name = "K", default_value_t = 1)]
+    every: usize,
 }
 
 #[derive(Subcommand)]
@@ -145,48 +149,7 @@ fn run() -> anyhow::Result<()> {
             }
             Ok(())
         }
-        Command::Solve {
-            scene,
-            method,
-            solver,
-            level,
-            steps,
-            out,
-            omega,
-            rho,
-            tol,
-            set,
-            floor,
-            every,
-        } => {
-            let method = Method::parse(&method).with_context(|| {
-                format!("--method: unknown cone '{method}'; use mortar (K_h^pi) or nts (K_h^I)")
-            })?;
-            let kind = SolverKind::parse(&solver).with_context(|| {
-                format!("--solver: unknown solver '{solver}'; use newton, paper or qp")
-            })?;
-            if !(tol > 0.0) {
-                anyhow::bail!("--tol: the tolerance must be positive, got {tol}");
-            }
-            let settings = Settings {
-                kind,
-                tol,
-                omega,
-                rho,
-                ..Settings::default()
-            };
-            solve_one(&SolveRequest {
-                scene,
-                method,
-                settings,
-                level,
-                steps,
-                out,
-                params: parse_sets(&set)?,
-                floor,
-                every,
-            })
-        }
+        Command::Solve(args) => solve_one(&args.request()?),
     }
 }
 
@@ -225,6 +188,45 @@ fn study(name: &str, out: Option<PathBuf>, shard: Option<&str>, merge: bool) -> 
         anyhow::bail!("rate below threshold: {}", failures.join("; "));
     }
     Ok(())
+}
+
+impl SolveArgs {
+    /// The checked request: the cone, the solver and its settings parsed.
+    fn request(self) -> anyhow::Result<SolveRequest> {
+        let method = Method::parse(&self.method).with_context(|| {
+            format!(
+                "--method: unknown cone '{}'; use mortar (K_h^pi) or nts (K_h^I)",
+                self.method
+            )
+        })?;
+        let kind = SolverKind::parse(&self.solver).with_context(|| {
+            format!(
+                "--solver: unknown solver '{}'; use newton, paper or qp",
+                self.solver
+            )
+        })?;
+        if !(self.tol > 0.0) {
+            anyhow::bail!("--tol: the tolerance must be positive, got {}", self.tol);
+        }
+        let settings = Settings {
+            kind,
+            tol: self.tol,
+            omega: self.omega,
+            rho: self.rho,
+            ..Settings::default()
+        };
+        Ok(SolveRequest {
+            scene: self.scene,
+            method,
+            settings,
+            level: self.level,
+            steps: self.steps,
+            out: self.out,
+            params: parse_sets(&self.set)?,
+            floor: self.floor,
+            every: self.every,
+        })
+    }
 }
 
 /// What `solve` was asked to do.
