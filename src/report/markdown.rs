@@ -35,6 +35,17 @@ impl Doc {
         self.text += &format!("- {text}\n");
         self
     }
+    /// A list: one item `- text` per entry, then a blank line (nothing for no entries).
+    pub fn list<S: Display>(&mut self, items: impl IntoIterator<Item = S>) -> &mut Self {
+        let before = self.text.len();
+        for item in items {
+            self.bullet(item);
+        }
+        if self.text.len() > before {
+            self.blank();
+        }
+        self
+    }
     /// A blank line (ends a list).
     pub fn blank(&mut self) -> &mut Self {
         self.text.push('\n');
@@ -116,5 +127,19 @@ mod tests {
             d.finish(),
             "## Errors\n\n| level | error |\n|---|---|\n| 0 | 1.0e-2 |\n| 1 | 2.5e-3 |\n\n- fitted\n"
         );
+    }
+
+    #[test]
+    fn a_list_ends_with_a_blank_line_and_an_empty_one_writes_nothing() {
+        let mut d = Doc::new();
+        d.list(Vec::<String>::new()).list(["a", "b"]).line("Data.");
+        assert_eq!(d.finish(), "- a\n- b\n\nData.\n");
+    }
+
+    #[test]
+    fn empty_cells_keep_their_column() {
+        let mut t = Table::new(["a", "b", "c"]);
+        t.row(["1", "", "3"]);
+        assert_eq!(t.render(), "| a | b | c |\n|---|---|---|\n| 1 |  | 3 |\n");
     }
 }

@@ -442,131 +442,164 @@ struct Plan {
     /// study measures against the exact solution.
     reference: Option<[JobId; 3]>,
     /// Every cone on every study level, cone by cone.
-    levels: Vec<(Method, usize, JobId)>,
+    levels: FamilyJobs,
     /// The variant families: their coarsest size and their levels like `levels`.
-    variants: Vec<(f64, Vec<(Method, usize, JobId)>)>,
-    /// The time study: its reference in time (none against the exact solution), then one
-    /// run per step count.
-    time: Option<(Option<JobId>, Vec<(usize, JobId)>)>,
+    variants: Vec<(f64, FamilyJobs)>,
+    /// The time study.
+    time: Option<TimeJobs>,
+}
+
+/// The solves of a mesh family: (cone, level, job), cone by cone.
+type FamilyJobs = Vec<(Method, usize, JobId)>;
+
+/// The time study's solves.
+struct TimeJobs {
+    /// Its reference in time (none against the exact solution).
+    reference: Option<JobId>,
+    /// One run per step count: (steps, job).
+    runs: Vec<(usize, JobId)>,
+}
+
+/// The study's solves as they are planned: each job added gets the next id.
+#[derive(Default)]
+struct JobList(Vec<Job>);
+
+impl JobList {
+    /// Add a job on `scene` (0: the study's, 1: the time study's) with both bodies at
+    /// `level`, and return its id.
+    fn add(
+        &mut self,
+        label: String,
+        method: Method,
+        level: usize,
+        params: &[(String, f64)],
+        steps: usize,
+        scene: usize,
+    ) -> JobId {
+        let id = self.0.len();
+        self.0.push(Job {
+            id,
+            label,
+            method,
+            level,
+            body_levels: [level, level],
+            params: params.to_vec(),
+            steps,
+            scene,
+        });
+        id
+    }
 }
 
 impl Plan {
     /// Plan every solve and check what can be checked before the first one: the reference
-    /// meshes must match on Gamma_C. Uniform splitting keeps matching traces matching, so
-    /// the coarsest reference level (a cheap mesh) decides for all three.
+    /// meshes must match on Gamma_C.
     fn new(study: &Study) -> Result<Self> {
         let sf = &study.file;
-        let family = sf.family_parameters();
-        let reference_parameters = sf.reference_parameters();
-        let mut jobs = Vec::new();
-        let time_scene = usize::from(study.time_scene.is_some());
-        let mut add = |label: String,
-                       method: Method,
-                       level: usize,
-                       params: &[(String, f64)],
-                       steps: usize,
-                       scene: usize| {
-            jobs.push(Job {
-                id: jobs.len(),
-                label,
-                method,
-                level,
-                body_levels: [level, level],
-                params: params.to_vec(),
-                steps,
-                scene,
-            });
-            jobs.len() - 1
-        };
-        let r = study.reference_level();
-        let reference = (!sf.reference.exact).then(|| {
-            [r - 2, r - 1, r].map(|l| {
-                add(
-                    format!("reference level {l}"),
-                    Method::Mortar,
-                    l,
-                    &reference_parameters,
-                    sf.steps,
-                    0,
-                )
+        let mut jobs = JobList::default();
+        let reference = Plan::reference(study, &mut jobs);
+        let levels = Plan::family(study, &mut jobs, &sf.family_parameters(), "");
+        let variants = sf
+            .mesh
+            .variants
+            .iter()
+            .map(|&coarsest| {
+                let params = sf.variant_parameters(coarsest);
+                let suffix = format!(" (family {coarsest})");
+                (coarsest, Plan::family(study, &mut jobs, &params, &suffix))
             })
-        });
-        let mut levels = Vec::new();
-        for &method in &sf.methods {
-            for &level in &sf.mesh.levels {
-                let id = add(
-                    format!("{method} level {level}"),
-                    method,
-                    level,
-                    &family,
-                    sf.steps,
-                    0,
-                );
-                levels.push((method, level, id));
-            }
-        }
-        let mut variants = Vec::new();
-        for &coarsest in &sf.mesh.variants {
-            let params = sf.variant_parameters(coarsest);
-            let mut runs = Vec::new();
-            for &method in &sf.methods {
-                for &level in &sf.mesh.levels {
-                    let label = format!("{method} level {level} (family {coarsest})");
-                    runs.push((
-                        method,
-                        level,
-                        add(label, method, level, &params, sf.steps, 0),
-                    ));
-                }
-            }
-            variants.push((coarsest, runs));
-        }
-        let time = sf.time.as_ref().map(|ts| {
-            let method = sf.methods[0];
-            let reference = ts.reference_steps.map(|r| {
-                add(
-                    format!("time reference ({r} steps)"),
-                    method,
-                    ts.level,
-                    &family,
-                    r,
-                    time_scene,
-                )
-            });
-            let runs = ts
-                .steps
-                .iter()
-                .map(|&n| {
-                    let label = format!("time study ({n} steps)");
-                    (n, add(label, method, ts.level, &family, n, time_scene))
-                })
-                .collect();
-            (reference, runs)
-        });
+            .collect();
+        let time = Plan::time_study(study, &mut jobs);
         if let Some(reference) = reference {
-            let coarsest = &jobs[reference[0]];
-            let case = Case::build(
-                &study.scene,
-                coarsest.level,
-                coarsest.method,
-                &coarsest.params,
-            )?;
-            if case.problem.interface.min_relative_separation() > 1e-9 {
-                return Err(Error::input(
-                    &study.path,
-                    "reference.parameters",
-                    "the reference meshes do not match on Gamma_C; set the .geo parameter that makes them match (e.g. matching = 1)",
-                ));
-            }
+            check_reference_matches(study, &jobs.0[reference[0]])?;
         }
         Ok(Plan {
-            jobs,
+            jobs: jobs.0,
             reference,
             levels,
             variants,
             time,
         })
     }
+
+    /// The reference's three levels, coarsest first (none against the exact solution).
+    fn reference(study: &Study, jobs: &mut JobList) -> Option<[JobId; 3]> {
+        let sf = &study.file;
+        let parameters = sf.reference_parameters();
+        let r = study.reference_level();
+        (!sf.reference.exact).then(|| {
+            [r - 2, r - 1, r].map(|l| {
+                let label = format!("reference level {l}");
+                jobs.add(label, Method::Mortar, l, &parameters, sf.steps, 0)
+            })
+        })
+    }
+
+    /// Every cone on every study level of a mesh family, cone by cone; `suffix` ends each
+    /// label.
+    fn family(
+        study: &Study,
+        jobs: &mut JobList,
+        params: &[(String, f64)],
+        suffix: &str,
+    ) -> FamilyJobs {
+        let sf = &study.file;
+        let mut runs = Vec::new();
+        for &method in &sf.methods {
+            for &level in &sf.mesh.levels {
+                let label = format!("{method} level {level}{suffix}");
+                runs.push((
+                    method,
+                    level,
+                    jobs.add(label, method, level, params, sf.steps, 0),
+                ));
+            }
+        }
+        runs
+    }
+
+    /// The time study on its scene: its reference in time (none against the exact
+    /// solution), then one run per step count.
+    fn time_study(study: &Study, jobs: &mut JobList) -> Option<TimeJobs> {
+        let sf = &study.file;
+        let family = sf.family_parameters();
+        let scene = usize::from(study.time_scene.is_some());
+        sf.time.as_ref().map(|ts| {
+            let method = sf.methods[0];
+            let reference = ts.reference_steps.map(|r| {
+                let label = format!("time reference ({r} steps)");
+                jobs.add(label, method, ts.level, &family, r, scene)
+            });
+            let runs = ts
+                .steps
+                .iter()
+                .map(|&n| {
+                    let label = format!("time study ({n} steps)");
+                    (n, jobs.add(label, method, ts.level, &family, n, scene))
+                })
+                .collect();
+            TimeJobs { reference, runs }
+        })
+    }
+}
+
+/// The reference meshes must match on Gamma_C. Uniform splitting keeps matching traces
+/// matching, so the coarsest reference level (a cheap mesh) decides for all three.
+fn check_reference_matches(study: &Study, coarsest: &Job) -> Result<()> {
+    let case = Case::build(
+        &study.scene,
+        coarsest.level,
+        coarsest.method,
+        &coarsest.params,
+    )?;
+    if case.problem.interface.min_relative_separation() > 1e-9 {
+        return Err(Error::input(
+            &study.path,
+            "reference.parameters",
+            "the reference meshes do not match on Gamma_C; set the .geo parameter that makes them match (e.g. matching = 1)",
+        ));
+    }
+    Ok(())
 }
 
 /// The reference solution with what every level is measured against.
@@ -1086,11 +1119,12 @@ fn time_study(
     points: usize,
 ) -> Result<Option<TimeStudy>> {
     let sf = &study.file;
-    let (Some(ts), Some((reference_id, run_ids))) = (sf.time.as_ref(), plan.time.as_ref()) else {
+    let (Some(ts), Some(jobs)) = (sf.time.as_ref(), plan.time.as_ref()) else {
         return Ok(None);
     };
-    let reference = reference_id.map(|id| solved.take(id));
-    let runs: Vec<(usize, Case, Solution)> = run_ids
+    let reference = jobs.reference.map(|id| solved.take(id));
+    let runs: Vec<(usize, Case, Solution)> = jobs
+        .runs
         .iter()
         .map(|&(steps, id)| {
             let (case, sol) = solved.take(id);
@@ -1231,61 +1265,25 @@ pub fn run(name: &str) -> Result<StudyResult> {
 /// only, no result), or a merge of the records of all shards.
 pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
     let t0 = Instant::now();
+    // 1. Plan the solves and run them (a shard stores its records and stops there).
     let study = Study::load(name)?;
     let sf = &study.file;
     let plan = Plan::new(&study)?;
-    let progress = Progress::new(plan.jobs.len() as u64, &study.name);
-    let scenes: Vec<&Scene> = std::iter::once(&study.scene)
-        .chain(study.time_scene.as_ref())
-        .collect();
-    let outputs = jobs::execute(
-        &plan.jobs,
-        &scenes,
-        sf.solver,
-        &study.text,
-        mode,
-        &|label| progress.tick(label),
-    )?;
-    progress.finish();
-    if let Mode::Shard(i, n) = mode {
-        eprintln!(
-            "shard {i}/{n}: {} of {} jobs solved, records in {}",
-            outputs.iter().filter(|o| o.is_some()).count(),
-            plan.jobs.len(),
-            jobs::records_dir().display()
-        );
+    let Some(mut solved) = solve_all(&study, &plan, mode)? else {
         return Ok(None);
-    }
-    let mut solved = Solved::complete(outputs).expect("every job ran or was loaded");
-    let truth = match plan.reference {
-        Some(ids) => Truth::Solved(reference(ids, &mut solved, study.reference_level())),
-        None => Truth::Exact(
-            study
-                .scene
-                .exact
-                .as_deref()
-                .expect("checked when the study was read"),
-            sf.reference.quadrature,
-        ),
     };
+    // 2. The reference, or the exact solution.
+    let truth = truth(&study, &plan, &mut solved);
+    // 3. Every level of every cone against it.
     let profile_level = sf.mesh.levels[sf.mesh.levels.len() / 2];
     let measured = measure_levels(sf, &plan, &mut solved, &truth, profile_level)?;
-    let rates = fit_rates(
-        sf,
-        &study.path,
-        &measured.errors,
-        &truth,
-        measured.resultant_fixed,
-    )?;
-    let variants = measure_variants(
-        sf,
-        &study.path,
-        &plan,
-        &mut solved,
-        &truth,
-        measured.resultant_fixed,
-    )?;
+    // 4. The rates and their thresholds, and the variant families'.
+    let fixed = measured.resultant_fixed;
+    let rates = fit_rates(sf, &study.path, &measured.errors, &truth, fixed)?;
+    let variants = measure_variants(sf, &study.path, &plan, &mut solved, &truth, fixed)?;
+    // 5. The rate in time on a fixed mesh.
     let time_study = time_study(&study, &plan, &mut solved, sf.reference.quadrature)?;
+    // 6. The provenance, with the mesh the truth was measured on.
     let (reference, exact_quadrature, mesh, warnings) = match &truth {
         Truth::Solved(r) => (
             Some(r.facts),
@@ -1321,4 +1319,50 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
         warnings,
         file: study.file,
     }))
+}
+
+/// Every job of the plan in `mode`: all of them, one shard's (records only: None), or the
+/// records of all shards.
+fn solve_all(study: &Study, plan: &Plan, mode: Mode) -> Result<Option<Solved>> {
+    let progress = Progress::new(plan.jobs.len() as u64, &study.name);
+    let scenes: Vec<&Scene> = std::iter::once(&study.scene)
+        .chain(study.time_scene.as_ref())
+        .collect();
+    let outputs = jobs::execute(
+        &plan.jobs,
+        &scenes,
+        study.file.solver,
+        &study.text,
+        mode,
+        &|label| progress.tick(label),
+    )?;
+    progress.finish();
+    if let Mode::Shard(i, n) = mode {
+        eprintln!(
+            "shard {i}/{n}: {} of {} jobs solved, records in {}",
+            outputs.iter().filter(|o| o.is_some()).count(),
+            plan.jobs.len(),
+            jobs::records_dir().display()
+        );
+        return Ok(None);
+    }
+    Ok(Some(
+        Solved::complete(outputs).expect("every job ran or was loaded"),
+    ))
+}
+
+/// What every level is measured against: the reference solve (with its own error), or the
+/// scene's exact solution.
+fn truth<'s>(study: &'s Study, plan: &Plan, solved: &mut Solved) -> Truth<'s> {
+    match plan.reference {
+        Some(ids) => Truth::Solved(reference(ids, solved, study.reference_level())),
+        None => Truth::Exact(
+            study
+                .scene
+                .exact
+                .as_deref()
+                .expect("checked when the study was read"),
+            study.file.reference.quadrature,
+        ),
+    }
 }

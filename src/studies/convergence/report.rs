@@ -5,12 +5,13 @@ use crate::contact::Method;
 use crate::error::Result;
 use crate::io::{csv_bytes, fmt3};
 use crate::report::folder::{write, write_folder};
+use crate::report::markdown::{Doc, Table};
 use crate::report::plot::{self, Panel, Series};
 use crate::studies::convergence::{RateRow, Source, StudyResult, TimeStudy, join};
 use crate::verify::quantity::Quantity;
 use crate::verify::rates::{self, Verdict};
 use crate::verify::study_file::Threshold;
-use crate::verify::table::{MethodLabel, RateRecord};
+use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -388,64 +389,249 @@ fn von_mises(res: &StudyResult, d: &Path) -> Result<()> {
     Ok(())
 }
 
+/// The README: the study and its scene, what separates the cones, the rates, the errors
+/// per level, the truth they are measured against, and the plots.
 fn readme(res: &StudyResult) -> String {
-    let mut s = String::new();
-    let _ = writeln!(s, "# Study `{}`\n\n{}\n", res.name, res.description);
-    let _ = writeln!(s, "Scene `{}`: {}\n", res.scene.name, res.scene.description);
-    let _ = writeln!(
-        s,
-        "Regenerate with `cargo run --release -- study {}` ({:.0} s on this machine, {} cores). Solver `{}`, {} uniform time steps over [0, {}].\n",
-        res.name,
-        res.wall_s,
-        res.provenance.get("cores").cloned().unwrap_or_default(),
-        res.file.solver,
-        res.file.steps,
-        res.scene.final_time
-    );
-    cones_compared(&mut s, res);
-    let _ = writeln!(s, "![error against h](error_vs_h.png)\n");
-    let _ = writeln!(
-        s,
-        "## Rates\n\nLeast-squares slope of log(error) against log(h) over the levels used (± standard error), rate against dofs, and successive rates between neighbouring levels. A rate never overstates: errors at round-off (<= 1e-10, the solvers' tolerance) are marked and never fitted (their successive rates are `-`), levels within 5x of the truth's own error in that quantity are left out, a rate needs at least 3 levels, and a quantity whose last two successive rates average below 0.15 is called non-converging and given no slope. The levels used are the longest trailing window (at least 3 levels) whose successive rates lie within 0.25 of each other; where even the last two differ by more, the fit over every level is shown, flagged pre-asymptotic. A window's rate that differs from the fit over every level, or from the mean of the last two successive rates, by more than max(0.15, 2 standard errors) is called drifting (the rate is still changing; the all-level fit is given beside it). A contact resultant fixed by equilibrium is named so and never fitted. Beside the fit, the conventions of ASME V&V 20 (Celik et al. 2008, J. Fluids Eng. 130, 078001) on the last three levels: the observed order p (non-uniform ratio, fixed-point iteration), oscillatory convergence named, the GCI of the finest level (safety factor 1.25 at the observed order, in the units of the error) and the asymptotic ratio GCI_coarse / (r^p GCI_fine) at the rate in h printed (1 where that rate describes the last three levels; at the observed order it would be 1 by construction). The `theorem` quantity is max_n (||u - u_ref||_H1 + ||sigma - sigma_ref||_L2) over both bodies, relative to the reference's; Theorem 3.1 predicts h^(3/4) for mortar (K_h^pi) and h^(1/2) for nts (K_h^I).\n"
-    );
-    let _ = writeln!(
-        s,
-        "| method | quantity | rate in h | levels used | rate in dofs | successive | observed order (last 3) | GCI fine | GCI ratio | threshold | pass |\n|---|---|---|---|---|---|---|---|---|---|---|"
-    );
+    let mut doc = Doc::new();
+    title(&mut doc, res);
+    cones_compared(&mut doc, res);
+    doc.image("error against h", "error_vs_h.png");
+    rates_table(&mut doc, res);
+    errors_table(&mut doc, res);
+    reference(&mut doc, res);
+    alignment(&mut doc, res);
+    if let Some(ts) = &res.time_study {
+        rate_in_time(&mut doc, ts);
+    }
+    doc.heading(2, "Contact and plasticity at T")
+        .image("pressure", "pressure.png")
+        .image("gap", "gap.png")
+        .image("von Mises", "von_mises.png");
+    doc.heading(2, "Cost")
+        .image("error against time", "error_vs_time.png");
+    provenance(&mut doc, res);
+    doc.finish()
+}
+
+/// The title, the study's and the scene's descriptions, and how to regenerate the report.
+fn title(doc: &mut Doc, res: &StudyResult) {
+    doc.heading(1, format!("Study `{}`", res.name))
+        .paragraph(&res.description)
+        .paragraph(format!(
+            "Scene `{}`: {}",
+            res.scene.name, res.scene.description
+        ))
+        .paragraph(format!(
+            "Regenerate with `cargo run --release -- study {}` ({:.0} s on this machine, {} cores). Solver `{}`, {} uniform time steps over [0, {}].",
+            res.name,
+            res.wall_s,
+            res.provenance.get("cores").cloned().unwrap_or_default(),
+            res.file.solver,
+            res.file.steps,
+            res.scene.final_time
+        ));
+}
+
+/// The report's lead: what separates the cones, quantity by quantity, contact quantities
+/// first: the error at the finest level and the rate (or why there is none) of each cone,
+/// and a sentence per quantity; only quantities whose verdicts compare the cones in every
+/// cone ([`Verdict::compares_cones`]), the others named below the table with the reason.
+fn cones_compared(doc: &mut Doc, res: &StudyResult) {
+    let finest = finest_level(res);
+    let against = if res.reference.is_some() {
+        "the reference"
+    } else {
+        "the exact solution"
+    };
+    let (quantities, left_out) = quantities_compared(res);
+    let mut header = vec!["quantity".to_string(), "where".to_string()];
+    for m in &res.file.methods {
+        header.push(format!("{m}: error at level {finest}"));
+        header.push(format!("{m}: rate"));
+    }
+    let mut table = Table::new(header);
+    for &q in &quantities {
+        let place = if q.is_contact() { "contact" } else { "bulk" };
+        let mut cells = vec![q.to_string(), place.to_string()];
+        for &m in &res.file.methods {
+            cells.push(finest_error(res, m, q).map_or(String::new(), |e| format!("{e:.3e}")));
+            cells.push(rate_row(res, m, q).map_or("n/a".into(), fmt_rate));
+        }
+        table.row(cells);
+    }
+    doc.heading(2, "What separates the cones")
+        .paragraph(format!(
+            "Every quantity against {against}, the contact quantities (on Gamma_C and in the band of triangles touching it) first: the error at level {finest} and the rate in h of each cone."
+        ))
+        .image("contact quantities against h", "contact_vs_h.png")
+        .table(&table);
+    if !left_out.is_empty() {
+        doc.paragraph(format!(
+            "Not compared (no rate the numbers support in some cone, or a quantity that does not measure the cones): {}.",
+            left_out.join(", ")
+        ));
+    }
+    if res.file.methods.len() == 2 {
+        doc.list(quantities.iter().filter_map(|&q| {
+            let sentence = cones_sentence(res, q)?;
+            Some(format!("{q}: {sentence} at level {finest}."))
+        }));
+    }
+}
+
+/// The finest level of the study.
+fn finest_level(res: &StudyResult) -> usize {
+    *res.file.mesh.levels.last().expect("levels")
+}
+
+/// The rate row of a cone and quantity.
+fn rate_row(res: &StudyResult, m: Method, q: Quantity) -> Option<&RateRow> {
+    res.rates.iter().find(|r| r.method == m && r.quantity == q)
+}
+
+/// The error of a cone and quantity at the finest level.
+fn finest_error(res: &StudyResult, m: Method, q: Quantity) -> Option<f64> {
+    let finest = finest_level(res);
+    res.errors
+        .iter()
+        .find(|e| e.method == m && e.quantity == q && e.level == finest)
+        .map(|e| e.error)
+}
+
+/// The quantities that compare the cones, contact quantities first, and the others, each
+/// named with every cone's verdict ("l2_u (mortar: ...; nts: ...)").
+fn quantities_compared(res: &StudyResult) -> (Vec<Quantity>, Vec<String>) {
+    let compared = |q: Quantity| {
+        res.file
+            .methods
+            .iter()
+            .all(|&m| rate_row(res, m, q).is_some_and(|r| r.assessment.verdict.compares_cones()))
+    };
+    let quantities = &res.file.quantities;
+    let ordered = quantities
+        .iter()
+        .filter(|q| q.is_contact())
+        .chain(quantities.iter().filter(|q| !q.is_contact()))
+        .copied();
+    let (shown, left_out): (Vec<Quantity>, Vec<Quantity>) = ordered.partition(|&q| compared(q));
+    let left_out = left_out
+        .into_iter()
+        .map(|q| {
+            let why: Vec<String> = res
+                .file
+                .methods
+                .iter()
+                .filter_map(|&m| rate_row(res, m, q).map(|r| format!("{m}: {}", fmt_rate(r))))
+                .collect();
+            format!("{q} ({})", why.join("; "))
+        })
+        .collect();
+    (shown, left_out)
+}
+
+/// How mortar and nts compare in one quantity at the finest level, from their errors and
+/// verdicts (None where a cone has no error there).
+fn cones_sentence(res: &StudyResult, q: Quantity) -> Option<String> {
+    let a = finest_error(res, Method::Mortar, q)?;
+    let b = finest_error(res, Method::Nts, q)?;
+    let verdict = |m: Method| rate_row(res, m, q).map(|r| r.assessment.verdict);
+    let floor = rates::ROUNDOFF;
+    Some(match (verdict(Method::Mortar), verdict(Method::Nts)) {
+        (Some(Verdict::RoundOff), Some(Verdict::RoundOff)) => {
+            "both cones are exact (round-off)".to_string()
+        }
+        (Some(Verdict::RoundOff), _) => {
+            format!("mortar is exact (round-off); nts's error is {b:.3e}")
+        }
+        (_, Some(Verdict::RoundOff)) => {
+            format!("nts is exact (round-off); mortar's error is {a:.3e}")
+        }
+        (Some(Verdict::NotConverging), Some(Verdict::NotConverging)) => {
+            "neither cone converges".to_string()
+        }
+        (_, Some(Verdict::NotConverging)) => format!(
+            "**nts does not converge** (stalls at {b:.3e}); mortar reaches {a:.3e}, {:.1}x smaller",
+            b / a.max(floor)
+        ),
+        (Some(Verdict::NotConverging), _) => {
+            format!("**mortar does not converge** (stalls at {a:.3e}); nts reaches {b:.3e}")
+        }
+        _ if b > 1.5 * a => format!("nts's error is {:.2}x mortar's", b / a.max(floor)),
+        _ if a > 1.5 * b => format!("mortar's error is {:.2}x nts's", a / b.max(floor)),
+        _ => format!(
+            "the cones agree within a factor 1.5 (nts / mortar = {:.3})",
+            b / a.max(floor)
+        ),
+    })
+}
+
+/// How the rates are judged, above the table of rates.
+const RATES_TEXT: &str = "Least-squares slope of log(error) against log(h) over the levels used (± standard error), rate against dofs, and successive rates between neighbouring levels. A rate never overstates: errors at round-off (<= 1e-10, the solvers' tolerance) are marked and never fitted (their successive rates are `-`), levels within 5x of the truth's own error in that quantity are left out, a rate needs at least 3 levels, and a quantity whose last two successive rates average below 0.15 is called non-converging and given no slope. The levels used are the longest trailing window (at least 3 levels) whose successive rates lie within 0.25 of each other; where even the last two differ by more, the fit over every level is shown, flagged pre-asymptotic. A window's rate that differs from the fit over every level, or from the mean of the last two successive rates, by more than max(0.15, 2 standard errors) is called drifting (the rate is still changing; the all-level fit is given beside it). A contact resultant fixed by equilibrium is named so and never fitted. Beside the fit, the conventions of ASME V&V 20 (Celik et al. 2008, J. Fluids Eng. 130, 078001) on the last three levels: the observed order p (non-uniform ratio, fixed-point iteration), oscillatory convergence named, the GCI of the finest level (safety factor 1.25 at the observed order, in the units of the error) and the asymptotic ratio GCI_coarse / (r^p GCI_fine) at the rate in h printed (1 where that rate describes the last three levels; at the observed order it would be 1 by construction). The `theorem` quantity is max_n (||u - u_ref||_H1 + ||sigma - sigma_ref||_L2) over both bodies, relative to the reference's; Theorem 3.1 predicts h^(3/4) for mortar (K_h^pi) and h^(1/2) for nts (K_h^I).";
+
+/// ## Rates: every cone and quantity's rate, with how it is judged.
+fn rates_table(doc: &mut Doc, res: &StudyResult) {
+    let mut table = Table::new([
+        "method",
+        "quantity",
+        "rate in h",
+        "levels used",
+        "rate in dofs",
+        "successive",
+        "observed order (last 3)",
+        "GCI fine",
+        "GCI ratio",
+        "threshold",
+        "pass",
+    ]);
     for r in &res.rates {
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
-            r.method,
-            r.quantity,
+        let a = &r.assessment;
+        table.row([
+            r.method.to_string(),
+            r.quantity.to_string(),
             fmt_rate(r),
-            join(&r.assessment.used),
+            join(&a.used),
             fmt3(r.rate_dofs().unwrap_or(f64::NAN)),
             successive(r),
             fmt_order(r),
-            r.assessment
-                .celik
+            a.celik
                 .map_or("-".into(), |c| format!("{:.2e}", c.gci_fine)),
-            r.assessment
-                .asymptotic_ratio
-                .map_or("-".into(), |v| format!("{v:.3}")),
+            a.asymptotic_ratio.map_or("-".into(), |v| format!("{v:.3}")),
             r.threshold
                 .map(|t| threshold_text(t, 2))
                 .unwrap_or_default(),
             r.pass
                 .map(|p| if p { "yes" } else { "**no**" })
                 .unwrap_or("")
-        );
+                .to_string(),
+        ]);
     }
-    let _ = writeln!(
-        s,
-        "\n## Errors\n\n| method | level | h | dofs | Gamma_C nodes (body 1 / body 2) | theorem | l2_pressure | max_penetration | iterations (max per step) | contact fraction | plastic fraction | solve (s) | fitted |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|"
-    );
+    doc.heading(2, "Rates").paragraph(RATES_TEXT).table(&table);
+}
+
+/// ## Errors: per cone and level, the mesh, the errors that matter most and the solve.
+fn errors_table(doc: &mut Doc, res: &StudyResult) {
+    let mut table = Table::new([
+        "method",
+        "level",
+        "h",
+        "dofs",
+        "Gamma_C nodes (body 1 / body 2)",
+        "theorem",
+        "l2_pressure",
+        "max_penetration",
+        "iterations (max per step)",
+        "contact fraction",
+        "plastic fraction",
+        "solve (s)",
+        "fitted",
+    ]);
     for l in &res.levels {
-        let e = |q: Quantity| {
+        let at_level = |r: &&ErrorRecord| r.method == l.method && r.level == l.level;
+        let error = |q: Quantity| {
             res.errors
                 .iter()
-                .find(|r| r.method == l.method && r.level == l.level && r.quantity == q)
+                .filter(at_level)
+                .find(|r| r.quantity == q)
                 .map(|r| {
                     if r.error <= rates::ROUNDOFF {
                         format!("{:.3e} (round-off)", r.error)
@@ -455,97 +641,178 @@ fn readme(res: &StudyResult) -> String {
                 })
                 .unwrap_or_default()
         };
-        let wall = res
-            .errors
-            .iter()
-            .find(|r| r.method == l.method && r.level == l.level)
-            .map(|r| r.wall_s)
-            .unwrap_or(0.0);
-        let _ = writeln!(
-            s,
-            "| {} | {} | {:.4} | {} | {} / {} | {} | {} | {} | {} ({}) | {:.3} | {:.3} | {:.2} | {} |",
-            l.method,
-            l.level,
-            l.h,
-            l.dofs,
-            l.slave_nodes,
-            l.master_nodes,
-            e(Quantity::Theorem),
-            e(Quantity::L2Pressure),
-            e(Quantity::MaxPenetration),
-            l.iterations,
-            l.max_step_iterations,
-            l.contact_fraction,
-            l.plastic_fraction,
-            wall,
+        let wall = res.errors.iter().find(at_level).map_or(0.0, |r| r.wall_s);
+        table.row([
+            l.method.to_string(),
+            l.level.to_string(),
+            format!("{:.4}", l.h),
+            l.dofs.to_string(),
+            format!("{} / {}", l.slave_nodes, l.master_nodes),
+            error(Quantity::Theorem),
+            error(Quantity::L2Pressure),
+            error(Quantity::MaxPenetration),
+            format!("{} ({})", l.iterations, l.max_step_iterations),
+            format!("{:.3}", l.contact_fraction),
+            format!("{:.3}", l.plastic_fraction),
+            format!("{wall:.2}"),
             if l.flagged {
                 "no (within 5x of the reference error)"
             } else {
                 "yes"
             }
-        );
+            .to_string(),
+        ]);
     }
+    doc.heading(2, "Errors").table(&table);
+}
+
+/// ## Reference (a matching-mesh solve and its own error) or ## Reference: the exact
+/// solution (how it is integrated).
+fn reference(doc: &mut Doc, res: &StudyResult) {
     match (res.reference, res.exact_quadrature) {
         (Some(r), _) => {
-            let _ = writeln!(
-                s,
-                "\n## Reference\n\nMatching meshes on Gamma_C (where K_h^pi = K_h^I is conforming), level {} (h = {:.4}, {} dofs, solved in {:.1} s). Its own error in the theorem norm, estimated from the two coarser reference levels with the nested-space model d(L, R)^2 = e_L^2 - e_R^2, e_L = C h^p (fitted p = {:.2}): **{:.3e}** relative. Levels whose error is within a factor 5 of it are left out of the fits.\n",
+            doc.heading(2, "Reference").paragraph(format!(
+                "Matching meshes on Gamma_C (where K_h^pi = K_h^I is conforming), level {} (h = {:.4}, {} dofs, solved in {:.1} s). Its own error in the theorem norm, estimated from the two coarser reference levels with the nested-space model d(L, R)^2 = e_L^2 - e_R^2, e_L = C h^p (fitted p = {:.2}): **{:.3e}** relative. Levels whose error is within a factor 5 of it are left out of the fits.",
                 r.level, r.h, r.dofs, r.wall_s, r.error_rate, r.error
-            );
+            ));
         }
         (None, Some(points)) => {
-            let _ = writeln!(
-                s,
-                "\n## Reference: the exact solution\n\nEvery error is measured against the exact solution of scene `{}` (its `[exact]` table), with no reference solve: integrated on each study mesh by a collapsed Gauss rule of {points} x {points} points per triangle (exact to degree {}) and {} Gauss points per segment of Gamma_C, each triangle or segment that a kink of a piecewise exact field crosses split along the kink and the rule applied on each piece (the loads are integrated the same way, with Dunavant's degree-8 rule). Doubling the rule changes no printed digit (tested).\n",
+            doc.heading(2, "Reference: the exact solution").paragraph(format!(
+                "Every error is measured against the exact solution of scene `{}` (its `[exact]` table), with no reference solve: integrated on each study mesh by a collapsed Gauss rule of {points} x {points} points per triangle (exact to degree {}) and {} Gauss points per segment of Gamma_C, each triangle or segment that a kink of a piecewise exact field crosses split along the kink and the rule applied on each piece (the loads are integrated the same way, with Dunavant's degree-8 rule). Doubling the rule changes no printed digit (tested).",
                 res.scene.name,
                 2 * points - 2,
                 2 * points
-            );
-            if res
+            ));
+            let manufactured_viscoplastic = res
                 .scene
                 .exact
                 .as_deref()
-                .is_some_and(|e| e.source_rate.is_some())
-            {
-                let _ = writeln!(
-                    s,
-                    "The scene is a manufactured viscoplastic solution: its constitutive law carries the source s = d sigma/dt - E eps(du/dt) - G(sigma), each triangle's mean (2 x 2 collapsed Gauss rule, split along the kinks) added as k s(t_n) to the backward-Euler update. Where its fields are affine in t (contact-mms-vp), the time-discrete law holds exactly and every error in h is spatial; a t^2 part (contact-mms-vp-time) is what the time study measures.\n"
-                );
+                .is_some_and(|e| e.source_rate.is_some());
+            if manufactured_viscoplastic {
+                doc.paragraph("The scene is a manufactured viscoplastic solution: its constitutive law carries the source s = d sigma/dt - E eps(du/dt) - G(sigma), each triangle's mean (2 x 2 collapsed Gauss rule, split along the kinks) added as k s(t_n) to the backward-Euler update. Where its fields are affine in t (contact-mms-vp), the time-discrete law holds exactly and every error in h is spatial; a t^2 part (contact-mms-vp-time) is what the time study measures.");
             }
         }
         (None, None) => {}
     }
-    alignment(&mut s, res);
-    if let Some(ts) = &res.time_study {
-        time_section(&mut s, ts);
-    }
-    let _ = writeln!(
-        s,
-        "## Contact and plasticity at T\n\n![pressure](pressure.png)\n\n![gap](gap.png)\n\n![von Mises](von_mises.png)\n"
-    );
-    let _ = writeln!(s, "## Cost\n\n![error against time](error_vs_time.png)\n");
-    let _ = writeln!(s, "## Provenance\n");
-    for (k, v) in &res.provenance {
-        let _ = writeln!(s, "- {k}: {v}");
-    }
-    let _ = writeln!(
-        s,
-        "- mesh family: {} = {} at level 0, h1/h2 = {}, levels {:?}; reference parameters {:?}",
-        res.file.mesh.size_parameter_1,
-        res.file.mesh.coarsest,
-        res.file.mesh.ratio,
-        res.file.mesh.levels,
-        res.file.reference.parameters
-    );
-    let _ = writeln!(
-        s,
-        "\nData: `errors.csv`, `rates.csv`, `levels.csv`, `pressure.csv`, `gap.csv`."
-    );
-    s
 }
 
-/// The rate in time: the runs, the truth they are measured against, and the judged rate.
-fn time_section(s: &mut String, ts: &TimeStudy) {
+/// ## Alignment of the contact edge: the variant families' rates of the contact quantities
+/// and their spread, and whether the main family's last successive rates stall.
+fn alignment(doc: &mut Doc, res: &StudyResult) {
+    if res.variants.is_empty() {
+        return;
+    }
+    let coarsest: Vec<String> = res
+        .variants
+        .iter()
+        .map(|v| v.coarsest.to_string())
+        .collect();
+    doc.heading(2, "Alignment of the contact edge")
+        .paragraph(format!(
+            "Nested refinement keeps a contact edge at the same place relative to the nodes every other level, which makes pressure and edge rates stall and jump. The same study on {} further families (body 1's size at level 0: {}; the same ratio and levels; data in `variants.csv`) puts the edge elsewhere. Rates (or verdicts) and successive rates per family:",
+            res.variants.len(),
+            coarsest.join(", ")
+        ))
+        .table(&families_table(res));
+    doc.list(
+        res.file
+            .methods
+            .iter()
+            .filter_map(|&m| stall_verdict(res, m)),
+    );
+}
+
+/// The main family and the variants: body 1's size at level 0 and the rates.
+fn families(res: &StudyResult) -> Vec<(f64, &Vec<RateRow>)> {
+    std::iter::once((res.file.mesh.coarsest, &res.rates))
+        .chain(res.variants.iter().map(|v| (v.coarsest, &v.rates)))
+        .collect()
+}
+
+/// Per contact quantity and cone, each family's rate (or verdict) with its successive
+/// rates, and the spread of the fitted rates.
+fn families_table(res: &StudyResult) -> Table {
+    let families = families(res);
+    let mut header = vec!["quantity".to_string(), "method".to_string()];
+    header.extend(families.iter().map(|(c, _)| format!("h1 = {c}")));
+    header.push("spread of the fitted rates".into());
+    let mut table = Table::new(header);
+    let shown = [
+        Quantity::L2Pressure,
+        Quantity::PressureWeighted,
+        Quantity::ContactEdge,
+    ];
+    for q in shown.iter().filter(|q| res.file.quantities.contains(q)) {
+        for &m in &res.file.methods {
+            let rows: Vec<Option<&RateRow>> = families
+                .iter()
+                .map(|(_, rates)| rates.iter().find(|r| r.method == m && r.quantity == *q))
+                .collect();
+            let mut cells = vec![q.to_string(), m.to_string()];
+            cells.extend(rows.iter().map(|r| {
+                r.map_or("-".into(), |r| {
+                    format!("{} ({})", verdict_text(r), successive(r))
+                })
+            }));
+            let fitted: Vec<f64> = rows
+                .iter()
+                .flatten()
+                .filter_map(|r| r.assessment.fit.map(|f| f.rate))
+                .collect();
+            cells.push(spread(&fitted));
+            table.row(cells);
+        }
+    }
+    table
+}
+
+/// "lo to hi" of at least two rates, else "n/a".
+fn spread(fitted: &[f64]) -> String {
+    if fitted.len() < 2 {
+        return "n/a".into();
+    }
+    let (lo, hi) = fitted
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    format!("{lo:.2} to {hi:.2}")
+}
+
+/// Whether the main family's last successive rate of l2_pressure stalls, against the
+/// variants': a stall in some families only is an alignment effect (None without a rate
+/// in the main family).
+fn stall_verdict(res: &StudyResult, m: Method) -> Option<String> {
+    let last = |rates: &Vec<RateRow>| {
+        rates
+            .iter()
+            .find(|r| r.method == m && r.quantity == Quantity::L2Pressure)
+            .and_then(|r| r.assessment.successive.last().copied().flatten())
+    };
+    let main = last(&res.rates)?;
+    let others: Vec<f64> = res.variants.iter().filter_map(|v| last(&v.rates)).collect();
+    let stalled = |r: f64| r < 0.3;
+    let stalling = others.iter().filter(|&&o| stalled(o)).count();
+    let verdict = match (stalled(main), stalling) {
+        (false, 0) => "no family stalls".to_string(),
+        (true, n) if n == others.len() => {
+            "every family stalls: not an alignment effect".to_string()
+        }
+        (_, n) => format!(
+            "the stall depends on the family ({} of {} families stall): an alignment effect of the contact edge with the nodes",
+            n + stalled(main) as usize,
+            others.len() + 1
+        ),
+    };
+    let others: Vec<String> = others.iter().map(|o| format!("{o:.3}")).collect();
+    Some(format!(
+        "{m} l2_pressure, last successive rate (below 0.3: stalled): {main:.3} in the main family, {} in the variants: {verdict}.",
+        others.join(", "),
+    ))
+}
+
+/// ## Rate in time: the runs, the truth they are measured against, and the judged rate.
+fn rate_in_time(doc: &mut Doc, ts: &TimeStudy) {
     let truth = match ts.reference_steps {
         Some(r) => {
             format!("a reference with {r} steps on the same mesh, at the common time points")
@@ -555,30 +822,24 @@ fn time_section(s: &mut String, ts: &TimeStudy) {
             ts.scene
         ),
     };
-    let _ = writeln!(
-        s,
-        "## Rate in time
-
-Scene `{}`, {}, fixed mesh (level {}, h = {:.4}, {} dofs), k halved from run to run, each run against {truth}. Errors are max_n ||e||, relative to the truth's theorem norm max_n (||u||_H1 + ||sigma||_L2) = {:.4e} (this scene's: not the normalization of a spatial study on another scene). Theorem 3.1 bounds the error by C (h^r + k): backward Euler's k term has rate 1, and as k -> 0 the error tends to this mesh's spatial error. The rate in k is judged as a rate in h is (the same windows and verdicts); data in `time.csv`.\n\n![error against k](error_vs_k.png)\n\n| steps | k | theorem error | successive rate | plastic fraction at T | solve (s) |\n|---|---|---|---|---|---|",
-        ts.scene,
-        ts.method,
-        ts.level,
-        ts.h,
-        ts.dofs,
-        ts.runs.last().map_or(f64::NAN, |r| r.norm)
-    );
+    let mut table = Table::new([
+        "steps",
+        "k",
+        "theorem error",
+        "successive rate",
+        "plastic fraction at T",
+        "solve (s)",
+    ]);
     for (i, r) in ts.runs.iter().enumerate() {
         let rate = i.checked_sub(1).and_then(|j| ts.assessment.successive[j]);
-        let _ = writeln!(
-            s,
-            "| {} | {:.5} | {:.3e} | {} | {:.3} | {:.2} |",
-            r.steps,
-            r.k,
-            r.error,
+        table.row([
+            r.steps.to_string(),
+            format!("{:.5}", r.k),
+            format!("{:.3e}", r.error),
             rate.map_or("-".into(), |v| format!("{v:.3}")),
-            r.plastic_fraction,
-            r.wall_s
-        );
+            format!("{:.3}", r.plastic_fraction),
+            format!("{:.2}", r.wall_s),
+        ]);
     }
     let a = &ts.assessment;
     let steps: Vec<String> = a
@@ -586,17 +847,48 @@ Scene `{}`, {}, fixed mesh (level {}, h = {:.4}, {} dofs), k halved from run to 
         .iter()
         .map(|&i| ts.runs[i].steps.to_string())
         .collect();
-    let _ = writeln!(
-        s,
-        "\nRate in k: **{}**, verdict `{}`, fitted on the step counts {} (backward Euler: 1).\n",
-        fmt_assessment(a),
-        a.verdict.name(),
-        if steps.is_empty() {
-            "-".into()
-        } else {
-            steps.join(", ")
-        }
-    );
+    doc.heading(2, "Rate in time")
+        .paragraph(format!(
+            "Scene `{}`, {}, fixed mesh (level {}, h = {:.4}, {} dofs), k halved from run to run, each run against {truth}. Errors are max_n ||e||, relative to the truth's theorem norm max_n (||u||_H1 + ||sigma||_L2) = {:.4e} (this scene's: not the normalization of a spatial study on another scene). Theorem 3.1 bounds the error by C (h^r + k): backward Euler's k term has rate 1, and as k -> 0 the error tends to this mesh's spatial error. The rate in k is judged as a rate in h is (the same windows and verdicts); data in `time.csv`.",
+            ts.scene,
+            ts.method,
+            ts.level,
+            ts.h,
+            ts.dofs,
+            ts.runs.last().map_or(f64::NAN, |r| r.norm)
+        ))
+        .image("error against k", "error_vs_k.png")
+        .table(&table)
+        .paragraph(format!(
+            "Rate in k: **{}**, verdict `{}`, fitted on the step counts {} (backward Euler: 1).",
+            fmt_assessment(a),
+            a.verdict.name(),
+            if steps.is_empty() {
+                "-".into()
+            } else {
+                steps.join(", ")
+            }
+        ));
+}
+
+/// ## Provenance: where and how the study ran, the mesh family, and the data files.
+fn provenance(doc: &mut Doc, res: &StudyResult) {
+    let mesh = &res.file.mesh;
+    doc.heading(2, "Provenance")
+        .list(
+            res.provenance
+                .iter()
+                .map(|(k, v)| format!("{k}: {v}"))
+                .chain(std::iter::once(format!(
+                    "mesh family: {} = {} at level 0, h1/h2 = {}, levels {:?}; reference parameters {:?}",
+                    mesh.size_parameter_1,
+                    mesh.coarsest,
+                    mesh.ratio,
+                    mesh.levels,
+                    res.file.reference.parameters
+                ))),
+        )
+        .line("Data: `errors.csv`, `rates.csv`, `levels.csv`, `pressure.csv`, `gap.csv`.");
 }
 
 /// What `study NAME` prints: the rates with their thresholds, the theorem error per level,
@@ -737,245 +1029,4 @@ fn verdict_text(r: &RateRow) -> String {
         (Verdict::FixedByEquilibrium, _) => "fixed by equilibrium".into(),
         _ => "no fit".into(),
     }
-}
-
-/// The report's lead: what separates the cones, quantity by quantity, contact quantities
-/// first: the error at the finest level and the rate (or why there is none) of each cone,
-/// and a sentence per quantity; only quantities whose verdicts compare the cones in every
-/// cone ([`Verdict::compares_cones`]), the others named below the table with the reason.
-fn cones_compared(s: &mut String, res: &StudyResult) {
-    let finest = *res.file.mesh.levels.last().expect("levels");
-    let against = if res.reference.is_some() {
-        "the reference"
-    } else {
-        "the exact solution"
-    };
-    let rate_of =
-        |m: Method, q: Quantity| res.rates.iter().find(|r| r.method == m && r.quantity == q);
-    let compared = |q: Quantity| {
-        res.file
-            .methods
-            .iter()
-            .all(|&m| rate_of(m, q).is_some_and(|r| r.assessment.verdict.compares_cones()))
-    };
-    let ordered: Vec<Quantity> = res
-        .file
-        .quantities
-        .iter()
-        .copied()
-        .filter(|q| q.is_contact())
-        .chain(
-            res.file
-                .quantities
-                .iter()
-                .copied()
-                .filter(|q| !q.is_contact()),
-        )
-        .collect();
-    let quantities: Vec<Quantity> = ordered.iter().copied().filter(|&q| compared(q)).collect();
-    let left_out: Vec<String> = ordered
-        .iter()
-        .copied()
-        .filter(|&q| !compared(q))
-        .map(|q| {
-            let why: Vec<String> = res
-                .file
-                .methods
-                .iter()
-                .filter_map(|&m| rate_of(m, q).map(|r| format!("{m}: {}", fmt_rate(r))))
-                .collect();
-            format!("{q} ({})", why.join("; "))
-        })
-        .collect();
-    let _ = writeln!(
-        s,
-        "## What separates the cones\n\nEvery quantity against {against}, the contact quantities (on Gamma_C and in the band of triangles touching it) first: the error at level {finest} and the rate in h of each cone.\n\n![contact quantities against h](contact_vs_h.png)\n\n| quantity | where | {} |\n|---|---|{}",
-        res.file
-            .methods
-            .iter()
-            .map(|m| format!("{m}: error at level {finest} | {m}: rate"))
-            .collect::<Vec<_>>()
-            .join(" | "),
-        "---|".repeat(2 * res.file.methods.len())
-    );
-    let error_of = |m: Method, q: Quantity| {
-        res.errors
-            .iter()
-            .find(|e| e.method == m && e.quantity == q && e.level == finest)
-            .map(|e| e.error)
-    };
-    for &q in &quantities {
-        let cells: Vec<String> = res
-            .file
-            .methods
-            .iter()
-            .map(|&m| {
-                let e = error_of(m, q).map_or(String::new(), |e| format!("{e:.3e}"));
-                let r = res
-                    .rates
-                    .iter()
-                    .find(|r| r.method == m && r.quantity == q)
-                    .map_or("n/a".into(), fmt_rate);
-                format!("{e} | {r}")
-            })
-            .collect();
-        let place = if q.is_contact() { "contact" } else { "bulk" };
-        let _ = writeln!(s, "| {q} | {place} | {} |", cells.join(" | "));
-    }
-    if !left_out.is_empty() {
-        let _ = writeln!(
-            s,
-            "\nNot compared (no rate the numbers support in some cone, or a quantity that does not measure the cones): {}.",
-            left_out.join(", ")
-        );
-    }
-    if res.file.methods.len() == 2 {
-        let _ = writeln!(s);
-        let verdict = |m: Method, q: Quantity| {
-            res.rates
-                .iter()
-                .find(|r| r.method == m && r.quantity == q)
-                .map(|r| r.assessment.verdict)
-        };
-        for &q in &quantities {
-            let (Some(a), Some(b)) = (error_of(Method::Mortar, q), error_of(Method::Nts, q)) else {
-                continue;
-            };
-            let floor = rates::ROUNDOFF;
-            let sentence = match (verdict(Method::Mortar, q), verdict(Method::Nts, q)) {
-                (Some(Verdict::RoundOff), Some(Verdict::RoundOff)) => {
-                    "both cones are exact (round-off)".to_string()
-                }
-                (Some(Verdict::RoundOff), _) => {
-                    format!("mortar is exact (round-off); nts's error is {b:.3e}")
-                }
-                (_, Some(Verdict::RoundOff)) => {
-                    format!("nts is exact (round-off); mortar's error is {a:.3e}")
-                }
-                (Some(Verdict::NotConverging), Some(Verdict::NotConverging)) => {
-                    "neither cone converges".to_string()
-                }
-                (_, Some(Verdict::NotConverging)) => format!(
-                    "**nts does not converge** (stalls at {b:.3e}); mortar reaches {a:.3e}, {:.1}x smaller",
-                    b / a.max(floor)
-                ),
-                (Some(Verdict::NotConverging), _) => {
-                    format!("**mortar does not converge** (stalls at {a:.3e}); nts reaches {b:.3e}")
-                }
-                _ if b > 1.5 * a => format!("nts's error is {:.2}x mortar's", b / a.max(floor)),
-                _ if a > 1.5 * b => format!("mortar's error is {:.2}x nts's", a / b.max(floor)),
-                _ => format!(
-                    "the cones agree within a factor 1.5 (nts / mortar = {:.3})",
-                    b / a.max(floor)
-                ),
-            };
-            let _ = writeln!(s, "- {q}: {sentence} at level {finest}.");
-        }
-    }
-    let _ = writeln!(s);
-}
-
-/// The variant families: the rates of the contact quantities per family and their spread,
-/// and whether the main family's last successive rates stall.
-fn alignment(s: &mut String, res: &StudyResult) {
-    if res.variants.is_empty() {
-        return;
-    }
-    let shown = [
-        Quantity::L2Pressure,
-        Quantity::PressureWeighted,
-        Quantity::ContactEdge,
-    ];
-    let families: Vec<(f64, &Vec<RateRow>)> = std::iter::once((res.file.mesh.coarsest, &res.rates))
-        .chain(res.variants.iter().map(|v| (v.coarsest, &v.rates)))
-        .collect();
-    let _ = writeln!(
-        s,
-        "## Alignment of the contact edge\n\nNested refinement keeps a contact edge at the same place relative to the nodes every other level, which makes pressure and edge rates stall and jump. The same study on {} further families (body 1's size at level 0: {}; the same ratio and levels; data in `variants.csv`) puts the edge elsewhere. Rates (or verdicts) and successive rates per family:\n\n| quantity | method | {} | spread of the fitted rates |\n|---|---|{}---|",
-        res.variants.len(),
-        res.variants
-            .iter()
-            .map(|v| v.coarsest.to_string())
-            .collect::<Vec<_>>()
-            .join(", "),
-        families
-            .iter()
-            .map(|(c, _)| format!("h1 = {c}"))
-            .collect::<Vec<_>>()
-            .join(" | "),
-        "---|".repeat(families.len())
-    );
-    for q in shown.iter().filter(|q| res.file.quantities.contains(q)) {
-        for &m in &res.file.methods {
-            let rows: Vec<Option<&RateRow>> = families
-                .iter()
-                .map(|(_, rates)| rates.iter().find(|r| r.method == m && r.quantity == *q))
-                .collect();
-            let cells: Vec<String> = rows
-                .iter()
-                .map(|r| {
-                    r.map_or("-".into(), |r| {
-                        format!("{} ({})", verdict_text(r), successive(r))
-                    })
-                })
-                .collect();
-            let fitted: Vec<f64> = rows
-                .iter()
-                .flatten()
-                .filter_map(|r| r.assessment.fit.map(|f| f.rate))
-                .collect();
-            let spread = if fitted.len() >= 2 {
-                let (lo, hi) = fitted
-                    .iter()
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                        (a.min(v), b.max(v))
-                    });
-                format!("{lo:.2} to {hi:.2}")
-            } else {
-                "n/a".into()
-            };
-            let _ = writeln!(s, "| {q} | {m} | {} | {spread} |", cells.join(" | "));
-        }
-    }
-    // The main family's last successive rate against the variants'.
-    let last = |rates: &Vec<RateRow>, m: Method| {
-        rates
-            .iter()
-            .find(|r| r.method == m && r.quantity == Quantity::L2Pressure)
-            .and_then(|r| r.assessment.successive.last().copied().flatten())
-    };
-    let _ = writeln!(s);
-    for &m in &res.file.methods {
-        let main = last(&res.rates, m);
-        let others: Vec<f64> = res
-            .variants
-            .iter()
-            .filter_map(|v| last(&v.rates, m))
-            .collect();
-        if let Some(main) = main {
-            let stalled = |r: f64| r < 0.3;
-            let stalling = others.iter().filter(|&&o| stalled(o)).count();
-            let verdict = match (stalled(main), stalling) {
-                (false, 0) => "no family stalls".to_string(),
-                (true, n) if n == others.len() => {
-                    "every family stalls: not an alignment effect".to_string()
-                }
-                (_, n) => format!(
-                    "the stall depends on the family ({} of {} families stall): an alignment effect of the contact edge with the nodes",
-                    n + stalled(main) as usize,
-                    others.len() + 1
-                ),
-            };
-            let _ = writeln!(
-                s,
-                "- {m} l2_pressure, last successive rate (below 0.3: stalled): {main:.3} in the main family, {} in the variants: {verdict}.",
-                others
-                    .iter()
-                    .map(|o| format!("{o:.3}"))
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            );
-        }
-    }
-    let _ = writeln!(s);
 }

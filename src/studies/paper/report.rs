@@ -3,6 +3,7 @@
 
 use crate::error::Result;
 use crate::report::folder::{write, write_folder};
+use crate::report::markdown::{Doc, Table};
 use crate::report::plot::{self, MeshPanel, Panel, Series};
 use crate::studies::paper::{PaperResult, Run};
 use std::fmt::Write as _;
@@ -106,52 +107,57 @@ fn pressure_plot(path: &Path, title: &str, runs: &[&Run]) -> Result<()> {
     )
 }
 
-fn table(s: &mut String, runs: &[&Run]) {
-    let _ = writeln!(
-        s,
-        "| run | level | triangles (body 1 / 2) | nodes (body 1 / 2) | dofs | time steps | iterations (max per step) | wall time (s) | max interpenetration (m) | contact fraction | plastic fraction |\n|---|---|---|---|---|---|---|---|---|---|---|"
-    );
+/// The runs of one test: meshes, solve and what contact and plasticity did.
+fn runs_table(runs: &[&Run]) -> Table {
+    let mut table = Table::new([
+        "run",
+        "level",
+        "triangles (body 1 / 2)",
+        "nodes (body 1 / 2)",
+        "dofs",
+        "time steps",
+        "iterations (max per step)",
+        "wall time (s)",
+        "max interpenetration (m)",
+        "contact fraction",
+        "plastic fraction",
+    ]);
     for r in runs {
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} / {} | {} / {} | {} | {} | {} ({}) | {:.3} | {:.3e} | {:.3} | {:.3} |",
-            r.label,
-            r.level,
-            r.triangles[0],
-            r.triangles[1],
-            r.nodes[0],
-            r.nodes[1],
-            r.dofs,
-            r.steps,
-            r.iterations.0,
-            r.iterations.1,
-            r.wall_s,
-            r.max_penetration,
-            r.contact_fraction,
-            r.plastic_fraction
-        );
+        table.row([
+            r.label.clone(),
+            r.level.to_string(),
+            format!("{} / {}", r.triangles[0], r.triangles[1]),
+            format!("{} / {}", r.nodes[0], r.nodes[1]),
+            r.dofs.to_string(),
+            r.steps.to_string(),
+            format!("{} ({})", r.iterations.0, r.iterations.1),
+            format!("{:.3}", r.wall_s),
+            format!("{:.3e}", r.max_penetration),
+            format!("{:.3}", r.contact_fraction),
+            format!("{:.3}", r.plastic_fraction),
+        ]);
     }
+    table
 }
 
 /// Write reports/paper (or `dir`).
 pub fn write_paper(res: &PaperResult, dir: &Path) -> Result<()> {
     write_folder(dir, |d| {
-        let mut s = String::new();
-        let _ = writeln!(
-            s,
-            "# The paper's numerical tests, regenerated\n\nFernandez-Garcia, Hild and Viano, section 5. Their figures are missing from our copy, so each geometry is reconstructed from the text (stated below); the data are the paper's (E, nu, lambda, sigma_Y, loads, T = 1). All runs: `newton` solver, 10 uniform time steps, non-matching meshes unless stated. Regenerate with `cargo run --release -- study paper` ({:.0} s).\n",
-            res.wall_s
-        );
-
-        test1(res, d, &mut s)?;
-        test2(res, d, &mut s)?;
-        test3(res, d, &mut s)?;
-        write(d, "README.md", s.as_bytes())
+        let mut doc = Doc::new();
+        doc.heading(1, "The paper's numerical tests, regenerated")
+            .paragraph(format!(
+                "Fernandez-Garcia, Hild and Viano, section 5. Their figures are missing from our copy, so each geometry is reconstructed from the text (stated below); the data are the paper's (E, nu, lambda, sigma_Y, loads, T = 1). All runs: `newton` solver, 10 uniform time steps, non-matching meshes unless stated. Regenerate with `cargo run --release -- study paper` ({:.0} s).",
+                res.wall_s
+            ));
+        test1(res, d, &mut doc)?;
+        test2(res, d, &mut doc)?;
+        test3(res, d, &mut doc)?;
+        write(d, "README.md", doc.finish().as_bytes())
     })
 }
 
 /// Test 1 (straight contact line): mesh, von Mises, pressure, table.
-fn test1(res: &PaperResult, d: &Path, s: &mut String) -> Result<()> {
+fn test1(res: &PaperResult, d: &Path, doc: &mut Doc) -> Result<()> {
     let (m1, n1) = (&res.test1[0], &res.test1[1]);
     let mag1 = magnification(&[m1]);
     plot::mesh_panels(
@@ -174,26 +180,23 @@ fn test1(res: &PaperResult, d: &Path, s: &mut String) -> Result<()> {
         "Test 1: contact pressure along Gamma_C at T = 1",
         &[m1, n1],
     )?;
-    let _ = writeln!(
-        s,
-        "## Test 1: straight contact line\n\nReconstruction: body 1 = [0,1]x[0,1] embedded on its left side x = 0, body 2 = [1,2]x[0.25,0.75]; symmetry (u_y = 0, zero tangential traction) on the upper and lower sides of both bodies, body 1's right side free outside the contact line; contact line x = 1, 0.25 <= y <= 0.75 (body 1 carries the constraint); a pressure of magnitude 10 t on body 2's right side pushing the bodies together (the paper prints g^2 = (10t, 0); with body 2 on the right this is (-10 t, 0) in our axes). E = 100, nu = 0.3, lambda = 100, sigma_Y = sqrt(10). Mesh sizes 0.12 and 0.0985 give {} and {} triangles (paper: 214 and 141).\n",
+    doc.heading(2, "Test 1: straight contact line").paragraph(format!(
+        "Reconstruction: body 1 = [0,1]x[0,1] embedded on its left side x = 0, body 2 = [1,2]x[0.25,0.75]; symmetry (u_y = 0, zero tangential traction) on the upper and lower sides of both bodies, body 1's right side free outside the contact line; contact line x = 1, 0.25 <= y <= 0.75 (body 1 carries the constraint); a pressure of magnitude 10 t on body 2's right side pushing the bodies together (the paper prints g^2 = (10t, 0); with body 2 on the right this is (-10 t, 0) in our axes). E = 100, nu = 0.3, lambda = 100, sigma_Y = sqrt(10). Mesh sizes 0.12 and 0.0985 give {} and {} triangles (paper: 214 and 141).",
         m1.triangles[0], m1.triangles[1]
-    );
-    let _ = writeln!(
-        s,
-        "![mesh](test1_mesh.png)\n\n![von Mises](test1_von_mises.png)\n\n![pressure](test1_pressure.png)\n"
-    );
-    table(s, &[m1, n1]);
-    let _ = writeln!(
-        s,
-        "\nMax interpenetration {:.3e} m with K_h^pi against {:.3e} m with K_h^I.\n",
+    ))
+    .image("mesh", "test1_mesh.png")
+    .image("von Mises", "test1_von_mises.png")
+    .image("pressure", "test1_pressure.png")
+    .table(&runs_table(&[m1, n1]))
+    .paragraph(format!(
+        "Max interpenetration {:.3e} m with K_h^pi against {:.3e} m with K_h^I.",
         m1.max_penetration, n1.max_penetration
-    );
+    ));
     Ok(())
 }
 
 /// Test 2 (the patch test): deformed sigma_22, pressure, table, the paper's words measured.
-fn test2(res: &PaperResult, d: &Path, s: &mut String) -> Result<()> {
+fn test2(res: &PaperResult, d: &Path, doc: &mut Doc) -> Result<()> {
     let (m2, n2) = (&res.test2[0], &res.test2[1]);
     let mag2 = magnification(&[m2, n2]);
     let t = &res.test2_numbers;
@@ -211,36 +214,72 @@ fn test2(res: &PaperResult, d: &Path, s: &mut String) -> Result<()> {
         "Test 2: contact pressure along Gamma_C at T = 1 (exact: 10)",
         &[m2, n2],
     )?;
-    let _ = writeln!(
-        s,
-        "## Test 2: local against global contact conditions (patch test)\n\nReconstruction: two stacked unit blocks, upper [0,1]x[1,2] (body 1), lower [0,1]x[0,1]; symmetry on both right sides (u_x = 0) and on the bottom (u_y = 0); pressure g^1 = (0, -10 t) on the top; no body force; E = 3e5, nu = 0.3, lambda = 100, sigma_Y = sqrt(10). The upper block is held vertically only by contact. Exact solution: sigma = diag(0, -10 t) in both bodies (the paper prints sigma_22 = 10 t for the compressive stress).\n"
-    );
-    let _ = writeln!(
-        s,
-        "![deformed](test2_deformed.png)\n\n![pressure](test2_pressure.png)\n"
-    );
-    table(s, &[m2, n2]);
-    let _ = writeln!(
-        s,
-        "\nThe paper's words, measured:\n\n- K_h^pi, \"the obtained stress field is constant\": max over all triangles and steps of |sigma - diag(0, -10 t)| / (10 t) = **{:.2e}**; at T: max |sigma_11| = {:.2e}, max |sigma_12| = {:.2e}, sigma_22 in [{:.12}, {:.12}].\n- K_h^pi, \"no interpenetration\": largest interpenetration {:.2e} of max |u|.\n- K_h^I, \"non negligible penetration\": largest interpenetration {:.3e} m = **{:.2e}** of max |u|.\n- K_h^I, \"artificial stresses near the contact zone\": largest |sigma - exact| / 10 at T = **{:.3}**, in the triangle centred at ({:.3}, {:.3}).\n",
-        t.mortar_stress_error,
-        t.mortar_s11_s12.0,
-        t.mortar_s11_s12.1,
-        t.mortar_s22.0,
-        t.mortar_s22.1,
-        t.mortar_penetration,
-        t.nts_penetration.0,
-        t.nts_penetration.1,
-        t.nts_stress_error.0,
-        t.nts_stress_error.1[0],
-        t.nts_stress_error.1[1]
-    );
+    doc.heading(2, "Test 2: local against global contact conditions (patch test)")
+        .paragraph("Reconstruction: two stacked unit blocks, upper [0,1]x[1,2] (body 1), lower [0,1]x[0,1]; symmetry on both right sides (u_x = 0) and on the bottom (u_y = 0); pressure g^1 = (0, -10 t) on the top; no body force; E = 3e5, nu = 0.3, lambda = 100, sigma_Y = sqrt(10). The upper block is held vertically only by contact. Exact solution: sigma = diag(0, -10 t) in both bodies (the paper prints sigma_22 = 10 t for the compressive stress).")
+        .image("deformed", "test2_deformed.png")
+        .image("pressure", "test2_pressure.png")
+        .table(&runs_table(&[m2, n2]))
+        .paragraph("The paper's words, measured:")
+        .list([
+            format!(
+                "K_h^pi, \"the obtained stress field is constant\": max over all triangles and steps of |sigma - diag(0, -10 t)| / (10 t) = **{:.2e}**; at T: max |sigma_11| = {:.2e}, max |sigma_12| = {:.2e}, sigma_22 in [{:.12}, {:.12}].",
+                t.mortar_stress_error,
+                t.mortar_s11_s12.0,
+                t.mortar_s11_s12.1,
+                t.mortar_s22.0,
+                t.mortar_s22.1,
+            ),
+            format!(
+                "K_h^pi, \"no interpenetration\": largest interpenetration {:.2e} of max |u|.",
+                t.mortar_penetration
+            ),
+            format!(
+                "K_h^I, \"non negligible penetration\": largest interpenetration {:.3e} m = **{:.2e}** of max |u|.",
+                t.nts_penetration.0, t.nts_penetration.1
+            ),
+            format!(
+                "K_h^I, \"artificial stresses near the contact zone\": largest |sigma - exact| / 10 at T = **{:.3}**, in the triangle centred at ({:.3}, {:.3}).",
+                t.nts_stress_error.0, t.nts_stress_error.1[0], t.nts_stress_error.1[1]
+            ),
+        ]);
     Ok(())
 }
 
 /// Test 3 (piecewise-straight contact line): meshes, von Mises, pressure, agreement with
 /// matching meshes.
-fn test3(res: &PaperResult, d: &Path, s: &mut String) -> Result<()> {
+fn test3(res: &PaperResult, d: &Path, doc: &mut Doc) -> Result<()> {
+    let (m3, n3, mm3) = (&res.test3[0], &res.test3[1], &res.test3[2]);
+    test3_figures(res, d)?;
+    let mut agreement = Table::new(["level", "h", "relative difference"]);
+    for (l, h, dd) in &res.test3_agreement {
+        agreement.row([l.to_string(), format!("{h:.4}"), format!("{dd:.3e}")]);
+    }
+    doc.heading(2, "Test 3: piecewise-straight contact line")
+        .paragraph("Reconstruction: lower body (body 2) between y = 0 (embedded) and the contact line (0,1)-(0.6,1)-(0.9,1.3)-(1.1,1.3)-(1.4,1)-(2,1) (five straight pieces, a trapezoidal bump), u_x = 0 on its vertical sides; upper body (body 1) between the contact line and y = 2, u_x = 0 on its vertical sides, g^1 = (0, -10 t) on its top. E = 100, nu = 0.3, lambda = 1000, sigma_Y = sqrt(10). Mesh sizes 0.15 (body 1) and 0.11 (body 2); the matching meshes let body 1 reuse body 2's contact lines. Corner nodes carry one constraint per piece.")
+        .image("meshes", "test3_meshes.png")
+        .image("von Mises", "test3_von_mises.png")
+        .image("matching", "test3_matching.png")
+        .image("matching von Mises", "test3_matching_von_mises.png")
+        .image("pressure", "test3_pressure.png")
+        .table(&runs_table(&[m3, n3, mm3]))
+        .paragraph("\"Good agreement\" with the matching meshes, measured: relative difference of the K_h^pi solutions on non-matching and matching meshes in the theorem norm max_n (||u - u_m||_H1 + ||sigma - sigma_m||_L2) / max_n (||u_m||_H1 + ||sigma_m||_L2), both meshes refined together:")
+        .table(&agreement);
+    if res.test3_agreement.len() >= 2 {
+        let hs: Vec<f64> = res.test3_agreement.iter().map(|a| a.1).collect();
+        let ds: Vec<f64> = res.test3_agreement.iter().map(|a| a.2).collect();
+        if let Some(f) = crate::verify::rates::fit(&hs, &ds) {
+            doc.paragraph(format!(
+                "The difference shrinks like h^{:.2} (least squares over the levels above).",
+                f.rate
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Test 3's figures (Figs. 8-11 and the pressure): non-matching and matching meshes,
+/// initial and deformed, von Mises stress.
+fn test3_figures(res: &PaperResult, d: &Path) -> Result<()> {
     let (m3, n3, mm3) = (&res.test3[0], &res.test3[1], &res.test3[2]);
     let mag3 = magnification(&[m3, mm3]);
     plot::mesh_panels(
@@ -283,33 +322,6 @@ fn test3(res: &PaperResult, d: &Path, s: &mut String) -> Result<()> {
         "Test 3: contact pressure along Gamma_C at T = 1",
         &[m3, n3, mm3],
     )?;
-    let _ = writeln!(
-        s,
-        "## Test 3: piecewise-straight contact line\n\nReconstruction: lower body (body 2) between y = 0 (embedded) and the contact line (0,1)-(0.6,1)-(0.9,1.3)-(1.1,1.3)-(1.4,1)-(2,1) (five straight pieces, a trapezoidal bump), u_x = 0 on its vertical sides; upper body (body 1) between the contact line and y = 2, u_x = 0 on its vertical sides, g^1 = (0, -10 t) on its top. E = 100, nu = 0.3, lambda = 1000, sigma_Y = sqrt(10). Mesh sizes 0.15 (body 1) and 0.11 (body 2); the matching meshes let body 1 reuse body 2's contact lines. Corner nodes carry one constraint per piece.\n"
-    );
-    let _ = writeln!(
-        s,
-        "![meshes](test3_meshes.png)\n\n![von Mises](test3_von_mises.png)\n\n![matching](test3_matching.png)\n\n![matching von Mises](test3_matching_von_mises.png)\n\n![pressure](test3_pressure.png)\n"
-    );
-    table(s, &[m3, n3, mm3]);
-    let _ = writeln!(
-        s,
-        "\n\"Good agreement\" with the matching meshes, measured: relative difference of the K_h^pi solutions on non-matching and matching meshes in the theorem norm max_n (||u - u_m||_H1 + ||sigma - sigma_m||_L2) / max_n (||u_m||_H1 + ||sigma_m||_L2), both meshes refined together:\n\n| level | h | relative difference |\n|---|---|---|"
-    );
-    for (l, h, dd) in &res.test3_agreement {
-        let _ = writeln!(s, "| {l} | {h:.4} | {dd:.3e} |");
-    }
-    if res.test3_agreement.len() >= 2 {
-        let hs: Vec<f64> = res.test3_agreement.iter().map(|a| a.1).collect();
-        let ds: Vec<f64> = res.test3_agreement.iter().map(|a| a.2).collect();
-        if let Some(f) = crate::verify::rates::fit(&hs, &ds) {
-            let _ = writeln!(
-                s,
-                "\nThe difference shrinks like h^{:.2} (least squares over the levels above).\n",
-                f.rate
-            );
-        }
-    }
     Ok(())
 }
 

@@ -5,11 +5,11 @@ use crate::contact::Method;
 use crate::error::Result;
 use crate::io::csv_bytes;
 use crate::report::folder::{write, write_folder};
+use crate::report::markdown::{Doc, Table};
 use crate::report::plot::{self, Series};
 use crate::solve::SolverKind;
 use crate::studies::speed::{FAMILIES, Family, SpeedResult, SpeedRun};
 use serde::Serialize;
-use std::fmt::Write as _;
 use std::path::Path;
 
 /// One row of speed.csv: one run against its floor.
@@ -227,126 +227,185 @@ fn time_vs_dofs(res: &SpeedResult, d: &Path) -> Result<()> {
 }
 
 /// The README: what the study measures, the ratio to the floor per family and cone, the
-/// plots, the table, newton against paper.
+/// floor's spread, the machine and threads, the plots, the table, newton against paper.
 fn readme(res: &SpeedResult) -> String {
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "# Study `speed`\n\nWhat each accuracy costs, on two families of the same non-matching meshes (h1/h2 = 1.4142, h_upper = 0.28 at level 0, every level splits each triangle in 4), {} time steps: `rates` (viscoplastic, about half the domain flows) and `rates-elastic` (no yield stress). Each run's cost, the solver's set-up (pattern, symbolic analysis) plus its time loop, is compared with the floor measured on the same mesh: what the problem cannot avoid, from scratch: the elastic stiffness's pattern and values, one sparse Cholesky of it (faer; ordering, symbolic and numeric; shifted by 1e-8 of its mean diagonal so that a body held only by contact does not make it singular), and one solve (two triangular solves) per time step. newton's runs are timed {} times, larger ones {} times, solver and floor alternately (the paper's solver once), each on a heap handed back to the system as in a fresh process, and the fastest of each is kept (single timings of 0.01-1 s scatter by up to a factor 2 on this shared 2-core machine). Errors (viscoplastic family) are in the theorem norm against a matching-mesh reference at level {} ({} dofs), shown where the reference is at least 3 levels finer. `peak RSS` is the process's peak during the solve (reset before it). Regenerate with `cargo run --release -- study speed` ({:.0} s).\n",
-        crate::studies::speed::STEPS,
-        crate::studies::speed::REPEATS
-            .iter()
-            .map(|(below, times)| format!("{times} below {below} dofs"))
-            .collect::<Vec<_>>()
-            .join(", "),
-        crate::studies::speed::REPEATS_ABOVE,
-        crate::studies::speed::REFERENCE_LEVEL,
+    let mut doc = Doc::new();
+    doc.heading(1, "Study `speed`")
+        .paragraph(what_is_measured(res))
+        .table(&ratios_table(res))
+        .paragraph(floor_spread(res));
+    machine_and_threads(&mut doc, res);
+    doc.image("work precision", "work_precision.png")
+        .image("time against dofs", "time_vs_dofs.png")
+        .table(&runs_table(res));
+    for sentence in newton_against_paper(res) {
+        doc.paragraph(sentence);
+    }
+    doc.finish()
+}
+
+/// The study's lead: the families, the floor, how the runs are timed, the errors.
+fn what_is_measured(res: &SpeedResult) -> String {
+    use crate::studies::speed::{REFERENCE_LEVEL, REPEATS, REPEATS_ABOVE, STEPS};
+    let repeats: Vec<String> = REPEATS
+        .iter()
+        .map(|(below, times)| format!("{times} below {below} dofs"))
+        .collect();
+    format!(
+        "What each accuracy costs, on two families of the same non-matching meshes (h1/h2 = 1.4142, h_upper = 0.28 at level 0, every level splits each triangle in 4), {STEPS} time steps: `rates` (viscoplastic, about half the domain flows) and `rates-elastic` (no yield stress). Each run's cost, the solver's set-up (pattern, symbolic analysis) plus its time loop, is compared with the floor measured on the same mesh: what the problem cannot avoid, from scratch: the elastic stiffness's pattern and values, one sparse Cholesky of it (faer; ordering, symbolic and numeric; shifted by 1e-8 of its mean diagonal so that a body held only by contact does not make it singular), and one solve (two triangular solves) per time step. newton's runs are timed {} times, larger ones {REPEATS_ABOVE} times, solver and floor alternately (the paper's solver once), each on a heap handed back to the system as in a fresh process, and the fastest of each is kept (single timings of 0.01-1 s scatter by up to a factor 2 on this shared 2-core machine). Errors (viscoplastic family) are in the theorem norm against a matching-mesh reference at level {REFERENCE_LEVEL} ({} dofs), shown where the reference is at least 3 levels finer. `peak RSS` is the process's peak during the solve (reset before it). Regenerate with `cargo run --release -- study speed` ({:.0} s).",
+        repeats.join(", "),
         res.reference_dofs,
         res.wall_s
-    );
-    s.push_str("| family | cone | newton / floor from 1e4 dofs (smallest - largest) | at the largest run | fill at the largest run, entries of L: newton / floor |\n|---|---|---|---|---|\n");
+    )
+}
+
+/// Per family and cone, newton's ratio to the floor from 1e4 dofs, and the largest run's
+/// time and fill against the floor's.
+fn ratios_table(res: &SpeedResult) -> Table {
+    let mut table = Table::new([
+        "family",
+        "cone",
+        "newton / floor from 1e4 dofs (smallest - largest)",
+        "at the largest run",
+        "fill at the largest run, entries of L: newton / floor",
+    ]);
     for family in &FAMILIES {
         for m in [Method::Mortar, Method::Nts] {
             let runs: Vec<&SpeedRun> = family_runs(res, family, m, SolverKind::Newton)
                 .filter(|r| r.run.dofs >= 10_000)
                 .collect();
             let ratios: Vec<f64> = runs.iter().map(|r| ratio(r)).collect();
-            if let Some(last) = runs.last() {
-                let _ = writeln!(
-                    s,
-                    "| {} | {m} | {:.2} - {:.2} | {:.2} at {} dofs ({:.1} s, floor {:.1} s) | {:.3e} / {:.3e} = {:.2} |",
-                    family.label,
+            let Some(last) = runs.last() else { continue };
+            let (entries, floor_entries) = (
+                last.run.timings.factor_entries as f64,
+                last.floor_entries as f64,
+            );
+            table.row([
+                family.label.to_string(),
+                m.to_string(),
+                format!(
+                    "{:.2} - {:.2}",
                     ratios.iter().copied().fold(f64::INFINITY, f64::min),
-                    ratios.iter().copied().fold(0.0, f64::max),
+                    ratios.iter().copied().fold(0.0, f64::max)
+                ),
+                format!(
+                    "{:.2} at {} dofs ({:.1} s, floor {:.1} s)",
                     ratio(last),
                     last.run.dofs,
                     last.run.time_loop_s + last.run.timings.setup_s,
-                    floor_of(last),
-                    last.run.timings.factor_entries as f64,
-                    last.floor_entries as f64,
-                    last.run.timings.factor_entries as f64 / last.floor_entries.max(1) as f64
-                );
-            }
+                    floor_of(last)
+                ),
+                format!(
+                    "{entries:.3e} / {floor_entries:.3e} = {:.2}",
+                    entries / floor_entries.max(1.0)
+                ),
+            ]);
         }
     }
-    // The spread the specification asks for: every row of a mesh times the same floor.
+    table
+}
+
+/// The spread the specification asks for: every row of a mesh times the same floor; its
+/// fastest time per row, smallest and largest, per mesh from 1e4 dofs.
+fn floor_spread(res: &SpeedResult) -> String {
     let mut floors: std::collections::BTreeMap<usize, (f64, f64)> = Default::default();
     for r in res
         .rows
         .iter()
-        .filter(|r| r.run.solver == SolverKind::Newton)
+        .filter(|r| r.run.solver == SolverKind::Newton && r.run.dofs >= 10_000)
     {
-        if r.run.dofs >= 10_000 {
-            let f = floors.entry(r.run.dofs).or_insert((f64::INFINITY, 0.0));
-            *f = (f.0.min(floor_of(r)), f.1.max(floor_of(r)));
-        }
+        let f = floors.entry(r.run.dofs).or_insert((f64::INFINITY, 0.0));
+        *f = (f.0.min(floor_of(r)), f.1.max(floor_of(r)));
     }
-    let _ = writeln!(
-        s,
-        "\nSpread: the floor is the same work in every row of a mesh (the same stiffness, whatever the family and cone), timed anew beside each; its fastest time per row, smallest - largest: {}. A ratio moves with its floor by as much.",
-        floors
-            .iter()
-            .map(|(dofs, (lo, hi))| format!(
+    let spread: Vec<String> = floors
+        .iter()
+        .map(|(dofs, (lo, hi))| {
+            format!(
                 "{dofs} dofs {} - {} s ({:.0}%)",
                 seconds(*lo),
                 seconds(*hi),
                 100.0 * (hi / lo - 1.0)
-            ))
-            .collect::<Vec<_>>()
-            .join(", ")
-    );
-    let _ = writeln!(
-        s,
-        "\nMachine: {}. The ratios depend on it: newton's runs are about 24 preconditioner applications (each reads the whole factor from memory) against the floor's 4 solves, so a machine with less memory bandwidth per core reads higher ratios for the same code (`study::speed::machine` gives a measured example).\n\nThreads: {} (rayon's pool; `RAYON_NUM_THREADS` sets it), the same for the solver and the floor. The stiffness is block diagonal, one block per body (they meet only through the contact rows): both sides factorize the blocks apart and side by side, in the same ordering (`solve::ordering`: METIS's nested dissection of the nodes for a block of 500,000 equations or more, faer's AMD below), the floor of each whole block, newton of the block's interior with its contact-interface unknowns last; newton's substitutions run as tasks on the threads, one per subtree of the blocks' elimination trees (`solve::substitution`: split until no subtree holds more than a fifth of the work, so that the larger body does not set the time), the floor's (4 per run) as faer's solve of each block, side by side. Newton factorizes in single precision (faer's LDL^T in f32 of the stiffness scaled to unit diagonal; the substitutions' arithmetic in f64) and reaches the tolerance 1e-10 through its Newton and GMRES iterations; the floor is the double-precision Cholesky and its two triangular solves per step, a double-precision answer with no iteration. The fill is the number of entries of the factor L on and below its diagonal (both bodies; newton's includes its interface rows).\n",
-        res.machine, res.threads
-    );
-    let one: Vec<&SpeedRun> = res.rows.iter().filter(|r| r.one_thread.is_some()).collect();
+            )
+        })
+        .collect();
+    format!(
+        "Spread: the floor is the same work in every row of a mesh (the same stiffness, whatever the family and cone), timed anew beside each; its fastest time per row, smallest - largest: {}. A ratio moves with its floor by as much.",
+        spread.join(", ")
+    )
+}
+
+/// The machine the ratios depend on, the threads and how both sides use them, and the runs
+/// timed on one thread as well.
+fn machine_and_threads(doc: &mut Doc, res: &SpeedResult) {
+    doc.paragraph(format!(
+        "Machine: {}. The ratios depend on it: newton's runs are about 24 preconditioner applications (each reads the whole factor from memory) against the floor's 4 solves, so a machine with less memory bandwidth per core reads higher ratios for the same code (`study::speed::machine` gives a measured example).",
+        res.machine
+    ))
+    .paragraph(format!(
+        "Threads: {} (rayon's pool; `RAYON_NUM_THREADS` sets it), the same for the solver and the floor. The stiffness is block diagonal, one block per body (they meet only through the contact rows): both sides factorize the blocks apart and side by side, in the same ordering (`solve::ordering`: METIS's nested dissection of the nodes for a block of 500,000 equations or more, faer's AMD below), the floor of each whole block, newton of the block's interior with its contact-interface unknowns last; newton's substitutions run as tasks on the threads, one per subtree of the blocks' elimination trees (`solve::substitution`: split until no subtree holds more than a fifth of the work, so that the larger body does not set the time), the floor's (4 per run) as faer's solve of each block, side by side. Newton factorizes in single precision (faer's LDL^T in f32 of the stiffness scaled to unit diagonal; the substitutions' arithmetic in f64) and reaches the tolerance 1e-10 through its Newton and GMRES iterations; the floor is the double-precision Cholesky and its two triangular solves per step, a double-precision answer with no iteration. The fill is the number of entries of the factor L on and below its diagonal (both bodies; newton's includes its interface rows).",
+        res.threads
+    ));
+    let one = one_thread_table(res);
     if !one.is_empty() {
-        let _ = writeln!(
-            s,
-            "| family | cone | dofs | newton, 1 thread (s) | newton, {n} threads (s) | speed-up | floor, 1 thread (s) | floor, {n} threads (s) | speed-up | newton / floor, 1 thread | newton / floor, {n} threads |\n|---|---|---|---|---|---|---|---|---|---|---|",
-            n = res.threads
-        );
-        for r in one {
-            let (one_s, one_floor) = r.one_thread.expect("filtered");
-            let all_s = r.run.time_loop_s + r.run.timings.setup_s;
-            let _ = writeln!(
-                s,
-                "| {} | {} | {} | {:.1} | {:.1} | {:.2} | {:.1} | {:.1} | {:.2} | {:.2} | {:.2} |",
-                r.family.label,
-                r.run.method,
-                r.run.dofs,
-                one_s,
-                all_s,
-                one_s / all_s,
-                one_floor,
-                floor_of(r),
-                one_floor / floor_of(r),
-                one_s / one_floor,
-                ratio(r)
-            );
-        }
+        doc.table(&one);
     }
-    let _ = writeln!(
-        s,
-        "\n![work precision](work_precision.png)\n\n![time against dofs](time_vs_dofs.png)\n"
-    );
-    s.push_str(&table(res));
+}
+
+/// The runs timed on one thread as well: newton's and the floor's speed-up.
+fn one_thread_table(res: &SpeedResult) -> Table {
+    let n = res.threads;
+    let mut table = Table::new([
+        "family".to_string(),
+        "cone".into(),
+        "dofs".into(),
+        "newton, 1 thread (s)".into(),
+        format!("newton, {n} threads (s)"),
+        "speed-up".into(),
+        "floor, 1 thread (s)".into(),
+        format!("floor, {n} threads (s)"),
+        "speed-up".into(),
+        "newton / floor, 1 thread".into(),
+        format!("newton / floor, {n} threads"),
+    ]);
+    for r in &res.rows {
+        let Some((one_s, one_floor)) = r.one_thread else {
+            continue;
+        };
+        let all_s = r.run.time_loop_s + r.run.timings.setup_s;
+        table.row([
+            r.family.label.to_string(),
+            r.run.method.to_string(),
+            r.run.dofs.to_string(),
+            format!("{one_s:.1}"),
+            format!("{all_s:.1}"),
+            format!("{:.2}", one_s / all_s),
+            format!("{one_floor:.1}"),
+            format!("{:.1}", floor_of(r)),
+            format!("{:.2}", one_floor / floor_of(r)),
+            format!("{:.2}", one_s / one_floor),
+            format!("{:.2}", ratio(r)),
+        ]);
+    }
+    table
+}
+
+/// Per cone, newton's time loop against the paper's solver at the paper's finest level.
+fn newton_against_paper(res: &SpeedResult) -> Vec<String> {
+    let finest = crate::studies::speed::PAPER_LEVELS.iter().max().unwrap();
+    let mut out = Vec::new();
     for m in [Method::Mortar, Method::Nts] {
-        let finest = crate::studies::speed::PAPER_LEVELS.iter().max().unwrap();
         let at_finest = |so| family_runs(res, &FAMILIES[0], m, so).find(|r| r.run.level == *finest);
         if let (Some(a), Some(b)) = (at_finest(SolverKind::Newton), at_finest(SolverKind::Paper)) {
-            let _ = writeln!(
-                s,
-                "\n{m}, level {finest}: newton {:.3} s ({:.2} x the floor), paper {:.3} s at the same final tolerance: newton's time loop is {:.1} x faster.",
+            out.push(format!(
+                "{m}, level {finest}: newton {:.3} s ({:.2} x the floor), paper {:.3} s at the same final tolerance: newton's time loop is {:.1} x faster.",
                 a.run.time_loop_s,
                 ratio(a),
                 b.run.time_loop_s,
                 b.run.time_loop_s / a.run.time_loop_s
-            );
+            ));
         }
     }
-    s
+    out
 }
 
 /// The two fills and their ratio (empty for a solver without a factor of the stiffness).
@@ -367,45 +426,58 @@ fn gib(v: Option<f64>) -> String {
 }
 
 /// The table of every run: cost split, floor, memory and error.
-fn table(res: &SpeedResult) -> String {
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "| family | method | solver | level | dofs | iterations | factorizations | time loop (s) | floor (s) | (set-up + loop) / floor | set-up (s) | factorizations (s) | solves (s) | assembly (s) | constitutive (s) | fill, newton / floor (entries of L) | peak RSS (GiB) | error |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
-    );
+fn runs_table(res: &SpeedResult) -> Table {
+    let mut table = Table::new([
+        "family",
+        "method",
+        "solver",
+        "level",
+        "dofs",
+        "iterations",
+        "factorizations",
+        "time loop (s)",
+        "floor (s)",
+        "(set-up + loop) / floor",
+        "set-up (s)",
+        "factorizations (s)",
+        "solves (s)",
+        "assembly (s)",
+        "constitutive (s)",
+        "fill, newton / floor (entries of L)",
+        "peak RSS (GiB)",
+        "error",
+    ]);
     for r in &res.rows {
         let (run, t) = (&r.run, &r.run.timings);
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.2} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {} | {} | {} |",
-            r.family.label,
-            run.method,
-            run.solver,
-            run.level,
-            run.dofs,
-            run.iterations,
-            t.factorizations,
-            run.time_loop_s,
-            floor_of(r),
-            ratio(r),
-            t.setup_s,
-            t.factor_s,
-            t.solve_s,
-            t.assembly_s,
-            t.constitutive_s,
+        table.row([
+            r.family.label.to_string(),
+            run.method.to_string(),
+            run.solver.to_string(),
+            run.level.to_string(),
+            run.dofs.to_string(),
+            run.iterations.to_string(),
+            t.factorizations.to_string(),
+            format!("{:.3}", run.time_loop_s),
+            format!("{:.3}", floor_of(r)),
+            format!("{:.2}", ratio(r)),
+            format!("{:.3}", t.setup_s),
+            format!("{:.3}", t.factor_s),
+            format!("{:.3}", t.solve_s),
+            format!("{:.3}", t.assembly_s),
+            format!("{:.3}", t.constitutive_s),
             fill(t.factor_entries, r.floor_entries),
             gib(run.peak_rss_gib),
-            r.error.map(|e| format!("{e:.3e}")).unwrap_or_default()
-        );
+            r.error.map(|e| format!("{e:.3e}")).unwrap_or_default(),
+        ]);
     }
-    s
+    table
 }
 
 /// What `study speed` prints: the table of the runs, and where the report went.
 pub fn console(res: &SpeedResult, dir: &Path) -> String {
     format!(
         "{}wrote {} ({:.1} s)\n",
-        table(res),
+        runs_table(res).render(),
         dir.display(),
         res.wall_s
     )

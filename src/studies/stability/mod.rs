@@ -229,6 +229,24 @@ struct Variant {
     baseline: Option<(Scene, f64)>,
 }
 
+impl Variant {
+    /// A variant of `case` at level 1 with 4 steps, the scene's own mesh parameters and
+    /// every solver.
+    fn new(case: HardCase, parameter: impl Into<String>, value: f64, scene: Scene) -> Self {
+        Variant {
+            case,
+            parameter: parameter.into(),
+            value,
+            scene,
+            level: 1,
+            params: Vec::new(),
+            steps: 4,
+            solvers: default_solvers(),
+            baseline: None,
+        }
+    }
+}
+
 fn default_solvers() -> Vec<(SolverKind, Settings)> {
     [SolverKind::Newton, SolverKind::Paper, SolverKind::Qp]
         .into_iter()
@@ -245,28 +263,31 @@ fn default_solvers() -> Vec<(SolverKind, Settings)> {
         .collect()
 }
 
-fn set_young(scene: &mut Scene, body: usize, e: f64) {
-    scene.bodies[body].material.elastic.young = e;
-}
-
+/// Every hard case's variants, in the report's order.
 fn plan() -> Result<Vec<Variant>> {
     let rates = Scene::load("rates")?;
-    let patch = Scene::load("patch")?;
-    let mut v = Vec::new();
-    let base = |case: HardCase, parameter: String, value: f64, scene: Scene| Variant {
-        case,
-        parameter,
-        value,
-        scene,
-        level: 1,
-        params: Vec::new(),
-        steps: 4,
-        solvers: default_solvers(),
-        baseline: None,
-    };
-    // Stiff viscosity: k E / lambda from 1e-2 to 1e4 at k = 0.25, E = 100, with 2 and 5
-    // to narrow down where the paper's fixed point stops converging.
-    for (ratio, label) in [
+    Ok([
+        stiff_viscosity(&rates),
+        modulus_contrast(&rates),
+        mesh_size_ratio(&rates),
+        vec![swapped_slave(&rates)],
+        vec![held_only_by_contact()?],
+        coincident_nodes(&rates),
+        slivers(&rates),
+        vec![units_rescaled(&rates)?],
+        newton_across_levels(&rates),
+        vec![single_step(&rates)],
+        omega_sweep(&rates)?,
+    ]
+    .into_iter()
+    .flatten()
+    .collect())
+}
+
+/// Stiff viscosity: k E / lambda from 1e-2 to 1e4 at k = 0.25, E = 100, with 2 and 5 to
+/// narrow down where the paper's fixed point stops converging.
+fn stiff_viscosity(rates: &Scene) -> Vec<Variant> {
+    let ratios = [
         (1e-2, "1e-2"),
         (1e-1, "1e-1"),
         (1.0, "1"),
@@ -276,153 +297,176 @@ fn plan() -> Result<Vec<Variant>> {
         (1e2, "1e2"),
         (1e3, "1e3"),
         (1e4, "1e4"),
-    ] {
-        let mut s = rates.clone();
-        for b in 0..2 {
-            if let Some(vp) = s.bodies[b].material.viscoplastic.as_mut() {
-                vp.lambda = 0.25 * 100.0 / ratio;
+    ];
+    ratios
+        .into_iter()
+        .map(|(ratio, label)| {
+            let mut s = rates.clone();
+            for body in &mut s.bodies {
+                if let Some(vp) = body.material.viscoplastic.as_mut() {
+                    vp.lambda = 0.25 * 100.0 / ratio;
+                }
             }
-        }
-        v.push(base(
-            HardCase::StiffViscosity,
-            format!("k E / lambda = {label}"),
-            ratio,
-            s,
-        ));
-    }
-    // Young's modulus contrast between the bodies.
-    for exp in [0, 2, 4, 6] {
-        let mut s = rates.clone();
-        set_young(&mut s, 1, 100.0 * 10f64.powi(exp));
-        v.push(base(
-            HardCase::ModulusContrast,
-            format!("E2 / E1 = 1e{exp}"),
-            10f64.powi(exp),
-            s,
-        ));
-    }
-    // Mesh-size ratio h1/h2 from 1/16 to 16.
-    for r in [1.0 / 16.0, 0.25, 1.0, 4.0, 16.0] {
-        let mut var = base(
-            HardCase::MeshSizeRatio,
-            format!("h1 / h2 = {r}"),
-            r,
-            rates.clone(),
-        );
-        var.params = vec![
-            ("h_upper".into(), 0.2 * f64::sqrt(r)),
-            ("h_lower".into(), 0.2 / f64::sqrt(r)),
-            ("grading".into(), 1.3),
-        ];
-        var.level = 0;
-        v.push(var);
-    }
-    // Slave and master swapped: the lower block carries the constraint.
-    {
-        let mut s = rates.clone();
-        s.bodies.swap(0, 1);
-        std::mem::swap(&mut s.slave_curve, &mut s.master_curve);
-        v.push(base(
-            HardCase::SwappedSlave,
-            "slave = lower block".into(),
-            1.0,
-            s,
-        ));
-    }
-    // A body held only by contact (the patch scene's upper block), E = 3e5: the paper's
-    // fixed point needs k L < 1, so it is run with 4 steps like the others.
-    v.push(base(
+            let parameter = format!("k E / lambda = {label}");
+            Variant::new(HardCase::StiffViscosity, parameter, ratio, s)
+        })
+        .collect()
+}
+
+/// Young's modulus contrast between the bodies: E2 / E1 from 1 to 1e6.
+fn modulus_contrast(rates: &Scene) -> Vec<Variant> {
+    [0, 2, 4, 6]
+        .into_iter()
+        .map(|exp| {
+            let mut s = rates.clone();
+            s.bodies[1].material.elastic.young = 100.0 * 10f64.powi(exp);
+            let parameter = format!("E2 / E1 = 1e{exp}");
+            Variant::new(HardCase::ModulusContrast, parameter, 10f64.powi(exp), s)
+        })
+        .collect()
+}
+
+/// Mesh-size ratio h1/h2 from 1/16 to 16 (graded meshes at level 0).
+fn mesh_size_ratio(rates: &Scene) -> Vec<Variant> {
+    [1.0 / 16.0, 0.25, 1.0, 4.0, 16.0]
+        .into_iter()
+        .map(|r| {
+            let parameter = format!("h1 / h2 = {r}");
+            let mut var = Variant::new(HardCase::MeshSizeRatio, parameter, r, rates.clone());
+            var.params = vec![
+                ("h_upper".into(), 0.2 * f64::sqrt(r)),
+                ("h_lower".into(), 0.2 / f64::sqrt(r)),
+                ("grading".into(), 1.3),
+            ];
+            var.level = 0;
+            var
+        })
+        .collect()
+}
+
+/// Slave and master swapped: the lower block carries the constraint.
+fn swapped_slave(rates: &Scene) -> Variant {
+    let mut s = rates.clone();
+    s.bodies.swap(0, 1);
+    std::mem::swap(&mut s.slave_curve, &mut s.master_curve);
+    Variant::new(HardCase::SwappedSlave, "slave = lower block", 1.0, s)
+}
+
+/// A body held only by contact (the patch scene's upper block), E = 3e5: the paper's fixed
+/// point needs k L < 1, so it is run with 4 steps like the others.
+fn held_only_by_contact() -> Result<Variant> {
+    Ok(Variant::new(
         HardCase::HeldOnlyByContact,
-        "patch, upper block".into(),
+        "patch, upper block",
         1.0,
-        patch.clone(),
-    ));
-    // Near-coincident (uniform sizing: 1e-11 h apart after splitting) and coincident nodes.
-    {
-        let mut var = base(
-            HardCase::NearCoincidentNodes,
-            "grading = 1 (nodes 1e-11 h apart)".into(),
-            1.0,
-            rates.clone(),
-        );
-        var.params = vec![("grading".into(), 1.0)];
-        var.level = 2;
-        v.push(var);
-        let mut var = base(
-            HardCase::CoincidentNodes,
-            "matching = 1".into(),
-            1.0,
-            rates.clone(),
-        );
-        var.params = vec![("matching".into(), 1.0)];
-        v.push(var);
-    }
-    // Slivers: a structured strip of the upper block along Gamma_C, one triangle pair per
-    // contact edge, thinner and thinner (the measured aspect ratio is in the parameter).
-    for strip in [2.9e-2, 2.9e-3, 2.9e-4] {
-        let mut var = base(
-            HardCase::Slivers,
-            format!("strip {strip:e}"),
-            0.0,
-            rates.clone(),
-        );
-        var.params = vec![("strip".into(), strip)];
-        v.push(var);
-    }
-    // Units rescaled: lengths x 1e3 (gmsh writes the mesh scaled), moduli, stresses,
-    // viscosity and tractions x 1e6; compared with the rates scene, solver by solver.
-    {
-        let mut var = base(
-            HardCase::UnitsRescaled,
-            "lengths x 1e3, moduli x 1e6".into(),
-            1.0,
-            Scene::load("rates-units")?,
-        );
-        var.baseline = Some((rates.clone(), 1e3));
-        v.push(var);
-    }
-    // Newton's iterations per step on the rates scene (study rates' family) at every level.
-    for level in 0..=5 {
-        let mut var = base(
-            HardCase::NewtonAcrossLevels,
-            format!("level {level}"),
-            level as f64,
-            rates.clone(),
-        );
-        var.level = level;
-        var.params = vec![("h_upper".into(), 0.3), ("h_lower".into(), 0.3 / 1.4142)];
-        var.solvers.truncate(1);
-        v.push(var);
-    }
-    // One single time step over [0, T].
-    {
-        let mut var = base(HardCase::SingleStep, "steps = 1".into(), 1.0, rates.clone());
-        var.steps = 1;
-        v.push(var);
-    }
-    // The paper's penalty parameter omega over 8 decades around the automatic value.
-    for exp in [-4, -2, 0, 2, 4] {
-        let mut var = base(
-            HardCase::OmegaSweep,
-            format!("omega = 1e{exp} x automatic"),
-            10f64.powi(exp),
-            rates.clone(),
-        );
-        var.solvers = vec![
-            (SolverKind::Newton, Settings::default()),
-            (
-                SolverKind::Paper,
-                Settings {
-                    kind: SolverKind::Paper,
-                    max_iterations: 100,
-                    omega: Some(omega_auto(&rates)? * 10f64.powi(exp)),
-                    ..Settings::default()
-                },
-            ),
-        ];
-        v.push(var);
-    }
-    Ok(v)
+        Scene::load("patch")?,
+    ))
+}
+
+/// Near-coincident nodes (uniform sizing: 1e-11 h apart after splitting) and coincident
+/// ones (matching meshes).
+fn coincident_nodes(rates: &Scene) -> Vec<Variant> {
+    let mut near = Variant::new(
+        HardCase::NearCoincidentNodes,
+        "grading = 1 (nodes 1e-11 h apart)",
+        1.0,
+        rates.clone(),
+    );
+    near.params = vec![("grading".into(), 1.0)];
+    near.level = 2;
+    let mut matching = Variant::new(
+        HardCase::CoincidentNodes,
+        "matching = 1",
+        1.0,
+        rates.clone(),
+    );
+    matching.params = vec![("matching".into(), 1.0)];
+    vec![near, matching]
+}
+
+/// Slivers: a structured strip of the upper block along Gamma_C, one triangle pair per
+/// contact edge, thinner and thinner (the measured aspect ratio is in the parameter).
+fn slivers(rates: &Scene) -> Vec<Variant> {
+    [2.9e-2, 2.9e-3, 2.9e-4]
+        .into_iter()
+        .map(|strip| {
+            let parameter = format!("strip {strip:e}");
+            let mut var = Variant::new(HardCase::Slivers, parameter, 0.0, rates.clone());
+            var.params = vec![("strip".into(), strip)];
+            var
+        })
+        .collect()
+}
+
+/// Units rescaled: lengths x 1e3 (gmsh writes the mesh scaled), moduli, stresses,
+/// viscosity and tractions x 1e6; compared with the rates scene, solver by solver.
+fn units_rescaled(rates: &Scene) -> Result<Variant> {
+    let mut var = Variant::new(
+        HardCase::UnitsRescaled,
+        "lengths x 1e3, moduli x 1e6",
+        1.0,
+        Scene::load("rates-units")?,
+    );
+    var.baseline = Some((rates.clone(), 1e3));
+    Ok(var)
+}
+
+/// Newton's iterations per step on the rates scene (study rates' family) at every level.
+// 1.4142 is that family's size ratio as studies/rates.toml writes it (the same meshes), not
+// sqrt(2).
+#[allow(clippy::approx_constant)]
+fn newton_across_levels(rates: &Scene) -> Vec<Variant> {
+    (0..=5)
+        .map(|level| {
+            let parameter = format!("level {level}");
+            let mut var = Variant::new(
+                HardCase::NewtonAcrossLevels,
+                parameter,
+                level as f64,
+                rates.clone(),
+            );
+            var.level = level;
+            var.params = vec![("h_upper".into(), 0.3), ("h_lower".into(), 0.3 / 1.4142)];
+            var.solvers.truncate(1);
+            var
+        })
+        .collect()
+}
+
+/// One single time step over [0, T].
+fn single_step(rates: &Scene) -> Variant {
+    let mut var = Variant::new(HardCase::SingleStep, "steps = 1", 1.0, rates.clone());
+    var.steps = 1;
+    var
+}
+
+/// The paper's penalty parameter omega over 8 decades around the automatic value (newton
+/// beside it as the reference).
+fn omega_sweep(rates: &Scene) -> Result<Vec<Variant>> {
+    let auto = omega_auto(rates)?;
+    Ok([-4, -2, 0, 2, 4]
+        .into_iter()
+        .map(|exp| {
+            let parameter = format!("omega = 1e{exp} x automatic");
+            let mut var = Variant::new(
+                HardCase::OmegaSweep,
+                parameter,
+                10f64.powi(exp),
+                rates.clone(),
+            );
+            let paper = Settings {
+                kind: SolverKind::Paper,
+                max_iterations: 100,
+                omega: Some(auto * 10f64.powi(exp)),
+                ..Settings::default()
+            };
+            var.solvers = vec![
+                (SolverKind::Newton, Settings::default()),
+                (SolverKind::Paper, paper),
+            ];
+            var
+        })
+        .collect())
 }
 
 /// The automatic omega of the paper solver on the rates scene at level 1 (mean stiffness
@@ -490,84 +534,90 @@ pub fn run() -> Result<StabilityResult> {
     let mut rows = Vec::new();
     for var in plan()? {
         for method in [Method::Mortar, Method::Nts] {
-            let case = Case::build(&var.scene, var.level, method, &var.params)?;
-            let (mut parameter, mut value) = (var.parameter.clone(), var.value);
-            if var.case == HardCase::Slivers {
-                value = metrics::max_aspect_ratio(&case.problem);
-                parameter = format!("{parameter}: max aspect ratio {value:.0}");
-            }
-            let baseline = match &var.baseline {
-                Some((scene, unit)) => {
-                    Some((Case::build(scene, var.level, method, &var.params)?, *unit))
-                }
-                None => None,
-            };
-            let mut newton: Option<Solution> = None;
-            for (kind, settings) in &var.solvers {
-                let t = std::time::Instant::now();
-                let out = solve::solve(&case.problem, settings, var.steps, true);
-                let wall_s = t.elapsed().as_secs_f64();
-                let row = match out {
-                    Ok(sol) => {
-                        let (error, note) = match (&baseline, &newton) {
-                            (Some((base_case, unit)), _) => {
-                                against_baseline(&sol, base_case, settings, var.steps, *unit)
-                            }
-                            (None, Some(n)) => (rel_diff(&sol, n), String::new()),
-                            (None, None) if *kind == SolverKind::Newton => (0.0, String::new()),
-                            (None, None) => (f64::NAN, String::new()),
-                        };
-                        let pen = sol
-                            .states
-                            .iter()
-                            .map(|s| metrics::max_penetration(&case.problem, s))
-                            .fold(0.0, f64::max);
-                        let r = StabilityRow {
-                            case: var.case,
-                            parameter: parameter.clone(),
-                            value,
-                            method,
-                            solver: *kind,
-                            converged: true,
-                            reason: sol
-                                .reports
-                                .last()
-                                .map(|r| r.reason.clone() + &note)
-                                .unwrap_or_default(),
-                            max_step_iterations: sol.max_step_iterations(),
-                            mean_step_iterations: sol.iterations() as f64
-                                / sol.reports.len().max(1) as f64,
-                            error,
-                            max_penetration: pen,
-                            wall_s,
-                        };
-                        if *kind == SolverKind::Newton {
-                            newton = Some(sol);
-                        }
-                        r
-                    }
-                    Err(Error::NotConverged(msg)) => StabilityRow {
-                        case: var.case,
-                        parameter: parameter.clone(),
-                        value,
-                        method,
-                        solver: *kind,
-                        converged: false,
-                        reason: msg,
-                        max_step_iterations: 0,
-                        mean_step_iterations: 0.0,
-                        error: f64::NAN,
-                        max_penetration: f64::NAN,
-                        wall_s,
-                    },
-                    Err(e) => return Err(e),
-                };
-                rows.push(row);
-            }
+            rows.extend(run_variant(&var, method)?);
         }
     }
     Ok(StabilityResult {
         rows,
         wall_s: t0.elapsed().as_secs_f64(),
     })
+}
+
+/// One variant with one cone, solver by solver (newton first: the others' errors are their
+/// differences to its solution); a solver that does not converge gives a row that says why.
+fn run_variant(var: &Variant, method: Method) -> Result<Vec<StabilityRow>> {
+    let case = Case::build(&var.scene, var.level, method, &var.params)?;
+    let (mut parameter, mut value) = (var.parameter.clone(), var.value);
+    if var.case == HardCase::Slivers {
+        value = metrics::max_aspect_ratio(&case.problem);
+        parameter = format!("{parameter}: max aspect ratio {value:.0}");
+    }
+    let baseline = match &var.baseline {
+        Some((scene, unit)) => Some((Case::build(scene, var.level, method, &var.params)?, *unit)),
+        None => None,
+    };
+    // A run's row before its outcome is known: the failure's blanks.
+    let row = |solver: SolverKind, wall_s: f64| StabilityRow {
+        case: var.case,
+        parameter: parameter.clone(),
+        value,
+        method,
+        solver,
+        converged: false,
+        reason: String::new(),
+        max_step_iterations: 0,
+        mean_step_iterations: 0.0,
+        error: f64::NAN,
+        max_penetration: f64::NAN,
+        wall_s,
+    };
+    let mut newton: Option<Solution> = None;
+    let mut rows = Vec::new();
+    for (kind, settings) in &var.solvers {
+        let t = std::time::Instant::now();
+        let out = solve::solve(&case.problem, settings, var.steps, true);
+        let wall_s = t.elapsed().as_secs_f64();
+        match out {
+            Ok(sol) => {
+                let (error, note) = match (&baseline, &newton) {
+                    (Some((base_case, unit)), _) => {
+                        against_baseline(&sol, base_case, settings, var.steps, *unit)
+                    }
+                    (None, Some(n)) => (rel_diff(&sol, n), String::new()),
+                    (None, None) if *kind == SolverKind::Newton => (0.0, String::new()),
+                    (None, None) => (f64::NAN, String::new()),
+                };
+                rows.push(StabilityRow {
+                    converged: true,
+                    reason: sol
+                        .reports
+                        .last()
+                        .map(|r| r.reason.clone() + &note)
+                        .unwrap_or_default(),
+                    max_step_iterations: sol.max_step_iterations(),
+                    mean_step_iterations: sol.iterations() as f64 / sol.reports.len().max(1) as f64,
+                    error,
+                    max_penetration: max_penetration(&case, &sol),
+                    ..row(*kind, wall_s)
+                });
+                if *kind == SolverKind::Newton {
+                    newton = Some(sol);
+                }
+            }
+            Err(Error::NotConverged(msg)) => rows.push(StabilityRow {
+                reason: msg,
+                ..row(*kind, wall_s)
+            }),
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(rows)
+}
+
+/// The largest interpenetration over the history (length).
+fn max_penetration(case: &Case, sol: &Solution) -> f64 {
+    sol.states
+        .iter()
+        .map(|s| metrics::max_penetration(&case.problem, s))
+        .fold(0.0, f64::max)
 }

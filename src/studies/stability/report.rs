@@ -5,6 +5,7 @@ use crate::contact::Method;
 use crate::error::Result;
 use crate::io::csv_bytes;
 use crate::report::folder::{write, write_folder};
+use crate::report::markdown::{Doc, Table};
 use crate::report::plot::{self, Series};
 use crate::solve::SolverKind;
 use crate::studies::stability::{HardCase, StabilityResult};
@@ -92,61 +93,68 @@ fn sweep_plots(res: &StabilityResult, d: &Path) -> Result<()> {
 
 /// The README: one section per case with its note, plots and table.
 fn readme(res: &StabilityResult, d: &Path) -> String {
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "# Study `stability`\n\nHard cases, each run with every solver and both cones (level 1 of the `rates` scene with 4 steps unless stated). A failure is a result: `converged = no` with the solver's reason. `error` is the largest nodal difference to newton's solution of the same discrete problem, relative to the largest displacement. Regenerate with `cargo run --release -- study stability` ({:.0} s).\n",
+    let mut doc = Doc::new();
+    doc.heading(1, "Study `stability`").paragraph(format!(
+        "Hard cases, each run with every solver and both cones (level 1 of the `rates` scene with 4 steps unless stated). A failure is a result: `converged = no` with the solver's reason. `error` is the largest nodal difference to newton's solution of the same discrete problem, relative to the largest displacement. Regenerate with `cargo run --release -- study stability` ({:.0} s).",
         res.wall_s
-    );
+    ));
     let mut cases: Vec<HardCase> = Vec::new();
     for r in &res.rows {
         if !cases.contains(&r.case) {
             cases.push(r.case);
         }
     }
-    for c in cases {
-        let _ = writeln!(s, "## {}\n", c.name());
-        if !c.note().is_empty() {
-            let _ = writeln!(s, "{}\n", c.note());
-        }
-        if let Some(sweep) = c.sweep() {
-            let file = sweep.file;
-            let _ = writeln!(s, "![iterations]({file}_iterations.png)\n");
-            if d.join(format!("{file}_error.png")).exists() {
-                let _ = writeln!(s, "![error]({file}_error.png)\n");
-            }
-        }
-        let _ = writeln!(
-            s,
-            "| parameter | method | solver | converged | max / mean iterations per step | error | max penetration | wall (s) | reason |\n|---|---|---|---|---|---|---|---|---|"
-        );
-        for r in res.rows.iter().filter(|r| r.case == c) {
-            let _ = writeln!(
-                s,
-                "| {} | {} | {} | {} | {} / {:.1} | {} | {} | {:.3} | {} |",
-                r.parameter,
-                r.method,
-                r.solver,
-                if r.converged { "yes" } else { "**no**" },
-                r.max_step_iterations,
-                r.mean_step_iterations,
-                if r.error.is_finite() {
-                    format!("{:.2e}", r.error)
-                } else {
-                    String::new()
-                },
-                if r.max_penetration.is_finite() {
-                    format!("{:.2e}", r.max_penetration)
-                } else {
-                    String::new()
-                },
-                r.wall_s,
-                r.reason.replace('|', "/")
-            );
-        }
-        let _ = writeln!(s);
+    for case in cases {
+        hard_case(&mut doc, res, case, d);
     }
-    s
+    doc.finish()
+}
+
+/// ## One hard case: its note, its sweep's plots (those written into `d`) and its runs.
+fn hard_case(doc: &mut Doc, res: &StabilityResult, case: HardCase, d: &Path) {
+    doc.heading(2, case.name());
+    if !case.note().is_empty() {
+        doc.paragraph(case.note());
+    }
+    if let Some(sweep) = case.sweep() {
+        let file = sweep.file;
+        doc.image("iterations", &format!("{file}_iterations.png"));
+        if d.join(format!("{file}_error.png")).exists() {
+            doc.image("error", &format!("{file}_error.png"));
+        }
+    }
+    let mut table = Table::new([
+        "parameter",
+        "method",
+        "solver",
+        "converged",
+        "max / mean iterations per step",
+        "error",
+        "max penetration",
+        "wall (s)",
+        "reason",
+    ]);
+    let finite = |v: f64| {
+        if v.is_finite() {
+            format!("{v:.2e}")
+        } else {
+            String::new()
+        }
+    };
+    for r in res.rows.iter().filter(|r| r.case == case) {
+        table.row([
+            r.parameter.clone(),
+            r.method.to_string(),
+            r.solver.to_string(),
+            if r.converged { "yes" } else { "**no**" }.to_string(),
+            format!("{} / {:.1}", r.max_step_iterations, r.mean_step_iterations),
+            finite(r.error),
+            finite(r.max_penetration),
+            format!("{:.3}", r.wall_s),
+            r.reason.replace('|', "/"),
+        ]);
+    }
+    doc.table(&table);
 }
 
 /// What `study stability` prints: one line per run, and where the report went.

@@ -63,6 +63,7 @@ use crate::studies::convergence::{Reference, Study, Truth, provenance, reference
 use crate::verify::jobs::{self, Job, JobId, Mode};
 use crate::verify::quantity::Quantity;
 use crate::verify::rates::{self, Assessment, LevelError, PowerSumFit};
+use crate::verify::study_file::TwoSizeSpec;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -284,6 +285,23 @@ impl Plan {
             pairs: planned,
         }
     }
+
+    /// The planned pairs' solves, taken from `solved`.
+    fn pair_runs(&self, solved: &mut jobs::Solved) -> Vec<PairRun> {
+        self.pairs
+            .iter()
+            .map(|&(slave, method, levels, id)| {
+                let (case, solution) = solved.take(id);
+                PairRun {
+                    slave,
+                    method,
+                    levels,
+                    case,
+                    solution,
+                }
+            })
+            .collect()
+    }
 }
 
 /// Free dofs on the nodes of each body.
@@ -298,12 +316,21 @@ fn body_dofs(case: &Case) -> [usize; 2] {
     })
 }
 
+/// One planned pair solved: its slave choice, cone and (slave, master) levels.
+struct PairRun {
+    /// Index into the slave choices.
+    slave: usize,
+    method: Method,
+    levels: [usize; 2],
+    case: Case,
+    solution: Solution,
+}
+
 /// Run the two-size study `name` (built-in name or path).
 pub fn run(name: &str) -> Result<TwoSizeResult> {
     let t0 = Instant::now();
     let study = Study::load(name)?;
-    let sf = &study.file;
-    let spec = sf.two_size.as_ref().ok_or_else(|| {
+    let spec = study.file.two_size.as_ref().ok_or_else(|| {
         Error::input(
             &study.path,
             "two_size",
@@ -311,102 +338,20 @@ pub fn run(name: &str) -> Result<TwoSizeResult> {
         )
     })?;
     // Step 1: the plan, a scene per slave choice.
-    let slaves: Vec<String> = if spec.slaves.is_empty() {
-        vec![study.scene.bodies[0].surface.clone()]
-    } else {
-        spec.slaves.clone()
-    };
+    let slaves = slave_choices(&study, spec);
     let scenes: Vec<Scene> = slaves
         .iter()
         .map(|s| study.scene.with_slave(s))
         .collect::<Result<_>>()?;
     let plan = Plan::new(&study, slaves.len(), spec.fixed);
-    // Step 2: every solve.
-    let progress = Progress::new(plan.jobs.len() as u64, &study.name);
-    let scene_refs: Vec<&Scene> = scenes.iter().collect();
-    let outputs = jobs::execute(
-        &plan.jobs,
-        &scene_refs,
-        sf.solver,
-        &study.text,
-        Mode::All,
-        &|l| progress.tick(l),
-    )?;
-    progress.finish();
-    let mut solved = jobs::Solved::complete(outputs).expect("every job ran");
-    let truths: Vec<Truth> = plan
-        .references
-        .iter()
-        .zip(&scenes)
-        .map(|(ids, scene)| match ids {
-            Some(ids) => Truth::Solved(reference(*ids, &mut solved, study.reference_level())),
-            None => Truth::Exact(
-                scene
-                    .exact
-                    .as_deref()
-                    .expect("checked when the study was read"),
-                sf.reference.quadrature,
-            ),
-        })
-        .collect();
+    // Step 2: every solve, and each slave choice's truth.
+    let mut solved = solve_all(&study, &plan, &scenes)?;
+    let truths = truths(&study, &plan, &scenes, &mut solved);
     // Step 3: every pair against its truth.
-    let runs: Vec<(usize, Method, [usize; 2], Case, Solution)> = plan
-        .pairs
-        .iter()
-        .map(|&(s, m, l, id)| {
-            let (case, sol) = solved.take(id);
-            (s, m, l, case, sol)
-        })
-        .collect();
-    let measured: Vec<BTreeMap<Quantity, f64>> = runs
-        .par_iter()
-        .map(|(s, _, _, case, sol)| truths[*s].relative_errors(case, sol))
-        .collect();
-    let mut points = Vec::new();
-    for ((s, method, levels, case, sol), errors) in runs.iter().zip(&measured) {
-        let m = &case.problem.model;
-        let dofs = body_dofs(case);
-        for &quantity in &sf.quantities {
-            let error = errors[&quantity];
-            if !error.is_finite() {
-                return Err(Error::NotConverged(format!(
-                    "slave {} {method} levels {levels:?}: the {quantity} error is not finite",
-                    slaves[*s]
-                )));
-            }
-            points.push(SizePoint {
-                slave: slaves[*s].clone(),
-                method: *method,
-                slave_level: levels[0],
-                master_level: levels[1],
-                h1: m.meshes[0].h(),
-                h2: m.meshes[1].h(),
-                dofs1: dofs[0],
-                dofs2: dofs[1],
-                quantity,
-                error,
-                wall_s: sol.wall_s,
-            });
-        }
-    }
+    let runs = plan.pair_runs(&mut solved);
+    let points = measure(&study, &slaves, &runs, &truths)?;
     // Step 4: the fits.
-    let mut fits = Vec::new();
-    for (s, slave) in slaves.iter().enumerate() {
-        for &method in &sf.methods {
-            for &quantity in &sf.quantities {
-                fits.push(fit(
-                    &points,
-                    slave,
-                    method,
-                    quantity,
-                    &sf.mesh.levels,
-                    spec.fixed,
-                    truths[s].quantity_error(quantity),
-                    &study.path,
-                )?);
-            }
-        }
-    }
+    let fits = fit_all(&study, spec, &slaves, &points, &truths)?;
     let references = truths
         .iter()
         .zip(&slaves)
@@ -415,8 +360,8 @@ pub fn run(name: &str) -> Result<TwoSizeResult> {
             Truth::Exact(..) => None,
         })
         .collect();
-    let first = &runs[0].3;
-    let provenance = provenance(&study, &first.mesh);
+    let first = &runs[0].case;
+    let sf = &study.file;
     Ok(TwoSizeResult {
         name: study.name.clone(),
         description: sf.description.clone(),
@@ -433,11 +378,130 @@ pub fn run(name: &str) -> Result<TwoSizeResult> {
         fits,
         references,
         exact_quadrature: sf.reference.exact.then_some(sf.reference.quadrature),
-        provenance,
+        provenance: provenance(&study, &first.mesh),
         wall_s: t0.elapsed().as_secs_f64(),
         warnings: first.warnings.clone(),
         scene: study.scene,
     })
+}
+
+/// The slave choices: the study's, or the scene's own slave surface.
+fn slave_choices(study: &Study, spec: &TwoSizeSpec) -> Vec<String> {
+    if spec.slaves.is_empty() {
+        vec![study.scene.bodies[0].surface.clone()]
+    } else {
+        spec.slaves.clone()
+    }
+}
+
+/// Every planned solve, with progress on the console.
+fn solve_all(study: &Study, plan: &Plan, scenes: &[Scene]) -> Result<jobs::Solved> {
+    let progress = Progress::new(plan.jobs.len() as u64, &study.name);
+    let scene_refs: Vec<&Scene> = scenes.iter().collect();
+    let outputs = jobs::execute(
+        &plan.jobs,
+        &scene_refs,
+        study.file.solver,
+        &study.text,
+        Mode::All,
+        &|l| progress.tick(l),
+    )?;
+    progress.finish();
+    Ok(jobs::Solved::complete(outputs).expect("every job ran"))
+}
+
+/// Each slave choice's truth: its reference solve, or its scene's exact solution.
+fn truths<'s>(
+    study: &Study,
+    plan: &Plan,
+    scenes: &'s [Scene],
+    solved: &mut jobs::Solved,
+) -> Vec<Truth<'s>> {
+    plan.references
+        .iter()
+        .zip(scenes)
+        .map(|(ids, scene)| match ids {
+            Some(ids) => Truth::Solved(reference(*ids, solved, study.reference_level())),
+            None => Truth::Exact(
+                scene
+                    .exact
+                    .as_deref()
+                    .expect("checked when the study was read"),
+                study.file.reference.quadrature,
+            ),
+        })
+        .collect()
+}
+
+/// Every pair's errors against its slave choice's truth, one point per quantity (an error
+/// that is not finite stops the study).
+fn measure(
+    study: &Study,
+    slaves: &[String],
+    runs: &[PairRun],
+    truths: &[Truth],
+) -> Result<Vec<SizePoint>> {
+    let measured: Vec<BTreeMap<Quantity, f64>> = runs
+        .par_iter()
+        .map(|r| truths[r.slave].relative_errors(&r.case, &r.solution))
+        .collect();
+    let mut points = Vec::new();
+    for (r, errors) in runs.iter().zip(&measured) {
+        let m = &r.case.problem.model;
+        let dofs = body_dofs(&r.case);
+        for &quantity in &study.file.quantities {
+            let error = errors[&quantity];
+            if !error.is_finite() {
+                return Err(Error::NotConverged(format!(
+                    "slave {} {} levels {:?}: the {quantity} error is not finite",
+                    slaves[r.slave], r.method, r.levels
+                )));
+            }
+            points.push(SizePoint {
+                slave: slaves[r.slave].clone(),
+                method: r.method,
+                slave_level: r.levels[0],
+                master_level: r.levels[1],
+                h1: m.meshes[0].h(),
+                h2: m.meshes[1].h(),
+                dofs1: dofs[0],
+                dofs2: dofs[1],
+                quantity,
+                error,
+                wall_s: r.solution.wall_s,
+            });
+        }
+    }
+    Ok(points)
+}
+
+/// The fits of every slave choice, cone and quantity.
+fn fit_all(
+    study: &Study,
+    spec: &TwoSizeSpec,
+    slaves: &[String],
+    points: &[SizePoint],
+    truths: &[Truth],
+) -> Result<Vec<SizeFit>> {
+    let sf = &study.file;
+    let mut fits = Vec::new();
+    for (s, slave) in slaves.iter().enumerate() {
+        for &method in &sf.methods {
+            for &quantity in &sf.quantities {
+                fits.push(fit(
+                    points,
+                    slave,
+                    method,
+                    quantity,
+                    &sf.mesh.levels,
+                    spec.fixed,
+                    truths[s].quantity_error(quantity),
+                    &study.path,
+                )?);
+            }
+        }
+    }
+    Ok(fits)
 }
 
 /// Step 4 for one slave choice, cone and quantity.

@@ -7,10 +7,11 @@ use crate::contact::Method;
 use crate::error::Result;
 use crate::io::{csv_bytes, fmt3};
 use crate::report::folder::{write, write_folder};
+use crate::report::markdown::{Doc, Table};
 use crate::report::plot::{self, GridPanel, Series};
 use crate::studies::two_size::{SizeFit, TwoSizeResult};
 use crate::verify::quantity::Quantity;
-use crate::verify::rates::{Assessment, Verdict};
+use crate::verify::rates::{Assessment, ROUNDOFF, Verdict};
 use crate::verify::table::{ErrorRecord, join};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -302,7 +303,7 @@ fn fmt_fit(f: &SizeFit, b: usize) -> String {
         Some(x) if x.rms_log_residual > FIT_RMS => {
             format!("poor fit (rms {:.2})", x.rms_log_residual)
         }
-        Some(x) if !(x.se[b] <= FIT_SE) || !(0.0..6.0).contains(&x.a[b]) => {
+        Some(x) if x.se[b].is_nan() || x.se[b] > FIT_SE || !(0.0..6.0).contains(&x.a[b]) => {
             match x.se[b].is_finite() {
                 true => format!("not identified ({:.2} ± {:.2})", x.a[b], x.se[b]),
                 false => format!("not identified ({:.2}, standard error unbounded)", x.a[b]),
@@ -325,9 +326,41 @@ fn fmt_sweep(a: &Assessment) -> String {
     }
 }
 
+/// One-sided refinements from the finest grid diagonal point (L, L): the slave refined to
+/// the fixed level (fixed, L) and the master refined to it (L, fixed), each gain in error
+/// divided by the dofs it adds.
+struct Refinements {
+    /// The error at (L, L).
+    base: f64,
+    /// The errors with the slave, then the master, refined.
+    refined: [f64; 2],
+    /// Error gained per added dof: slave, master.
+    gain: [f64; 2],
+}
+
+/// The one-sided refinements of one slave choice, cone and quantity (None where a point
+/// was not measured).
+fn refinements(res: &TwoSizeResult, f: &SizeFit) -> Option<Refinements> {
+    let finest = *res.levels.last().expect("levels");
+    let at = |l: [usize; 2]| {
+        res.of(&f.slave, f.method, f.quantity)
+            .find(|p| [p.slave_level, p.master_level] == l)
+    };
+    let base = at([finest, finest])?;
+    let s1 = at([res.fixed, finest])?;
+    let s2 = at([finest, res.fixed])?;
+    Some(Refinements {
+        base: base.error,
+        refined: [s1.error, s2.error],
+        gain: [
+            (base.error - s1.error) / (s1.dofs1 as f64 - base.dofs1 as f64),
+            (base.error - s2.error) / (s2.dofs2 as f64 - base.dofs2 as f64),
+        ],
+    })
+}
+
 /// The plain answer for one slave choice, cone and quantity, from the measured errors
-/// alone: from the finest grid diagonal point (L, L), refining the slave to the fixed level
-/// (fixed, L) against refining the master (L, fixed), each gain divided by the dofs it adds.
+/// alone ([`Refinements`]): which body's refinement gains more per added dof.
 fn answer(res: &TwoSizeResult, f: &SizeFit) -> String {
     let master = res
         .scene
@@ -337,21 +370,14 @@ fn answer(res: &TwoSizeResult, f: &SizeFit) -> String {
         .find(|s| *s != f.slave)
         .unwrap_or("?");
     let finest = *res.levels.last().expect("levels");
-    let at = |l: [usize; 2]| {
-        res.of(&f.slave, f.method, f.quantity)
-            .find(|p| [p.slave_level, p.master_level] == l)
-    };
-    let (Some(base), Some(s1), Some(s2)) = (
-        at([finest, finest]),
-        at([res.fixed, finest]),
-        at([finest, res.fixed]),
-    ) else {
+    let Some(Refinements {
+        base,
+        refined,
+        gain,
+    }) = refinements(res, f)
+    else {
         return "not measured".into();
     };
-    let gain = [
-        (base.error - s1.error) / (s1.dofs1 as f64 - base.dofs1 as f64),
-        (base.error - s2.error) / (s2.dofs2 as f64 - base.dofs2 as f64),
-    ];
     let names = [
         format!("the slave '{}'", f.slave),
         format!("the master '{master}'"),
@@ -359,8 +385,8 @@ fn answer(res: &TwoSizeResult, f: &SizeFit) -> String {
     let better = usize::from(gain[1] > gain[0]);
     if gain[0] <= 0.0 && gain[1] <= 0.0 {
         return format!(
-            "from {:.3e} at ({finest}, {finest}), refining the slave to level {} gives {:.3e}, the master {:.3e}: neither refinement alone reduces it (the error depends on both meshes together)",
-            base.error, res.fixed, s1.error, s2.error
+            "from {base:.3e} at ({finest}, {finest}), refining the slave to level {} gives {:.3e}, the master {:.3e}: neither refinement alone reduces it (the error depends on both meshes together)",
+            res.fixed, refined[0], refined[1]
         );
     }
     let words = |g: f64, e: f64| {
@@ -370,38 +396,45 @@ fn answer(res: &TwoSizeResult, f: &SizeFit) -> String {
             format!("not at all ({e:.3e})")
         }
     };
+    let factor = if gain[0].min(gain[1]) > 0.0 {
+        format!(" ({:.1}x more per dof)", gain[better] / gain[1 - better])
+    } else {
+        String::new()
+    };
     format!(
-        "from {:.3e} at ({finest}, {finest}), refining the slave to level {} brings it {}, the master {}; per added dof {:.2e} against {:.2e}: {} limits the error{}",
-        base.error,
+        "from {base:.3e} at ({finest}, {finest}), refining the slave to level {} brings it {}, the master {}; per added dof {:.2e} against {:.2e}: {} limits the error{factor}",
         res.fixed,
-        words(gain[0], s1.error),
-        words(gain[1], s2.error),
+        words(gain[0], refined[0]),
+        words(gain[1], refined[1]),
         gain[0],
         gain[1],
         names[better],
-        if gain[0].max(gain[1]) > 0.0 && gain[0].min(gain[1]) > 0.0 {
-            format!(" ({:.1}x more per dof)", gain[better] / gain[1 - better])
-        } else {
-            String::new()
-        }
     )
 }
 
-/// The diagonal pairs against the diagonal study's committed errors (same meshes).
-fn diagonal(res: &TwoSizeResult, s: &mut String) {
-    let Some(name) = &res.diagonal else { return };
-    let path = crate::report::reports_dir().join(name).join("errors.csv");
-    // Without the diagonal study's report there is nothing to compare with.
-    let Ok(rows) = crate::verify::table::read::<ErrorRecord>(&path) else {
-        return;
-    };
+/// One quantity's agreement of the grid diagonal with the diagonal study.
+struct DiagonalAgreement {
+    quantity: Quantity,
+    /// Diagonal pairs compared (both cones, every level).
+    pairs: usize,
+    /// Largest relative difference over them.
+    largest: f64,
+    /// Whether both sides are at round-off in every pair (then they agree to round-off,
+    /// not relatively).
+    roundoff: bool,
+}
+
+/// The diagonal pairs against the diagonal study's errors, per quantity.
+fn diagonal_agreement(res: &TwoSizeResult, rows: &[ErrorRecord]) -> Vec<DiagonalAgreement> {
     let slave = &res.scene.bodies[0].surface;
-    let mut worst: Vec<(String, f64, usize, bool)> = Vec::new();
+    let mut out = Vec::new();
     for &q in &res.quantities {
-        let mut w = 0.0f64;
-        let mut n = 0;
-        // Errors at round-off on both sides agree to round-off, not relatively.
-        let mut roundoff = true;
+        let mut agreement = DiagonalAgreement {
+            quantity: q,
+            pairs: 0,
+            largest: 0.0,
+            roundoff: true,
+        };
         for &m in &res.methods {
             for &l in &res.levels {
                 let (Some(a), Some(b)) = (
@@ -412,61 +445,109 @@ fn diagonal(res: &TwoSizeResult, s: &mut String) {
                 ) else {
                     continue;
                 };
-                let tiny = crate::verify::rates::ROUNDOFF;
-                if a > tiny || b > tiny {
-                    roundoff = false;
-                    w = w.max((a - b).abs() / b.abs().max(f64::MIN_POSITIVE));
+                if a > ROUNDOFF || b > ROUNDOFF {
+                    agreement.roundoff = false;
+                    let difference = (a - b).abs() / b.abs().max(f64::MIN_POSITIVE);
+                    agreement.largest = agreement.largest.max(difference);
                 }
-                n += 1;
+                agreement.pairs += 1;
             }
         }
-        if n > 0 {
-            worst.push((q.name().to_string(), w, n, roundoff));
+        if agreement.pairs > 0 {
+            out.push(agreement);
         }
     }
-    let _ = writeln!(
-        s,
-        "## The diagonal against `{name}`\n\nWhere both bodies have the same level the mesh is the diagonal study's (each body split from the same gmsh level-0 mesh; slave '{slave}'), so its errors must agree with [`reports/{name}`](../{name}/README.md) to the solver tolerance (this study's {} time steps against its own; a quantity taken as the max over the steps may differ where they do). Largest relative difference per quantity over both cones and levels {}:\n\n| quantity | pairs | largest relative difference |\n|---|---|---|",
-        res.steps,
-        join(&res.levels)
-    );
-    for (q, w, n, roundoff) in worst {
-        if roundoff {
-            let _ = writeln!(
-                s,
-                "| {q} | {n} | both at round-off (<= {:.0e}) |",
-                crate::verify::rates::ROUNDOFF
-            );
-        } else {
-            let _ = writeln!(s, "| {q} | {n} | {w:.2e} |");
-        }
-    }
-    let _ = writeln!(s);
+    out
 }
 
+/// ## The diagonal against the diagonal study: its committed errors on the same meshes.
+fn diagonal(doc: &mut Doc, res: &TwoSizeResult) {
+    let Some(name) = &res.diagonal else { return };
+    let path = crate::report::reports_dir().join(name).join("errors.csv");
+    // Without the diagonal study's report there is nothing to compare with.
+    let Ok(rows) = crate::verify::table::read::<ErrorRecord>(&path) else {
+        return;
+    };
+    let mut table = Table::new(["quantity", "pairs", "largest relative difference"]);
+    for a in diagonal_agreement(res, &rows) {
+        let difference = if a.roundoff {
+            format!("both at round-off (<= {ROUNDOFF:.0e})")
+        } else {
+            format!("{:.2e}", a.largest)
+        };
+        table.row([a.quantity.to_string(), a.pairs.to_string(), difference]);
+    }
+    doc.heading(2, format!("The diagonal against `{name}`"))
+        .paragraph(format!(
+            "Where both bodies have the same level the mesh is the diagonal study's (each body split from the same gmsh level-0 mesh; slave '{}'), so its errors must agree with [`reports/{name}`](../{name}/README.md) to the solver tolerance (this study's {} time steps against its own; a quantity taken as the max over the steps may differ where they do). Largest relative difference per quantity over both cones and levels {}:",
+            res.scene.bodies[0].surface,
+            res.steps,
+            join(&res.levels)
+        ))
+        .table(&table);
+}
+
+/// The README: which exponents the grid fits, which mesh limits the error, which body
+/// should be the slave, the diagonal against its study, the plots, the truth.
 fn readme(res: &TwoSizeResult) -> String {
-    let mut s = String::new();
-    let _ = writeln!(s, "# Study `{}`\n\n{}\n", res.name, res.description);
-    let _ = writeln!(s, "Scene `{}`: {}\n", res.scene.name, res.scene.description);
-    let _ = writeln!(
-        s,
-        "Regenerate with `cargo run --release -- study {}` ({:.0} s on this machine, {} cores). Grid: every pair of levels {} of the slave (body 1) and the master (body 2); one-sided sweeps: each body over those levels with the other at level {fixed}; and (level {fixed}, level {fixed}) as their floor. Slave choices: {}. {} time steps.\n",
-        res.name,
-        res.wall_s,
-        res.provenance.get("cores").cloned().unwrap_or_default(),
-        join(&res.levels),
-        res.slaves.join(", "),
-        res.steps,
-        fixed = res.fixed
-    );
-    // The lead: the exponents per cone and slave against the Lemma.
-    let _ = writeln!(
-        s,
-        "## What differs between the cones: exponents in h1 (slave) and h2 (master)\n\nRows of the two cones side by side (the quantities mapped below; every quantity in `fits.csv`). The grid fitted to E = C1 h1^a1 + C2 h2^a2 (nonlinear least squares in log space, ± standard errors, rms of the log residuals), beside Lemma 3.1's consistency exponents (K_h^pi: h1^(3/4) + h2; K_h^I: (h1^(1/2) ||e||)^(1/2) + h1^(3/4) + h2^(3/4), i.e. h1^(1/2) + h2^(3/4)); the finite elements' own approximation adds h1 + h2 in the theorem norm. The one-sided rates: the slave swept with the master at level {fixed}, the master swept with the slave at level {fixed} (a sweep level within 5x of the error at ({fixed}, {fixed}), which bounds the fixed body's own error, is left out: that is how the fixed level is checked to be fine enough; `too few levels` there means the swept body's error is swamped by that floor from the second level on: its mesh does not limit the error). Thresholds: the fitted a1 of the threshold quantity must reach the study's rate threshold minus its tolerance where the fit identifies it ({:.2} mortar, {:.2} nts).\n\n| slave | method | quantity | a1 (h1) | a2 (h2) | Lemma (a1, a2) | rms log residual | rate in h1, master fixed | rate in h2, slave fixed | floor ({fixed}, {fixed}) |\n|---|---|---|---|---|---|---|---|---|---|",
-        res.thresholds[0],
-        res.thresholds[1],
-        fixed = res.fixed
-    );
+    let mut doc = Doc::new();
+    title(&mut doc, res);
+    exponents(&mut doc, res);
+    which_mesh_limits(&mut doc, res);
+    if res.slaves.len() > 1 {
+        which_body_slave(&mut doc, res);
+    }
+    diagonal(&mut doc, res);
+    doc.heading(2, "Maps and sweeps");
+    for slave in &res.slaves {
+        for &m in &res.methods {
+            doc.image(&format!("{m}, slave {slave}"), &map_file(slave, m));
+        }
+        doc.image(&format!("sweeps, slave {slave}"), &sweep_file(slave));
+    }
+    truth(&mut doc, res);
+    doc.heading(2, "Provenance")
+        .list(res.provenance.iter().map(|(k, v)| format!("{k}: {v}")))
+        .line("Data: `grid.csv` (every pair and quantity), `fits.csv` (every fit).");
+    doc.finish()
+}
+
+/// The title, the study's and the scene's descriptions, the grid and how to regenerate it.
+fn title(doc: &mut Doc, res: &TwoSizeResult) {
+    doc.heading(1, format!("Study `{}`", res.name))
+        .paragraph(&res.description)
+        .paragraph(format!(
+            "Scene `{}`: {}",
+            res.scene.name, res.scene.description
+        ))
+        .paragraph(format!(
+            "Regenerate with `cargo run --release -- study {}` ({:.0} s on this machine, {} cores). Grid: every pair of levels {} of the slave (body 1) and the master (body 2); one-sided sweeps: each body over those levels with the other at level {fixed}; and (level {fixed}, level {fixed}) as their floor. Slave choices: {}. {} time steps.",
+            res.name,
+            res.wall_s,
+            res.provenance.get("cores").cloned().unwrap_or_default(),
+            join(&res.levels),
+            res.slaves.join(", "),
+            res.steps,
+            fixed = res.fixed
+        ));
+}
+
+/// ## What differs between the cones: the lead, the exponents per cone and slave against
+/// the Lemma's, and the one-sided rates.
+fn exponents(doc: &mut Doc, res: &TwoSizeResult) {
+    let fixed = res.fixed;
+    let mut table = Table::new([
+        "slave".to_string(),
+        "method".into(),
+        "quantity".into(),
+        "a1 (h1)".into(),
+        "a2 (h2)".into(),
+        "Lemma (a1, a2)".into(),
+        "rms log residual".into(),
+        "rate in h1, master fixed".into(),
+        "rate in h2, slave fixed".into(),
+        format!("floor ({fixed}, {fixed})"),
+    ]);
     let mut rows: Vec<&SizeFit> = res
         .fits
         .iter()
@@ -481,132 +562,120 @@ fn readme(res: &TwoSizeResult) -> String {
     });
     for f in rows {
         let lemma = f.method.lemma_exponents();
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} | {} | {} | ({}, {}) | {} | {} | {} | {:.3e} |",
-            f.slave,
-            f.method,
-            f.quantity,
+        table.row([
+            f.slave.clone(),
+            f.method.to_string(),
+            f.quantity.to_string(),
             fmt_fit(f, 0),
             fmt_fit(f, 1),
-            lemma[0],
-            lemma[1],
+            format!("({}, {})", lemma[0], lemma[1]),
             fmt3(f.fit.map_or(f64::NAN, |x| x.rms_log_residual)),
             fmt_sweep(&f.sweeps[0]),
             fmt_sweep(&f.sweeps[1]),
-            f.floor
-        );
+            format!("{:.3e}", f.floor),
+        ]);
     }
-    let _ = writeln!(
-        s,
-        "\n`poor fit`: the grid fit misses the errors by more than 28 % rms (rms log residual > {FIT_RMS}): the additive model does not describe them. Where an error grows when one body alone is refined (below: K_h^I's contact quantities when the master is refined past the slave, whose nodes alone carry the constraint), no sum of two positive terms C1 h1^a1 + C2 h2^a2 can fit it: the error depends on the ratio h1/h2, not on each size separately. `not identified`: a term too small on the grid for its exponent to be measured (standard error > {FIT_SE})."
-    );
+    doc.heading(2, "What differs between the cones: exponents in h1 (slave) and h2 (master)")
+        .paragraph(format!(
+            "Rows of the two cones side by side (the quantities mapped below; every quantity in `fits.csv`). The grid fitted to E = C1 h1^a1 + C2 h2^a2 (nonlinear least squares in log space, ± standard errors, rms of the log residuals), beside Lemma 3.1's consistency exponents (K_h^pi: h1^(3/4) + h2; K_h^I: (h1^(1/2) ||e||)^(1/2) + h1^(3/4) + h2^(3/4), i.e. h1^(1/2) + h2^(3/4)); the finite elements' own approximation adds h1 + h2 in the theorem norm. The one-sided rates: the slave swept with the master at level {fixed}, the master swept with the slave at level {fixed} (a sweep level within 5x of the error at ({fixed}, {fixed}), which bounds the fixed body's own error, is left out: that is how the fixed level is checked to be fine enough; `too few levels` there means the swept body's error is swamped by that floor from the second level on: its mesh does not limit the error). Thresholds: the fitted a1 of the threshold quantity must reach the study's rate threshold minus its tolerance where the fit identifies it ({:.2} mortar, {:.2} nts).",
+            res.thresholds[0],
+            res.thresholds[1],
+        ))
+        .table(&table)
+        .paragraph(format!(
+            "`poor fit`: the grid fit misses the errors by more than 28 % rms (rms log residual > {FIT_RMS}): the additive model does not describe them. Where an error grows when one body alone is refined (below: K_h^I's contact quantities when the master is refined past the slave, whose nodes alone carry the constraint), no sum of two positive terms C1 h1^a1 + C2 h2^a2 can fit it: the error depends on the ratio h1/h2, not on each size separately. `not identified`: a term too small on the grid for its exponent to be measured (standard error > {FIT_SE})."
+        ));
+}
+
+/// ## Which mesh limits the error: the plain answer per slave choice, cone and quantity.
+fn which_mesh_limits(doc: &mut Doc, res: &TwoSizeResult) {
     let finest = *res.levels.last().expect("levels");
-    let _ = writeln!(
-        s,
-        "\n## Which mesh limits the error\n\nMeasured, no model: from the finest grid diagonal point (level {finest} for both bodies), the error with the slave refined to level {} and with the master refined to it, each gain divided by the dofs the refinement adds (every quantity in `fits.csv`: the fitted terms C_b h_b^a_b at that point and a_b C_b h_b^a_b / (2 N_b), the model's gain per dof).\n",
-        res.fixed
-    );
-    for f in res.fits.iter().filter(|f| MAPPED.contains(&f.quantity)) {
-        let _ = writeln!(
-            s,
-            "- {} / {} / {}: {}.",
-            f.slave,
-            f.method,
-            f.quantity,
-            answer(res, f)
-        );
-    }
-    if res.slaves.len() > 1 {
-        let _ = writeln!(
-            s,
-            "\n## Which body should be the slave\n\nThe same meshes (level {finest} for both bodies) with each body carrying the constraint in turn:\n\n| method | quantity | {} | smaller error with slave |\n|---|---|{}---|",
-            res.slaves
+    doc.heading(2, "Which mesh limits the error")
+        .paragraph(format!(
+            "Measured, no model: from the finest grid diagonal point (level {finest} for both bodies), the error with the slave refined to level {} and with the master refined to it, each gain divided by the dofs the refinement adds (every quantity in `fits.csv`: the fitted terms C_b h_b^a_b at that point and a_b C_b h_b^a_b / (2 N_b), the model's gain per dof).",
+            res.fixed
+        ))
+        .list(
+            res.fits
                 .iter()
-                .map(|x| format!("slave '{x}'"))
-                .collect::<Vec<_>>()
-                .join(" | "),
-            "---|".repeat(res.slaves.len())
+                .filter(|f| MAPPED.contains(&f.quantity))
+                .map(|f| {
+                    format!(
+                        "{} / {} / {}: {}.",
+                        f.slave,
+                        f.method,
+                        f.quantity,
+                        answer(res, f)
+                    )
+                }),
         );
-        for &m in &res.methods {
-            for &q in &res.quantities {
-                let e: Vec<Option<f64>> = res
-                    .slaves
-                    .iter()
-                    .map(|x| res.error(x, m, q, [finest, finest]))
-                    .collect();
-                let shown: Vec<String> = e
-                    .iter()
-                    .map(|v| v.map_or("-".into(), |v| format!("{v:.3e}")))
-                    .collect();
-                let best = if e
-                    .iter()
-                    .all(|v| v.is_some_and(|v| v <= crate::verify::rates::ROUNDOFF))
-                {
-                    "both at round-off".to_string()
-                } else if shown.windows(2).all(|w| w[0] == w[1]) {
-                    "the same to the digits shown".to_string()
-                } else {
-                    e.iter()
-                        .enumerate()
-                        .filter_map(|(i, v)| v.map(|v| (i, v)))
-                        .min_by(|a, b| a.1.total_cmp(&b.1))
-                        .map(|(i, _)| res.slaves[i].clone())
-                        .unwrap_or_default()
-                };
-                let _ = writeln!(
-                    s,
-                    "| {m} | {q} | {} | {best} |",
-                    e.iter()
-                        .map(|v| v.map_or("-".into(), |v| format!("{v:.3e}")))
-                        .collect::<Vec<_>>()
-                        .join(" | ")
-                );
-            }
+}
+
+/// ## Which body should be the slave: the same meshes with each body carrying the
+/// constraint in turn.
+fn which_body_slave(doc: &mut Doc, res: &TwoSizeResult) {
+    let finest = *res.levels.last().expect("levels");
+    let mut header = vec!["method".to_string(), "quantity".to_string()];
+    header.extend(res.slaves.iter().map(|x| format!("slave '{x}'")));
+    header.push("smaller error with slave".into());
+    let mut table = Table::new(header);
+    for &m in &res.methods {
+        for &q in &res.quantities {
+            let e: Vec<Option<f64>> = res
+                .slaves
+                .iter()
+                .map(|x| res.error(x, m, q, [finest, finest]))
+                .collect();
+            let shown: Vec<String> = e
+                .iter()
+                .map(|v| v.map_or("-".into(), |v| format!("{v:.3e}")))
+                .collect();
+            let best = if e.iter().all(|v| v.is_some_and(|v| v <= ROUNDOFF)) {
+                "both at round-off".to_string()
+            } else if shown.windows(2).all(|w| w[0] == w[1]) {
+                "the same to the digits shown".to_string()
+            } else {
+                e.iter()
+                    .enumerate()
+                    .filter_map(|(i, v)| v.map(|v| (i, v)))
+                    .min_by(|a, b| a.1.total_cmp(&b.1))
+                    .map(|(i, _)| res.slaves[i].clone())
+                    .unwrap_or_default()
+            };
+            let mut cells = vec![m.to_string(), q.to_string()];
+            cells.extend(shown);
+            cells.push(best);
+            table.row(cells);
         }
-        let _ = writeln!(s);
     }
-    diagonal(res, &mut s);
-    let _ = writeln!(s, "## Maps and sweeps\n");
-    for slave in &res.slaves {
-        for &m in &res.methods {
-            let _ = writeln!(s, "![{m}, slave {slave}]({})\n", map_file(slave, m));
-        }
-        let _ = writeln!(s, "![sweeps, slave {slave}]({})\n", sweep_file(slave));
-    }
+    doc.heading(2, "Which body should be the slave")
+        .paragraph(format!(
+            "The same meshes (level {finest} for both bodies) with each body carrying the constraint in turn:"
+        ))
+        .table(&table);
+}
+
+/// ## Truth: the exact solution, or the matching-mesh reference per slave choice.
+fn truth(doc: &mut Doc, res: &TwoSizeResult) {
     match (&res.exact_quadrature, res.references.is_empty()) {
         (Some(points), _) => {
-            let _ = writeln!(
-                s,
-                "## Truth\n\nThe exact solution of scene `{}`, integrated with {points} x {points} Gauss points per triangle split along its kinks (as in the diagonal exact studies).\n",
+            doc.heading(2, "Truth").paragraph(format!(
+                "The exact solution of scene `{}`, integrated with {points} x {points} Gauss points per triangle split along its kinks (as in the diagonal exact studies).",
                 res.scene.name
-            );
+            ));
         }
         (None, false) => {
-            let _ = writeln!(
-                s,
-                "## Truth\n\nA reference on matching meshes per slave choice (the bodies are numbered by it):\n"
-            );
-            for (slave, r) in &res.references {
-                let _ = writeln!(
-                    s,
-                    "- slave '{slave}': level {} (h = {:.4}, {} dofs, {:.1} s), estimated error {:.3e} in the theorem norm (rate {:.2}).",
-                    r.level, r.h, r.dofs, r.wall_s, r.error, r.error_rate
-                );
-            }
-            let _ = writeln!(s);
+            doc.heading(2, "Truth")
+                .paragraph("A reference on matching meshes per slave choice (the bodies are numbered by it):")
+                .list(res.references.iter().map(|(slave, r)| {
+                    format!(
+                        "slave '{slave}': level {} (h = {:.4}, {} dofs, {:.1} s), estimated error {:.3e} in the theorem norm (rate {:.2}).",
+                        r.level, r.h, r.dofs, r.wall_s, r.error, r.error_rate
+                    )
+                }));
         }
         _ => {}
     }
-    let _ = writeln!(s, "## Provenance\n");
-    for (k, v) in &res.provenance {
-        let _ = writeln!(s, "- {k}: {v}");
-    }
-    let _ = writeln!(
-        s,
-        "\nData: `grid.csv` (every pair and quantity), `fits.csv` (every fit)."
-    );
-    s
 }
 
 /// What `study NAME` prints for a two-size study.
