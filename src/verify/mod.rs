@@ -14,6 +14,7 @@ pub mod quantity;
 pub mod rates;
 pub mod study_file;
 pub mod table;
+pub mod truth;
 
 use crate::case::Case;
 use crate::error::Result;

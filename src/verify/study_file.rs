@@ -1,9 +1,11 @@
 //! The TOML layout of a study file (studies/NAME.toml).
 
 use super::quantity::Quantity;
+use crate::analytical::Field;
 use crate::contact::Method;
 use crate::error::{Error, Result};
-use crate::solve::SolverKind;
+use crate::scene::Scene;
+use crate::solve::{Settings, SolverKind};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -515,4 +517,161 @@ impl StudyFile {
         }
         v
     }
+}
+
+/// A study file with its scene, read and checked.
+pub struct LoadedStudy {
+    /// The study's name (the file's stem): its report folder under reports/.
+    pub name: String,
+    /// The study file.
+    pub path: PathBuf,
+    /// Its text (part of every job's record key).
+    pub text: String,
+    /// Its contents, checked.
+    pub file: StudyFile,
+    /// The scene it names.
+    pub scene: Scene,
+    /// The time study's scene, where it is not the study's own.
+    pub time_scene: Option<Scene>,
+}
+
+/// A scene named by a study file: a path relative to the study file, else a built-in name.
+fn study_scene(path: &Path, name: &str) -> Result<Scene> {
+    let scene_path = path.parent().unwrap_or(Path::new(".")).join(name);
+    if scene_path.exists() {
+        Scene::load(&scene_path.display().to_string())
+    } else {
+        Scene::load(name)
+    }
+}
+
+impl LoadedStudy {
+    /// Read the study file `name` (a built-in name or a path) and its scenes, and check that
+    /// an exact solution covers every quantity the study measures against it.
+    pub fn load(name: &str) -> Result<Self> {
+        let path = resolve(name).ok_or_else(|| {
+            Error::input(
+                name,
+                "study",
+                "no such study file; `study list` lists the built-in studies",
+            )
+        })?;
+        let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+        let file = StudyFile::from_toml(&text, &path)?;
+        let scene = study_scene(&path, &file.scene)?;
+        let time_scene = match file.time.as_ref().and_then(|t| t.scene.as_ref()) {
+            Some(name) => Some(study_scene(&path, name)?),
+            None => None,
+        };
+        if file.reference.exact {
+            check_covered(&file, &scene, &path)?;
+            if let Some(ts) = &time_scene {
+                check_time_covered(ts, &path)?;
+            }
+        }
+        Ok(LoadedStudy {
+            name: path.file_stem().unwrap().to_string_lossy().to_string(),
+            path,
+            text,
+            file,
+            scene,
+            time_scene,
+        })
+    }
+
+    /// The reference level: the finest study level plus `levels_above`.
+    pub fn reference_level(&self) -> usize {
+        self.file.mesh.levels.last().unwrap() + self.file.reference.levels_above
+    }
+}
+
+/// What the exact solution must give for quantity `q`.
+fn needs(q: Quantity) -> &'static [Field] {
+    match q {
+        Quantity::Theorem => &[Field::Displacement, Field::Stress],
+        Quantity::H1U | Quantity::L2U => &[Field::Displacement],
+        // The truth has no penetration; without an exact displacement the study's own
+        // largest displacement makes it relative.
+        Quantity::MaxPenetration | Quantity::L2Penetration => &[],
+        Quantity::L2Stress => &[Field::Stress],
+        Quantity::L2Pressure
+        | Quantity::ContactEdge
+        | Quantity::PressureResultant
+        | Quantity::PressureWeighted
+        | Quantity::PressureOscillation => &[Field::Pressure],
+        Quantity::BandStress => &[Field::Stress],
+    }
+}
+
+/// Every quantity of an exact study must be covered by the scene's exact solution.
+fn check_covered(file: &StudyFile, scene: &Scene, path: &Path) -> Result<()> {
+    let Some(exact) = scene.exact.as_deref() else {
+        return Err(Error::input(
+            path,
+            "reference.exact",
+            format!(
+                "scene '{}' gives no exact solution; add an [exact] table to {} or measure against a reference solve (reference.exact = false)",
+                scene.name,
+                scene.file.display()
+            ),
+        ));
+    };
+    for &q in &file.quantities {
+        if let Some(f) = needs(q).iter().find(|f| !exact.gives(**f)) {
+            return Err(Error::input(
+                path,
+                "quantities",
+                format!(
+                    "quantity '{q}' needs the exact solution's {} (`{}` in the scene's [exact] table), which scene '{}' does not give; add it there or remove '{q}'",
+                    &f.key()["exact.".len()..],
+                    f.key(),
+                    scene.name
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The time study measures the theorem norm: its scene's exact solution must give the
+/// displacement and the stress.
+fn check_time_covered(scene: &Scene, path: &Path) -> Result<()> {
+    let covered = scene
+        .exact
+        .as_deref()
+        .is_some_and(|e| needs(Quantity::Theorem).iter().all(|f| e.gives(*f)));
+    if covered {
+        return Ok(());
+    }
+    Err(Error::input(
+        path,
+        "time.scene",
+        format!(
+            "scene '{}' gives no exact displacement and stress, which the time study measures against (reference.exact = true); add them to its [exact] table or choose another scene",
+            scene.name
+        ),
+    ))
+}
+
+/// Where a study's numbers come from: gmsh, the .geo, the solver, the cores, the commit.
+pub fn provenance(
+    study: &LoadedStudy,
+    mesh: &crate::mesh::gmsh::GeneratedMesh,
+) -> BTreeMap<String, String> {
+    let geo = study.scene.geo.file_name().unwrap().to_string_lossy();
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    BTreeMap::from([
+        ("gmsh".into(), mesh.gmsh_version.clone()),
+        ("geo".into(), format!("{geo} (sha256 {})", mesh.geo_hash)),
+        (
+            "solver".into(),
+            format!(
+                "{} (tolerance {:.0e})",
+                study.file.solver,
+                Settings::default().tol
+            ),
+        ),
+        ("cores".into(), cores.to_string()),
+        ("commit".into(), crate::verify::commit()),
+    ])
 }

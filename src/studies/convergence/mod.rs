@@ -48,30 +48,29 @@ impl Outcome for StudyResult {
     }
 }
 
-use crate::analytical::{Exact, Field};
+use crate::analytical::Exact;
 use crate::case::Case;
 use crate::contact::Method;
 use crate::error::{Error, Result};
 use crate::metrics;
 use crate::progress::Progress;
 use crate::scene::Scene;
-use crate::solve::{Settings, Solution, inf_norm};
-use crate::verify::contact_error::{
-    self, ContactStep, TruthPressure, contact_step, reference_profile,
-};
+use crate::solve::{Solution, inf_norm};
 use crate::verify::exact_error::{
-    ExactComparison, ExactDifference, exact_profiles, max_exact_displacement,
+    ExactComparison, exact_profiles, max_exact_displacement,
 };
 use crate::verify::jobs::{self, Job, JobId, Mode, Solved};
-use crate::verify::norms::{self, Comparison, SquaredNorms};
-use crate::verify::quantity::{Differences, Quantity};
+use crate::verify::norms::{self};
+use crate::verify::quantity::Quantity;
 use crate::verify::rates::{self, Assessment, LevelError, Verdict};
-use crate::verify::study_file::{StudyFile, Threshold};
+use crate::verify::study_file::{LoadedStudy, StudyFile, Threshold, provenance};
+pub use crate::verify::truth::{Reference, estimated_reference_error};
+use crate::verify::truth::{Truth, reference};
 pub use crate::verify::table::{ErrorRecord, join};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize, Serializer};
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 /// The fitted rate of one quantity of one cone.
@@ -188,22 +187,6 @@ pub struct DeformedMesh {
     pub magnification: f64,
 }
 
-/// The reference solution's facts.
-#[derive(Debug, Clone, Copy)]
-pub struct Reference {
-    /// Mesh level.
-    pub level: usize,
-    /// Max element diameter (length).
-    pub h: f64,
-    /// Free dofs.
-    pub dofs: usize,
-    /// Wall time of its solve (s).
-    pub wall_s: f64,
-    /// Its estimated relative error in the theorem norm.
-    pub error: f64,
-    /// The rate p of the nested-space model used for that estimate.
-    pub error_rate: f64,
-}
 
 /// One run of the time study.
 #[derive(Debug, Clone, Copy, Serialize, Deserialize)]
@@ -246,9 +229,9 @@ pub struct TimeStudy {
 /// Everything a study measured.
 #[derive(Debug, Clone)]
 pub struct StudyResult {
-    /// Study name.
+    /// LoadedStudy name.
     pub name: String,
-    /// Study description.
+    /// LoadedStudy description.
     pub description: String,
     /// The parsed study file.
     pub file: StudyFile,
@@ -308,132 +291,11 @@ impl StudyResult {
     }
 }
 
-/// A study file with its scene, read and checked.
-pub(crate) struct Study {
-    pub(crate) name: String,
-    pub(crate) path: PathBuf,
-    pub(crate) text: String,
-    pub(crate) file: StudyFile,
-    pub(crate) scene: Scene,
-    /// The time study's scene, where it is not the study's own.
-    pub(crate) time_scene: Option<Scene>,
-}
 
-/// A scene named by a study file: a path relative to the study file, else a built-in name.
-fn study_scene(path: &Path, name: &str) -> Result<Scene> {
-    let scene_path = path.parent().unwrap_or(Path::new(".")).join(name);
-    if scene_path.exists() {
-        Scene::load(&scene_path.display().to_string())
-    } else {
-        Scene::load(name)
-    }
-}
 
-impl Study {
-    pub(crate) fn load(name: &str) -> Result<Self> {
-        let path = crate::verify::study_file::resolve(name).ok_or_else(|| {
-            Error::input(
-                name,
-                "study",
-                "no such study file; `study list` lists the built-in studies",
-            )
-        })?;
-        let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
-        let file = StudyFile::from_toml(&text, &path)?;
-        let scene = study_scene(&path, &file.scene)?;
-        let time_scene = match file.time.as_ref().and_then(|t| t.scene.as_ref()) {
-            Some(name) => Some(study_scene(&path, name)?),
-            None => None,
-        };
-        if file.reference.exact {
-            check_covered(&file, &scene, &path)?;
-            if let Some(ts) = &time_scene {
-                check_time_covered(ts, &path)?;
-            }
-        }
-        Ok(Study {
-            name: path.file_stem().unwrap().to_string_lossy().to_string(),
-            path,
-            text,
-            file,
-            scene,
-            time_scene,
-        })
-    }
 
-    /// The reference level: the finest study level plus `levels_above`.
-    pub(crate) fn reference_level(&self) -> usize {
-        self.file.mesh.levels.last().unwrap() + self.file.reference.levels_above
-    }
-}
 
-/// What the exact solution must give for quantity `q`.
-fn needs(q: Quantity) -> &'static [Field] {
-    match q {
-        Quantity::Theorem => &[Field::Displacement, Field::Stress],
-        Quantity::H1U | Quantity::L2U => &[Field::Displacement],
-        // The truth has no penetration; without an exact displacement the study's own
-        // largest displacement makes it relative.
-        Quantity::MaxPenetration | Quantity::L2Penetration => &[],
-        Quantity::L2Stress => &[Field::Stress],
-        Quantity::L2Pressure
-        | Quantity::ContactEdge
-        | Quantity::PressureResultant
-        | Quantity::PressureWeighted
-        | Quantity::PressureOscillation => &[Field::Pressure],
-        Quantity::BandStress => &[Field::Stress],
-    }
-}
 
-/// Every quantity of an exact study must be covered by the scene's exact solution.
-fn check_covered(file: &StudyFile, scene: &Scene, path: &Path) -> Result<()> {
-    let Some(exact) = scene.exact.as_deref() else {
-        return Err(Error::input(
-            path,
-            "reference.exact",
-            format!(
-                "scene '{}' gives no exact solution; add an [exact] table to {} or measure against a reference solve (reference.exact = false)",
-                scene.name,
-                scene.file.display()
-            ),
-        ));
-    };
-    for &q in &file.quantities {
-        if let Some(f) = needs(q).iter().find(|f| !exact.gives(**f)) {
-            return Err(Error::input(
-                path,
-                "quantities",
-                format!(
-                    "quantity '{q}' needs the exact solution's {} (`{}` in the scene's [exact] table), which scene '{}' does not give; add it there or remove '{q}'",
-                    &f.key()["exact.".len()..],
-                    f.key(),
-                    scene.name
-                ),
-            ));
-        }
-    }
-    Ok(())
-}
-
-/// The time study measures the theorem norm: its scene's exact solution must give the
-/// displacement and the stress.
-fn check_time_covered(scene: &Scene, path: &Path) -> Result<()> {
-    let covered = scene
-        .exact
-        .as_deref()
-        .is_some_and(|e| needs(Quantity::Theorem).iter().all(|f| e.gives(*f)));
-    if covered {
-        return Ok(());
-    }
-    Err(Error::input(
-        path,
-        "time.scene",
-        format!(
-            "scene '{}' gives no exact displacement and stress, which the time study measures against (reference.exact = true); add them to its [exact] table or choose another scene",
-            scene.name
-        ),
-    ))
-}
 
 /// The study's solves, with a named handle for each.
 struct Plan {
@@ -494,7 +356,7 @@ impl JobList {
 impl Plan {
     /// Plan every solve and check what can be checked before the first one: the reference
     /// meshes must match on Gamma_C.
-    fn new(study: &Study) -> Result<Self> {
+    fn new(study: &LoadedStudy) -> Result<Self> {
         let sf = &study.file;
         let mut jobs = JobList::default();
         let reference = Plan::reference(study, &mut jobs);
@@ -523,7 +385,7 @@ impl Plan {
     }
 
     /// The reference's three levels, coarsest first (none against the exact solution).
-    fn reference(study: &Study, jobs: &mut JobList) -> Option<[JobId; 3]> {
+    fn reference(study: &LoadedStudy, jobs: &mut JobList) -> Option<[JobId; 3]> {
         let sf = &study.file;
         let parameters = sf.reference_parameters();
         let r = study.reference_level();
@@ -538,7 +400,7 @@ impl Plan {
     /// Every cone on every study level of a mesh family, cone by cone; `suffix` ends each
     /// label.
     fn family(
-        study: &Study,
+        study: &LoadedStudy,
         jobs: &mut JobList,
         params: &[(String, f64)],
         suffix: &str,
@@ -560,7 +422,7 @@ impl Plan {
 
     /// The time study on its scene: its reference in time (none against the exact
     /// solution), then one run per step count.
-    fn time_study(study: &Study, jobs: &mut JobList) -> Option<TimeJobs> {
+    fn time_study(study: &LoadedStudy, jobs: &mut JobList) -> Option<TimeJobs> {
         let sf = &study.file;
         let family = sf.family_parameters();
         let scene = usize::from(study.time_scene.is_some());
@@ -585,7 +447,7 @@ impl Plan {
 
 /// The reference meshes must match on Gamma_C. Uniform splitting keeps matching traces
 /// matching, so the coarsest reference level (a cheap mesh) decides for all three.
-fn check_reference_matches(study: &Study, coarsest: &Job) -> Result<()> {
+fn check_reference_matches(study: &LoadedStudy, coarsest: &Job) -> Result<()> {
     let case = Case::build(
         &study.scene,
         coarsest.level,
@@ -602,110 +464,10 @@ fn check_reference_matches(study: &Study, coarsest: &Job) -> Result<()> {
     Ok(())
 }
 
-/// The reference solution with what every level is measured against.
-pub(crate) struct ReferenceSolution {
-    pub(crate) case: Case,
-    pub(crate) solution: Solution,
-    /// Squared norms per step t_1..t_N.
-    norms: Vec<SquaredNorms>,
-    /// Largest |u| over the history (length).
-    max_displacement: f64,
-    pub(crate) facts: Reference,
-    /// Each quantity's estimated own error (the same nested-space model per quantity).
-    quantity_errors: BTreeMap<Quantity, f64>,
-}
 
-/// The estimated relative error of a reference R and the rate p of the model, from its
-/// distances d1 = d(R-1, R) and d2 = d(R-2, R) to its two coarser nested levels: with
-/// e_L = C h_L^p and d(L, R)^2 = e_L^2 - e_R^2, (d2 / d1)^2 = 4^p + 1 and
-/// e_R = d1 / sqrt(4^p - 1). p is kept in [0.25, 3].
-pub fn estimated_reference_error(d1: f64, d2: f64) -> (f64, f64) {
-    let p = ((d2 / d1).powi(2) - 1.0)
-        .max(1.0 + 1e-12)
-        .log(4.0)
-        .clamp(0.25, 3.0);
-    (d1 / (4f64.powf(p) - 1.0).sqrt(), p)
-}
 
-/// Step 2: the reference and the estimate of its own error. The reference levels are nested
-/// conforming spaces, so their errors are close to orthogonal: d(L, R)^2 = e_L^2 - e_R^2 with
-/// e_L = C h_L^p (measured on the rates scene: d(R-2,R)/d(R-1,R) = 2.24 = sqrt(5), i.e.
-/// p = 1). Hence (d(R-2,R)/d(R-1,R))^2 = 4^p + 1 and e_R = d(R-1,R) / sqrt(4^p - 1).
-pub(crate) fn reference(ids: [JobId; 3], solved: &mut Solved, level: usize) -> ReferenceSolution {
-    let [coarser2, coarser1, finest] = ids.map(|id| solved.take(id));
-    let (case, solution) = finest;
-    let norms = solution
-        .states
-        .iter()
-        .skip(1)
-        .map(|s| norms::norms(&case.problem.model, s))
-        .collect();
-    let max_displacement = solution
-        .states
-        .iter()
-        .map(|s| inf_norm(&s.u))
-        .fold(0.0f64, f64::max);
-    let facts = Reference {
-        level,
-        h: case.h,
-        dofs: case.problem.model.n_free,
-        wall_s: solution.wall_s,
-        error: 0.0,
-        error_rate: 0.0,
-    };
-    let mut reference = ReferenceSolution {
-        case,
-        solution,
-        norms,
-        max_displacement,
-        facts,
-        quantity_errors: BTreeMap::new(),
-    };
-    // Every quantity's distances of the two coarser levels to the reference.
-    let d1 = relative_errors(&coarser1.0, &coarser1.1, &reference);
-    let d2 = relative_errors(&coarser2.0, &coarser2.1, &reference);
-    for q in Quantity::ALL {
-        let (error, rate) = estimated_reference_error(d1[&q], d2[&q]);
-        if q == Quantity::Theorem {
-            (reference.facts.error, reference.facts.error_rate) = (error, rate);
-        }
-        reference
-            .quantity_errors
-            .insert(q, if d1[&q] > 0.0 { error } else { 0.0 });
-    }
-    reference
-}
 
-/// What the levels are measured against.
-pub(crate) enum Truth<'s> {
-    /// A fine reference solve on matching meshes.
-    Solved(ReferenceSolution),
-    /// The scene's exact solution, with the Gauss points per direction of the rule.
-    Exact(&'s Exact, usize),
-}
 
-impl Truth<'_> {
-    /// Every quantity's relative error of one solved level.
-    pub(crate) fn relative_errors(&self, case: &Case, sol: &Solution) -> BTreeMap<Quantity, f64> {
-        match self {
-            Truth::Solved(reference) => relative_errors(case, sol, reference),
-            Truth::Exact(exact, points) => exact_errors(case, sol, exact, *points),
-        }
-    }
-
-    /// The estimated error of the truth in the theorem norm (0 for the exact solution).
-    pub(crate) fn error(&self) -> f64 {
-        self.quantity_error(Quantity::Theorem)
-    }
-
-    /// The estimated error of the truth in quantity `q` (0 for the exact solution).
-    pub(crate) fn quantity_error(&self, q: Quantity) -> f64 {
-        match self {
-            Truth::Solved(r) => r.quantity_errors[&q],
-            Truth::Exact(..) => 0.0,
-        }
-    }
-}
 
 /// What step 3 measured.
 #[derive(Default)]
@@ -872,58 +634,7 @@ fn measure_variants(
     Ok(out)
 }
 
-/// Every quantity's relative error of one solved level against the exact solution.
-fn exact_errors(
-    case: &Case,
-    sol: &Solution,
-    exact: &Exact,
-    points: usize,
-) -> BTreeMap<Quantity, f64> {
-    let cmp = ExactComparison::new(exact, points);
-    let diffs: Vec<ExactDifference> = sol
-        .states
-        .iter()
-        .skip(1)
-        .map(|s| cmp.difference(&case.problem, s))
-        .collect();
-    let fields: Vec<SquaredNorms> = diffs.iter().map(|d| d.difference).collect();
-    let reference: Vec<SquaredNorms> = diffs.iter().map(|d| d.exact).collect();
-    let pressure: Vec<(f64, f64)> = diffs.iter().map(|d| d.pressure).collect();
-    let band_stress: Vec<f64> = diffs.iter().map(|d| d.band_stress).collect();
-    let contact: Vec<ContactStep> = sol
-        .states
-        .iter()
-        .skip(1)
-        .map(|s| contact_step(&case.problem, s, &TruthPressure::Exact(exact, s.time)))
-        .collect();
-    let penetration = history_penetration(case, sol);
-    Differences {
-        fields: &fields,
-        reference: &reference,
-        pressure: &pressure,
-        penetration,
-        reference_displacement: match exact.displacement {
-            Some(_) => diffs.iter().map(|d| d.max_displacement).fold(0.0, f64::max),
-            None => sol
-                .states
-                .iter()
-                .map(|s| inf_norm(&s.u))
-                .fold(0.0, f64::max),
-        },
-        contact: &contact,
-        band_stress: &band_stress,
-        contact_length: case.problem.interface.length(),
-    }
-    .relative()
-}
 
-/// The largest interpenetration over a solution's history (length).
-fn history_penetration(case: &Case, sol: &Solution) -> f64 {
-    sol.states
-        .iter()
-        .map(|s| metrics::max_penetration(&case.problem, s))
-        .fold(0.0f64, f64::max)
-}
 
 /// The exact pressure and gap along Gamma_C at time `t`, where the solution gives them.
 fn exact_profile_points(case: &Case, exact: &Exact, t: f64, out: &mut Measured) {
@@ -947,43 +658,6 @@ fn exact_profile_points(case: &Case, exact: &Exact, t: f64, out: &mut Measured) 
     }
 }
 
-/// Every quantity's relative error of one solved level against the reference.
-fn relative_errors(
-    case: &Case,
-    sol: &Solution,
-    reference: &ReferenceSolution,
-) -> BTreeMap<Quantity, f64> {
-    let (rcase, rsol) = (&reference.case, &reference.solution);
-    let (model, rmodel) = (&case.problem.model, &rcase.problem.model);
-    let cmp = Comparison::new(model, rmodel);
-    let steps = || sol.states.iter().zip(&rsol.states).skip(1);
-    let fields: Vec<SquaredNorms> = steps()
-        .map(|(s, r)| cmp.difference(model, s, rmodel, r))
-        .collect();
-    let pressure: Vec<(f64, f64)> = steps()
-        .map(|(s, r)| norms::pressure_difference(&case.problem, s, &rcase.problem, r))
-        .collect();
-    let band = contact_error::band(&case.problem);
-    let band_stress: Vec<f64> = steps().map(|(s, r)| cmp.band_stress(s, r, &band)).collect();
-    let contact: Vec<ContactStep> = steps()
-        .map(|(s, r)| {
-            let truth = reference_profile(&case.problem.interface, &rcase.problem, r);
-            contact_step(&case.problem, s, &truth)
-        })
-        .collect();
-    let penetration = history_penetration(case, sol);
-    Differences {
-        fields: &fields,
-        reference: &reference.norms,
-        pressure: &pressure,
-        penetration,
-        reference_displacement: reference.max_displacement,
-        contact: &contact,
-        band_stress: &band_stress,
-        contact_length: case.problem.interface.length(),
-    }
-    .relative()
-}
 
 fn level_info(case: &Case, sol: &Solution, method: Method, flagged: bool) -> LevelInfo {
     let pieces = &case.problem.interface.pieces;
@@ -1113,7 +787,7 @@ fn fit_rates(
 /// step (`points`: the Gauss points per direction of the error rule). The rate in k is
 /// judged as a rate in h is ([`rates::assess`]: the same windows and verdicts).
 fn time_study(
-    study: &Study,
+    study: &LoadedStudy,
     plan: &Plan,
     solved: &mut Solved,
     points: usize,
@@ -1233,28 +907,6 @@ fn time_reference_error(
     (error / norm, norm)
 }
 
-/// Step 6: where the numbers come from.
-pub(crate) fn provenance(
-    study: &Study,
-    mesh: &crate::mesh::gmsh::GeneratedMesh,
-) -> BTreeMap<String, String> {
-    let geo = study.scene.geo.file_name().unwrap().to_string_lossy();
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    BTreeMap::from([
-        ("gmsh".into(), mesh.gmsh_version.clone()),
-        ("geo".into(), format!("{geo} (sha256 {})", mesh.geo_hash)),
-        (
-            "solver".into(),
-            format!(
-                "{} (tolerance {:.0e})",
-                study.file.solver,
-                Settings::default().tol
-            ),
-        ),
-        ("cores".into(), cores.to_string()),
-        ("commit".into(), crate::verify::commit()),
-    ])
-}
 
 /// Run the convergence study `name` (built-in name or path).
 pub fn run(name: &str) -> Result<StudyResult> {
@@ -1266,7 +918,7 @@ pub fn run(name: &str) -> Result<StudyResult> {
 pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
     let t0 = Instant::now();
     // 1. Plan the solves and run them (a shard stores its records and stops there).
-    let study = Study::load(name)?;
+    let study = LoadedStudy::load(name)?;
     let sf = &study.file;
     let plan = Plan::new(&study)?;
     let Some(mut solved) = solve_all(&study, &plan, mode)? else {
@@ -1323,7 +975,7 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
 
 /// Every job of the plan in `mode`: all of them, one shard's (records only: None), or the
 /// records of all shards.
-fn solve_all(study: &Study, plan: &Plan, mode: Mode) -> Result<Option<Solved>> {
+fn solve_all(study: &LoadedStudy, plan: &Plan, mode: Mode) -> Result<Option<Solved>> {
     let progress = Progress::new(plan.jobs.len() as u64, &study.name);
     let scenes: Vec<&Scene> = std::iter::once(&study.scene)
         .chain(study.time_scene.as_ref())
@@ -1353,7 +1005,7 @@ fn solve_all(study: &Study, plan: &Plan, mode: Mode) -> Result<Option<Solved>> {
 
 /// What every level is measured against: the reference solve (with its own error), or the
 /// scene's exact solution.
-fn truth<'s>(study: &'s Study, plan: &Plan, solved: &mut Solved) -> Truth<'s> {
+fn truth<'s>(study: &'s LoadedStudy, plan: &Plan, solved: &mut Solved) -> Truth<'s> {
     match plan.reference {
         Some(ids) => Truth::Solved(reference(ids, solved, study.reference_level())),
         None => Truth::Exact(

@@ -59,7 +59,8 @@ use crate::error::{Error, Result};
 use crate::progress::Progress;
 use crate::scene::Scene;
 use crate::solve::Solution;
-use crate::studies::convergence::{Reference, Study, Truth, provenance, reference};
+use crate::verify::study_file::{LoadedStudy, provenance};
+use crate::verify::truth::{Reference, Truth, reference};
 use crate::verify::jobs::{self, Job, JobId, Mode};
 use crate::verify::quantity::Quantity;
 use crate::verify::rates::{self, Assessment, LevelError, PowerSumFit};
@@ -122,9 +123,9 @@ pub struct SizeFit {
 /// Everything a two-size study measured.
 #[derive(Debug, Clone)]
 pub struct TwoSizeResult {
-    /// Study name.
+    /// LoadedStudy name.
     pub name: String,
-    /// Study description.
+    /// LoadedStudy description.
     pub description: String,
     /// The scene (as its file names the slave).
     pub scene: Scene,
@@ -235,7 +236,7 @@ struct Plan {
 }
 
 impl Plan {
-    fn new(study: &Study, slaves: usize, fixed: usize) -> Self {
+    fn new(study: &LoadedStudy, slaves: usize, fixed: usize) -> Self {
         let sf = &study.file;
         let family = sf.family_parameters();
         let reference_parameters = sf.reference_parameters();
@@ -329,7 +330,7 @@ struct PairRun {
 /// Run the two-size study `name` (built-in name or path).
 pub fn run(name: &str) -> Result<TwoSizeResult> {
     let t0 = Instant::now();
-    let study = Study::load(name)?;
+    let study = LoadedStudy::load(name)?;
     let spec = study.file.two_size.as_ref().ok_or_else(|| {
         Error::input(
             &study.path,
@@ -386,7 +387,7 @@ pub fn run(name: &str) -> Result<TwoSizeResult> {
 }
 
 /// The slave choices: the study's, or the scene's own slave surface.
-fn slave_choices(study: &Study, spec: &TwoSizeSpec) -> Vec<String> {
+fn slave_choices(study: &LoadedStudy, spec: &TwoSizeSpec) -> Vec<String> {
     if spec.slaves.is_empty() {
         vec![study.scene.bodies[0].surface.clone()]
     } else {
@@ -395,7 +396,7 @@ fn slave_choices(study: &Study, spec: &TwoSizeSpec) -> Vec<String> {
 }
 
 /// Every planned solve, with progress on the console.
-fn solve_all(study: &Study, plan: &Plan, scenes: &[Scene]) -> Result<jobs::Solved> {
+fn solve_all(study: &LoadedStudy, plan: &Plan, scenes: &[Scene]) -> Result<jobs::Solved> {
     let progress = Progress::new(plan.jobs.len() as u64, &study.name);
     let scene_refs: Vec<&Scene> = scenes.iter().collect();
     let outputs = jobs::execute(
@@ -412,7 +413,7 @@ fn solve_all(study: &Study, plan: &Plan, scenes: &[Scene]) -> Result<jobs::Solve
 
 /// Each slave choice's truth: its reference solve, or its scene's exact solution.
 fn truths<'s>(
-    study: &Study,
+    study: &LoadedStudy,
     plan: &Plan,
     scenes: &'s [Scene],
     solved: &mut jobs::Solved,
@@ -436,7 +437,7 @@ fn truths<'s>(
 /// Every pair's errors against its slave choice's truth, one point per quantity (an error
 /// that is not finite stops the study).
 fn measure(
-    study: &Study,
+    study: &LoadedStudy,
     slaves: &[String],
     runs: &[PairRun],
     truths: &[Truth],
@@ -477,7 +478,7 @@ fn measure(
 
 /// The fits of every slave choice, cone and quantity.
 fn fit_all(
-    study: &Study,
+    study: &LoadedStudy,
     spec: &TwoSizeSpec,
     slaves: &[String],
     points: &[SizePoint],
