@@ -131,3 +131,114 @@ fn every_fitted_rate_agrees_with_its_last_successive_rates() {
     println!("{checked} fitted rates checked");
     assert!(checked > 20);
 }
+
+/// What a headline row states, one (method, quantity, text) per cell part: the contact
+/// quantities that separate the cones ("`l2_pressure` 63x (mortar 1.85, nts not
+/// converging)", "`band_stress` mortar exact (nts 0.60)") and the judged rate of each cone
+/// ("0.981 ± 0.005 fitted" of the theorem norm, "`l2_stress` 0.601 ± 0.032 fitted").
+fn row_claims(row: &str) -> Vec<(String, String, String)> {
+    let cells: Vec<&str> = row
+        .trim()
+        .trim_matches('|')
+        .split('|')
+        .map(str::trim)
+        .collect();
+    assert_eq!(cells.len(), 5, "a headline row has 5 cells: {row}");
+    let mut claims = Vec::new();
+    if let Some((_, items)) = cells[1].split_once(": ") {
+        for item in items.split("), ") {
+            let item = item.trim_end_matches(')');
+            let mut parts = item.splitn(3, '`');
+            let (_, quantity, after) = (parts.next(), parts.next().unwrap(), parts.next().unwrap());
+            let (head, inner) = after.trim().split_once(" (").unwrap();
+            for method in ["mortar", "nts"] {
+                if head == format!("{method} exact") {
+                    claims.push((method.into(), quantity.into(), "exact".into()));
+                }
+            }
+            for part in inner.split(", ") {
+                let (method, text) = part.split_once(' ').unwrap();
+                claims.push((method.into(), quantity.into(), text.into()));
+            }
+        }
+    }
+    for (method, cell) in [("mortar", cells[3]), ("nts", cells[4])] {
+        let (quantity, text) = match cell.strip_prefix('`') {
+            Some(rest) => rest.split_once("` ").unwrap(),
+            None => ("theorem", cell),
+        };
+        if text != "not measured" {
+            claims.push((method.into(), quantity.into(), text.into()));
+        }
+    }
+    claims
+}
+
+/// Whether `text` says what the row `r` of rates.csv supports: its rate (and standard
+/// error) where the verdict is fitted or drifting, "exact" at round-off, else the verdict.
+fn states(r: &RateRecord, text: &str) -> bool {
+    let words: Vec<&str> = text.split_whitespace().collect();
+    let rounded = |v: f64, token: &str| {
+        let decimals = token.split_once('.').map_or(0, |(_, d)| d.len());
+        decimals >= 2 && token == format!("{v:.decimals$}")
+    };
+    match (r.verdict, r.rate, r.stderr) {
+        (Verdict::Fitted | Verdict::Drifting, Some(rate), Some(se)) => match words.as_slice() {
+            [v] => r.verdict == Verdict::Fitted && rounded(rate, v),
+            [v, "drifting"] => r.verdict == Verdict::Drifting && rounded(rate, v),
+            [v, "±", s, verdict] => {
+                rounded(rate, v) && rounded(se, s) && *verdict == r.verdict.name()
+            }
+            _ => false,
+        },
+        (Verdict::RoundOff, _, _) => text == "exact" || text == "exact (round-off)",
+        (v, _, _) => text == v.name(),
+    }
+}
+
+/// The claims of `row` that rates.csv's row of the same method and quantity does not
+/// support.
+fn unsupported(row: &str, rates: &[RateRecord]) -> Vec<String> {
+    row_claims(row)
+        .into_iter()
+        .filter(|(m, q, text)| {
+            !rates
+                .iter()
+                .find(|r| r.method.name() == m && r.quantity.name() == q)
+                .is_some_and(|r| states(r, text))
+        })
+        .map(|(m, q, text)| format!("{m} {q}: '{text}'"))
+        .collect()
+}
+
+/// Each rate, standard error and verdict in the headline table is the one of its own
+/// method and quantity in that study's rates.csv (not just some row's), and a cell
+/// with the cones swapped is refused.
+#[test]
+fn headline_cells_state_their_own_rows_rates() {
+    let text = headline(&root().join("reports")).unwrap();
+    let mut checked = 0;
+    for (name, _) in HEADLINE {
+        let row = text
+            .lines()
+            .find(|l| l.starts_with(&format!("| [`{name}`]")))
+            .unwrap_or_else(|| panic!("no headline row for {name}"));
+        let rates: Vec<RateRecord> =
+            read(&root().join("reports").join(name).join("rates.csv")).unwrap();
+        let wrong = unsupported(row, &rates);
+        assert!(
+            wrong.is_empty(),
+            "{name}: not what rates.csv says: {wrong:?}\n{row}"
+        );
+        checked += row_claims(row).len();
+        if name == "rates-exact" {
+            let swapped = row
+                .replace("mortar", "\u{0}")
+                .replace("nts", "mortar")
+                .replace('\u{0}', "nts");
+            assert!(!unsupported(&swapped, &rates).is_empty(), "{swapped}");
+        }
+    }
+    println!("{checked} headline cells checked");
+    assert!(checked >= 20);
+}
