@@ -27,7 +27,7 @@ use contact_rates::fe::FIXED;
 use contact_rates::material::{Material, Stress};
 use contact_rates::quadrature;
 use contact_rates::scene::Scene;
-use contact_rates::studies::convergence as study;
+use contact_rates::studies::convergence;
 use contact_rates::verify::{quantity::Quantity, rates::Verdict};
 
 /// Stress, strain (tensor components) and source of body `b` at (x, y, t).
@@ -266,7 +266,7 @@ fn a_viscoplastic_body_without_stress_and_a_non_symmetric_stress_are_refused() {
 #[test]
 fn quick_viscoplastic_exact_study_meets_the_thresholds_and_its_rate_in_k_is_backward_eulers() {
     contact_rates::init();
-    let res = study::run("rates-exact-vp-quick").unwrap();
+    let res = convergence::run("rates-exact-vp-quick").unwrap();
     for r in res.rates.iter().filter(|r| r.quantity == Quantity::Theorem) {
         common::assert_rate_passes(r, &[0, 1, 2]);
     }

@@ -7,7 +7,7 @@
 mod common;
 
 use contact_rates::contact::Method;
-use contact_rates::studies::{Study, convergence as study};
+use contact_rates::studies::{Study, convergence};
 use contact_rates::verify::{
     jobs::Mode,
     quantity::Quantity,
@@ -18,7 +18,7 @@ use contact_rates::verify::{
 #[test]
 fn quick_rates_study_meets_the_theorem_thresholds() {
     contact_rates::init();
-    let res = study::run("rates-quick").unwrap();
+    let res = convergence::run("rates-quick").unwrap();
     let reference = res.reference.expect("a reference solve");
     let (ref_err, p) = (reference.error, reference.error_rate);
     println!("reference error estimate {ref_err:.3e} (fitted p = {p:.2})");
@@ -54,16 +54,16 @@ fn quick_rates_study_meets_the_theorem_thresholds() {
     // The same study spread over two shards and merged from their records gives the same
     // errors and rates to the last bit (the jobs are independent and deterministic).
     assert!(
-        study::run_mode("rates-quick", Mode::Shard(1, 2))
+        convergence::run_mode("rates-quick", Mode::Shard(1, 2))
             .unwrap()
             .is_none()
     );
     assert!(
-        study::run_mode("rates-quick", Mode::Shard(2, 2))
+        convergence::run_mode("rates-quick", Mode::Shard(2, 2))
             .unwrap()
             .is_none()
     );
-    let merged = study::run_mode("rates-quick", Mode::Merge)
+    let merged = convergence::run_mode("rates-quick", Mode::Merge)
         .unwrap()
         .unwrap();
     assert_eq!(res.errors.len(), merged.errors.len());

@@ -38,7 +38,8 @@ pub struct Kind {
 pub trait Outcome {
     /// Write the report into `dir` (normally reports/NAME), all or nothing.
     fn write(&self, dir: &Path) -> Result<()>;
-    /// What the console shows after the report was written into `dir`.
+    /// What the console shows after the report was written into `dir`: whole lines, each
+    /// ending in a newline, the last naming the report (the CLI prints it as it is).
     fn console(&self, dir: &Path) -> String;
     /// Warnings about the scene, for the user.
     fn warnings(&self) -> &[String] {

@@ -138,7 +138,7 @@ pub struct TimeSpec {
     pub scene: Option<String>,
 }
 
-/// A two-size study: the two bodies refined independently (`study::two_size`).
+/// A two-size study: the two bodies refined independently (`studies::two_size`).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TwoSizeSpec {

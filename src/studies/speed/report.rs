@@ -338,7 +338,7 @@ fn floor_spread(res: &SpeedResult) -> String {
 /// timed on one thread as well.
 fn machine_and_threads(doc: &mut Doc, res: &SpeedResult) {
     doc.paragraph(format!(
-        "Machine: {}. The ratios depend on it: newton's runs are about 24 preconditioner applications (each reads the whole factor from memory) against the floor's 4 solves, so a machine with less memory bandwidth per core reads higher ratios for the same code (`study::speed::machine` gives a measured example).",
+        "Machine: {}. The ratios depend on it: newton's runs are about 24 preconditioner applications (each reads the whole factor from memory) against the floor's 4 solves, so a machine with less memory bandwidth per core reads higher ratios for the same code (`studies::speed::machine` gives a measured example).",
         res.machine
     ))
     .paragraph(format!(
