@@ -8,7 +8,7 @@
 
 use crate::error::{Error, Result};
 use plotters::coord::Shift;
-use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint};
+use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, ValueFormatter};
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -26,6 +26,25 @@ fn register() {
 
 fn err<E: std::fmt::Display>(path: &Path) -> impl Fn(E) -> Error + '_ {
     move |e| Error::io(path, std::io::Error::other(e.to_string()))
+}
+
+/// A white figure of `dim` pixels to be written to `path`.
+fn white_figure(path: &Path, dim: (u32, u32)) -> Result<DrawingArea<BitMapBackend<'_>, Shift>> {
+    register();
+    let root = BitMapBackend::new(path, dim).into_drawing_area();
+    root.fill(&WHITE).map_err(err(path))?;
+    Ok(root)
+}
+
+/// A white figure with `title` across its top: the area below the title.
+fn titled_figure<'p>(
+    path: &'p Path,
+    dim: (u32, u32),
+    title: &str,
+) -> Result<DrawingArea<BitMapBackend<'p>, Shift>> {
+    white_figure(path, dim)?
+        .titled(title, ("sans-serif", 20))
+        .map_err(err(path))
 }
 
 /// Colours of the series (colour-blind friendly).
@@ -86,6 +105,14 @@ impl Ticks {
 
     fn values(&self) -> Vec<f64> {
         self.major.iter().map(|t| t.0).collect()
+    }
+
+    /// The labelled ticks alone (no light grid lines).
+    fn without_minor(&self) -> Ticks {
+        Ticks {
+            major: self.major.clone(),
+            minor: Vec::new(),
+        }
     }
 }
 
@@ -368,6 +395,40 @@ fn best_even(ax: &Axis, min: usize) -> Option<(Kept, Vec<Dec>)> {
     best.map(|b| (b.1, b.2))
 }
 
+/// The candidate ticks of a log axis.
+impl Axis {
+    /// Every whole decade 10^e on the axis whose e is a multiple of `step`.
+    fn decades(&self, step: i32) -> Vec<Dec> {
+        self.exponents()
+            .filter(|e| e.rem_euclid(step) == 0)
+            .map(|e| Dec { m: 1, e })
+            .filter(|d| self.on_axis(d))
+            .collect()
+    }
+
+    /// m × 10^e on the axis for every mantissa m in `set`, decade by decade.
+    fn per_decade(&self, set: &[i64]) -> Vec<Dec> {
+        self.exponents()
+            .flat_map(|e| set.iter().map(move |&m| Dec { m, e }))
+            .filter(|d| self.on_axis(d))
+            .collect()
+    }
+
+    /// The exponents of the decades around the axis, one beyond each end.
+    fn exponents(&self) -> std::ops::RangeInclusive<i32> {
+        self.lo.log10().floor() as i32 - 1..=self.hi.log10().ceil() as i32 + 1
+    }
+
+    fn on_axis(&self, d: &Dec) -> bool {
+        d.value() >= self.lo * (1.0 - 1e-9) && d.value() <= self.hi * (1.0 + 1e-9)
+    }
+
+    /// The ticks of `vals` on a log axis, labelled, if they fit.
+    fn fit_log(&self, vals: &[Dec]) -> Option<Kept> {
+        self.fit(vals, &tick_labels(vals, 0, true))
+    }
+}
+
 /// Ticks of a log axis over [lo, hi] (lo > 0) `pixels` long, labels `font_px` high and at
 /// most `max_width` pixels wide, no two labels closer than 0.6 font size across (0.4 up).
 /// Across a decade or more: whole decades when three or more are on the axis (every second,
@@ -388,49 +449,18 @@ pub fn log_ticks(lo: f64, hi: f64, pixels: f64, font_px: f64, side: Side, max_wi
         side,
         max_width,
     };
-    let (k0, k1) = (lo.log10().floor() as i32 - 1, hi.log10().ceil() as i32 + 1);
-    let on_axis = |d: &Dec| d.value() >= lo * (1.0 - 1e-9) && d.value() <= hi * (1.0 + 1e-9);
-    let per_decade = |set: &[i64]| -> Vec<Dec> {
-        (k0..=k1)
-            .flat_map(|e| set.iter().map(move |&m| Dec { m, e }))
-            .filter(on_axis)
-            .collect()
-    };
-    let decades = |step: i32| -> Vec<Dec> {
-        (k0..=k1)
-            .filter(|e| e.rem_euclid(step) == 0)
-            .map(|e| Dec { m: 1, e })
-            .filter(on_axis)
-            .collect()
-    };
-    let attempt = |vals: &[Dec]| ax.fit(vals, &tick_labels(vals, 0, true));
-    let mantissas = per_decade(&[1, 2, 3, 4, 5, 6, 7, 8, 9]);
+    let mantissas = ax.per_decade(&[1, 2, 3, 4, 5, 6, 7, 8, 9]);
     let decade_px = pixels / (hi / lo).log10();
-
-    if hi / lo < 10.0 {
-        // Within a decade 1-2-5 or 1..9 may label one end only: score the spread too.
-        let mut sets: Vec<(Kept, Vec<Dec>)> = [per_decade(&[1, 2, 5]), mantissas.clone()]
-            .iter()
-            .filter_map(|v| attempt(v).map(|k| (k, mantissas.clone())))
-            .collect();
-        for (major, minor, decimals) in even_candidates(lo, hi) {
-            if let Some(k) = ax.fit(&major, &tick_labels(&major, decimals, true)) {
-                sets.push((k, minor));
-            }
-        }
-        let score = |k: &Kept| (k.len() as f64 - ax.target()).abs() + 4.0 * (1.0 - ax.coverage(k));
-        let best = sets
-            .into_iter()
-            .filter(|s| s.0.len() >= 3)
-            .min_by(|a, b| score(&a.0).total_cmp(&score(&b.0)));
-        if let Some((major, minor)) = best {
-            return ax.finish(major, &minor);
-        }
+    if hi / lo < 10.0
+        && let Some(ticks) = within_decade(&ax)
+    {
+        return ticks;
     }
-
-    if decades(1).len() >= 3 {
+    if ax.decades(1).len() >= 3 {
         for step in [1, 2, 3, 5, 10, 20, 50, 100] {
-            let Some(major) = attempt(&decades(step)).filter(|m| (2..=12).contains(&m.len()))
+            let Some(major) = ax
+                .fit_log(&ax.decades(step))
+                .filter(|m| (2..=12).contains(&m.len()))
             else {
                 continue;
             };
@@ -438,13 +468,13 @@ pub fn log_ticks(lo: f64, hi: f64, pixels: f64, font_px: f64, side: Side, max_wi
                 // Light lines at 2..9 only where a decade is wide enough not to turn grey.
                 1 if decade_px >= 60.0 => mantissas.clone(),
                 1 => Vec::new(),
-                _ => decades(1),
+                _ => ax.decades(1),
             };
             return ax.finish(major, &minor);
         }
     }
     for set in [&[1, 2, 5][..], &[1, 2, 3, 4, 5, 6, 7, 8, 9][..]] {
-        if let Some(major) = attempt(&per_decade(set)).filter(|m| m.len() >= 3) {
+        if let Some(major) = ax.fit_log(&ax.per_decade(set)).filter(|m| m.len() >= 3) {
             return ax.finish(major, &mantissas);
         }
     }
@@ -452,10 +482,11 @@ pub fn log_ticks(lo: f64, hi: f64, pixels: f64, font_px: f64, side: Side, max_wi
         return ax.finish(major, &minor);
     }
     // Fewer than three labels fit: the set with the most.
-    let mut sets: Vec<(Kept, Vec<Dec>)> = [decades(1), per_decade(&[1, 2, 5]), mantissas.clone()]
-        .into_iter()
-        .filter_map(|v| attempt(&v).map(|k| (k, mantissas.clone())))
-        .collect();
+    let mut sets: Vec<(Kept, Vec<Dec>)> =
+        [ax.decades(1), ax.per_decade(&[1, 2, 5]), mantissas.clone()]
+            .into_iter()
+            .filter_map(|v| ax.fit_log(&v).map(|k| (k, mantissas.clone())))
+            .collect();
     sets.extend(best_even(&ax, 2));
     match sets.into_iter().max_by_key(|s| s.0.len()) {
         Some((major, minor)) if !major.is_empty() => ax.finish(major, &minor),
@@ -464,6 +495,28 @@ pub fn log_ticks(lo: f64, hi: f64, pixels: f64, font_px: f64, side: Side, max_wi
             ax.finish(ax.thin(&mantissas, &labels), &[])
         }
     }
+}
+
+/// The ticks of a log axis spanning less than a decade: of 1-2-5, 1..9 and the evenly spaced
+/// sets that fit with three labels or more, the one spread widest and nearest the target
+/// count (1-2-5 or 1..9 may label one end only); `None` if none has three.
+fn within_decade(ax: &Axis) -> Option<Ticks> {
+    let mantissas = ax.per_decade(&[1, 2, 3, 4, 5, 6, 7, 8, 9]);
+    let mut sets: Vec<(Kept, Vec<Dec>)> = [ax.per_decade(&[1, 2, 5]), mantissas.clone()]
+        .iter()
+        .filter_map(|v| ax.fit_log(v).map(|k| (k, mantissas.clone())))
+        .collect();
+    for (major, minor, decimals) in even_candidates(ax.lo, ax.hi) {
+        if let Some(k) = ax.fit(&major, &tick_labels(&major, decimals, true)) {
+            sets.push((k, minor));
+        }
+    }
+    let score = |k: &Kept| (k.len() as f64 - ax.target()).abs() + 4.0 * (1.0 - ax.coverage(k));
+    let (major, minor) = sets
+        .into_iter()
+        .filter(|s| s.0.len() >= 3)
+        .min_by(|a, b| score(&a.0).total_cmp(&score(&b.0)))?;
+    Some(ax.finish(major, &minor))
 }
 
 /// Ticks of a linear axis over [lo, hi] `pixels` long, labels `font_px` high and at most
@@ -633,6 +686,16 @@ struct Rect {
 }
 
 impl Rect {
+    /// The box reaching `hw` either side of `c` across and `hh` up and down.
+    fn around(c: (f64, f64), hw: f64, hh: f64) -> Rect {
+        Rect {
+            x0: c.0 - hw,
+            y0: c.1 - hh,
+            x1: c.0 + hw,
+            y1: c.1 + hh,
+        }
+    }
+
     fn contains(&self, p: (f64, f64), pad: f64) -> bool {
         p.0 >= self.x0 - pad && p.0 <= self.x1 + pad && p.1 >= self.y0 - pad && p.1 <= self.y1 + pad
     }
@@ -722,6 +785,26 @@ fn place_box(
     (b.1, b.2)
 }
 
+/// The pixel of `p` on `area`, counted from the area's upper left corner.
+fn relative_px<DB: DrawingBackend, CT: CoordTranslate<From = (f64, f64)>>(
+    area: &DrawingArea<DB, CT>,
+    p: (f64, f64),
+) -> (f64, f64) {
+    let q = area.map_coordinate(&p);
+    let base = area.get_base_pixel();
+    (f64::from(q.0 - base.0), f64::from(q.1 - base.1))
+}
+
+/// The whole pixel nearest `p`.
+fn nearest_px(p: (f64, f64)) -> (i32, i32) {
+    (p.0.round() as i32, p.1.round() as i32)
+}
+
+/// A size in pixels as f64.
+fn pixels_f64(dim: (u32, u32)) -> (f64, f64) {
+    (f64::from(dim.0), f64::from(dim.1))
+}
+
 /// Pixel positions (relative to the plotting area) along every series: its points and,
 /// where a line joins them, a sample every 4 pixels along each segment; weight 1 each.
 fn data_samples<DB: DrawingBackend, CT: CoordTranslate<From = (f64, f64)>>(
@@ -730,11 +813,7 @@ fn data_samples<DB: DrawingBackend, CT: CoordTranslate<From = (f64, f64)>>(
     log: bool,
 ) -> Vec<((f64, f64), f64)> {
     let area = chart.plotting_area();
-    let base = area.get_base_pixel();
-    let px = |p: &(f64, f64)| {
-        let q = area.map_coordinate(p);
-        (f64::from(q.0 - base.0), f64::from(q.1 - base.1))
-    };
+    let px = |p: &(f64, f64)| relative_px(area, *p);
     let mut out = Vec::new();
     for s in series {
         let pts: Vec<(f64, f64)> = s
@@ -901,20 +980,74 @@ where
     Ok(())
 }
 
-/// The legend at `pos`, in the style of [`loglog`] and [`lines`].
-fn draw_legend<'b, CT: CoordTranslate>(
-    chart: &mut ChartContext<'b, BitMapBackend<'b>, CT>,
+/// The legend at `pos`, labels `font_px` high on white of the given opacity, framed black.
+fn draw_legend<'a, 'b: 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, BitMapBackend<'b>, CT>,
     pos: SeriesLabelPosition,
+    font_px: f64,
+    opacity: f64,
     path: &Path,
 ) -> Result<()> {
     chart
         .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
+        .background_style(WHITE.mix(opacity))
         .border_style(BLACK)
-        .label_font(("sans-serif", TICK_FONT_PX))
+        .label_font(("sans-serif", font_px))
         .position(pos)
         .draw()
         .map_err(err(path))
+}
+
+/// The x and y ticks of a chart laid out by `layout` on a figure of `size` pixels over the
+/// data ranges `x` and `y`, fitted by `fit` ([`log_ticks`] or [`linear_ticks`]) to its
+/// plotting area with labels [`TICK_FONT_PX`] high.
+fn fitted_ticks(
+    layout: &Layout,
+    size: (u32, u32),
+    x: (f64, f64),
+    y: (f64, f64),
+    fit: fn(f64, f64, f64, f64, Side, f64) -> Ticks,
+) -> (Ticks, Ticks) {
+    let (pw, ph) = pixels_f64(layout.plot_dim(size));
+    let room = layout.label_room(layout.y_label_px, TICK_FONT_PX);
+    (
+        fit(x.0, x.1, pw, TICK_FONT_PX, Side::Horizontal, f64::INFINITY),
+        fit(y.0, y.1, ph, TICK_FONT_PX, Side::Vertical, room),
+    )
+}
+
+/// The grid, axis descriptions and tick labels of a [`loglog`] or [`lines`] chart.
+fn draw_axes<X, Y>(
+    chart: &mut ChartContext<'_, BitMapBackend<'_>, Cartesian2d<X, Y>>,
+    (xlabel, ylabel): (&str, &str),
+    (xt, yt): (&Ticks, &Ticks),
+    path: &Path,
+) -> Result<()>
+where
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    chart
+        .configure_mesh()
+        .x_desc(xlabel)
+        .y_desc(ylabel)
+        .label_style(("sans-serif", TICK_FONT_PX))
+        .x_label_formatter(&|v| xt.label(*v))
+        .y_label_formatter(&|v| yt.label(*v))
+        .draw()
+        .map_err(err(path))
+}
+
+/// Where the legend of `labels` covers the fewest `samples` in the plotting area of `chart`
+/// (`None` without labels).
+fn legend_place<DB: DrawingBackend, CT: CoordTranslate>(
+    chart: &ChartContext<'_, DB, CT>,
+    labels: &[&str],
+    samples: &[((f64, f64), f64)],
+) -> Option<(SeriesLabelPosition, Rect)> {
+    let dim = pixels_f64(chart.plotting_area().dim_in_pixel());
+    let size = legend_size(labels, TICK_FONT_PX);
+    (!labels.is_empty()).then(|| place_box(size, dim, samples, &[], 5.0, &LEGEND_ORDER))
 }
 
 /// A log-log plot with optional reference slope triangles (slopes given with labels).
@@ -926,15 +1059,9 @@ pub fn loglog(
     series: &[Series],
     slopes: &[(f64, &str)],
 ) -> Result<()> {
-    register();
-    let root = BitMapBackend::new(path, LOGLOG_SIZE).into_drawing_area();
-    root.fill(&WHITE).map_err(err(path))?;
+    let root = white_figure(path, LOGLOG_SIZE)?;
     let ((x0, x1), (y0, y1)) = bounds(series, true);
-    let (pw, ph) = LOGLOG.plot_dim(LOGLOG_SIZE);
-    let (pw, ph) = (f64::from(pw), f64::from(ph));
-    let room = LOGLOG.label_room(LOGLOG.y_label_px, TICK_FONT_PX);
-    let xt = log_ticks(x0, x1, pw, TICK_FONT_PX, Side::Horizontal, f64::INFINITY);
-    let yt = log_ticks(y0, y1, ph, TICK_FONT_PX, Side::Vertical, room);
+    let (xt, yt) = fitted_ticks(&LOGLOG, LOGLOG_SIZE, (x0, x1), (y0, y1), log_ticks);
     let mut chart = LOGLOG
         .builder(&root, title)
         .build_cartesian_2d(
@@ -948,35 +1075,16 @@ pub fn loglog(
                 .with_light_points(yt.minor.clone()),
         )
         .map_err(err(path))?;
-    chart
-        .configure_mesh()
-        .x_desc(xlabel)
-        .y_desc(ylabel)
-        .label_style(("sans-serif", TICK_FONT_PX))
-        .x_label_formatter(&|v| xt.label(*v))
-        .y_label_formatter(&|v| yt.label(*v))
-        .draw()
-        .map_err(err(path))?;
+    draw_axes(&mut chart, (xlabel, ylabel), (&xt, &yt), path)?;
     draw_series(&mut chart, series, 5, path)?;
     let samples = data_samples(&chart, series, true);
-    let labels = legend_labels(series);
-    let (dw, dh) = chart.plotting_area().dim_in_pixel();
-    let legend = (!labels.is_empty()).then(|| {
-        place_box(
-            legend_size(&labels, TICK_FONT_PX),
-            (f64::from(dw), f64::from(dh)),
-            &samples,
-            &[],
-            5.0,
-            &LEGEND_ORDER,
-        )
-    });
+    let legend = legend_place(&chart, &legend_labels(series), &samples);
     if !slopes.is_empty() {
         let taken: Vec<Rect> = legend.iter().map(|l| l.1).collect();
         slope_triangles(&chart, ((x0, x1), (y0, y1)), &samples, &taken, slopes, path)?;
     }
     if let Some((pos, _)) = legend {
-        draw_legend(&mut chart, pos, path)?;
+        draw_legend(&mut chart, pos, TICK_FONT_PX, 0.85, path)?;
     }
     root.present().map_err(err(path))?;
     Ok(())
@@ -1050,37 +1158,18 @@ pub fn lines(
     ylabel: &str,
     series: &[Series],
 ) -> Result<()> {
-    register();
-    let root = BitMapBackend::new(path, LINES_SIZE).into_drawing_area();
-    root.fill(&WHITE).map_err(err(path))?;
+    let root = white_figure(path, LINES_SIZE)?;
     let ((x0, x1), (y0, y1)) = bounds(series, false);
-    let (pw, ph) = LINES.plot_dim(LINES_SIZE);
-    let (pw, ph) = (f64::from(pw), f64::from(ph));
-    let room = LINES.label_room(LINES.y_label_px, TICK_FONT_PX);
-    let xt = linear_ticks(x0, x1, pw, TICK_FONT_PX, Side::Horizontal, f64::INFINITY);
-    let yt = linear_ticks(y0, y1, ph, TICK_FONT_PX, Side::Vertical, room);
+    let (xt, yt) = fitted_ticks(&LINES, LINES_SIZE, (x0, x1), (y0, y1), linear_ticks);
     let mut chart = LINES
         .builder(&root, title)
         .build_cartesian_2d(LinearAxis::new(x0, x1, &xt), LinearAxis::new(y0, y1, &yt))
         .map_err(err(path))?;
-    chart
-        .configure_mesh()
-        .x_desc(xlabel)
-        .y_desc(ylabel)
-        .label_style(("sans-serif", TICK_FONT_PX))
-        .x_label_formatter(&|v| xt.label(*v))
-        .y_label_formatter(&|v| yt.label(*v))
-        .draw()
-        .map_err(err(path))?;
+    draw_axes(&mut chart, (xlabel, ylabel), (&xt, &yt), path)?;
     draw_series(&mut chart, series, 3, path)?;
-    let labels = legend_labels(series);
-    if !labels.is_empty() {
-        let samples = data_samples(&chart, series, false);
-        let size = legend_size(&labels, TICK_FONT_PX);
-        let (dw, dh) = chart.plotting_area().dim_in_pixel();
-        let dim = (f64::from(dw), f64::from(dh));
-        let (pos, _) = place_box(size, dim, &samples, &[], 5.0, &LEGEND_ORDER);
-        draw_legend(&mut chart, pos, path)?;
+    let samples = data_samples(&chart, series, false);
+    if let Some((pos, _)) = legend_place(&chart, &legend_labels(series), &samples) {
+        draw_legend(&mut chart, pos, TICK_FONT_PX, 0.85, path)?;
     }
     root.present().map_err(err(path))?;
     Ok(())
@@ -1108,6 +1197,43 @@ pub fn colormap(t: f64) -> RGBColor {
     let w = (t - a.0) / (b.0 - a.0);
     let c = |i: usize| (a.1[i] + w * (b.1[i] - a.1[i])).round() as u8;
     RGBColor(c(0), c(1), c(2))
+}
+
+/// A linear colour scale: `lo` at the bottom of [`colormap`], `hi` at its top (data units,
+/// or log10 of them).
+#[derive(Clone, Copy, Debug)]
+struct ColourScale {
+    lo: f64,
+    hi: f64,
+}
+
+impl ColourScale {
+    /// The range of the finite `values` ([0, 1] if none); one value gets a scale 2% wide
+    /// around it.
+    fn spanning(values: impl Iterator<Item = f64>) -> ColourScale {
+        let (mut lo, mut hi) = values
+            .filter(|v| v.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(v), b.max(v))
+            });
+        if lo > hi {
+            (lo, hi) = (0.0, 1.0);
+        }
+        if hi - lo <= 1e-9 * hi.abs().max(lo.abs()) {
+            let d = if hi == 0.0 { 1.0 } else { 0.01 * hi.abs() };
+            (lo, hi) = (lo - d, hi + d);
+        }
+        ColourScale { lo, hi }
+    }
+
+    /// Where `v` falls on [`colormap`]'s [0, 1] (outside it beyond the scale's ends).
+    fn fraction(&self, v: f64) -> f64 {
+        (v - self.lo) / (self.hi - self.lo)
+    }
+
+    fn colour(&self, v: f64) -> RGBColor {
+        colormap(self.fraction(v))
+    }
 }
 
 type Square<'a, 'b> = ChartContext<'a, BitMapBackend<'b>, Cartesian2d<LinearAxis, LinearAxis>>;
@@ -1149,22 +1275,8 @@ fn square_chart<'a, 'b>(
     let mut chart = layout
         .builder(area, title)
         .build_cartesian_2d(
-            LinearAxis::new(
-                xr.0,
-                xr.1,
-                &Ticks {
-                    minor: Vec::new(),
-                    ..xt.clone()
-                },
-            ),
-            LinearAxis::new(
-                yr.0,
-                yr.1,
-                &Ticks {
-                    minor: Vec::new(),
-                    ..yt.clone()
-                },
-            ),
+            LinearAxis::new(xr.0, xr.1, &xt.without_minor()),
+            LinearAxis::new(yr.0, yr.1, &yt.without_minor()),
         )
         .map_err(err(path))?;
     chart
@@ -1194,110 +1306,112 @@ pub struct Panel {
 
 /// Panels side by side sharing one colour bar, which spans the values' range exactly.
 pub fn field_panels(path: &Path, title: &str, bar_label: &str, panels: &[Panel]) -> Result<()> {
-    register();
-    const BAR_FONT_PX: f64 = 13.0;
     let w = (560 * panels.len() as u32 + 140).max(1000);
-    let root = BitMapBackend::new(path, (w, 640)).into_drawing_area();
-    root.fill(&WHITE).map_err(err(path))?;
-    let root = root.titled(title, ("sans-serif", 20)).map_err(err(path))?;
-    let (mut vmin, mut vmax) = panels
-        .iter()
-        .flat_map(|p| p.values.iter().copied())
-        .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-            (a.min(v), b.max(v))
-        });
-    if vmin > vmax {
-        (vmin, vmax) = (0.0, 1.0);
-    }
-    if vmax - vmin <= 1e-9 * vmax.abs().max(vmin.abs()) {
-        // One value: a bar 2% wide around it.
-        let d = if vmax == 0.0 { 1.0 } else { 0.01 * vmax.abs() };
-        (vmin, vmax) = (vmin - d, vmax + d);
-    }
+    let root = titled_figure(path, (w, 640), title)?;
+    let scale = ColourScale::spanning(panels.iter().flat_map(|p| p.values.iter().copied()));
     let (main, bar) = root.split_horizontally(w - 140);
     let areas = main.split_evenly((1, panels.len()));
     for (p, area) in panels.iter().zip(areas.iter()) {
         let mut chart = square_chart(area, &p.title, 17, &p.triangles, path)?;
         for (i, t) in p.triangles.iter().enumerate() {
-            let c = colormap((p.values[i] - vmin) / (vmax - vmin));
-            let pts: Vec<(f64, f64)> = t.iter().map(|v| (v[0], v[1])).collect();
-            let mut closed = pts.clone();
-            closed.push(closed[0]);
-            chart
-                .draw_series(std::iter::once(Polygon::new(pts, c.filled())))
-                .map_err(err(path))?;
-            // The fill leaves some boundary pixels out: outline in the fill's colour first.
-            chart
-                .draw_series(std::iter::once(PathElement::new(
-                    closed.clone(),
-                    c.stroke_width(1),
-                )))
-                .map_err(err(path))?;
-            let edge = if p.body[i] == 1 {
-                BLACK.mix(0.35)
-            } else {
-                RGBColor(90, 90, 90).mix(0.35)
+            let c = scale.colour(p.values[i]);
+            let edge = match p.body[i] {
+                1 => BLACK.mix(0.35),
+                _ => RGBColor(90, 90, 90).mix(0.35),
             };
-            chart
-                .draw_series(std::iter::once(PathElement::new(
-                    closed,
-                    edge.stroke_width(1),
-                )))
-                .map_err(err(path))?;
+            // The fill leaves some boundary pixels out: outline in the fill's colour first.
+            let outlines = [c.stroke_width(1), edge.stroke_width(1)];
+            draw_triangle(&mut chart, t, c, &outlines, path)?;
         }
-        for s in &p.highlight {
-            chart
-                .draw_series(std::iter::once(PathElement::new(
-                    vec![(s[0][0], s[0][1]), (s[1][0], s[1][1])],
-                    RED.stroke_width(3),
-                )))
-                .map_err(err(path))?;
-        }
+        draw_segments(&mut chart, &p.highlight, RED.stroke_width(3), path)?;
     }
-    // Colour bar.
-    let layout = Layout {
+    colour_bar(&bar, scale, bar_label, path)?;
+    root.present().map_err(err(path))
+}
+
+/// A vertical colour bar of `scale` filling `area`, its ticks and `label` on its right.
+fn colour_bar(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    scale: ColourScale,
+    label: &str,
+    path: &Path,
+) -> Result<()> {
+    const FONT_PX: f64 = 13.0;
+    const LAYOUT: Layout = Layout {
         margin: [60, 60, 0, 40],
         title_px: 0.0,
         x_label_px: 0,
         y_label_px: 0,
         right_label_px: 90,
     };
-    let (_, bar_px) = layout.plot_dim(bar.dim_in_pixel());
-    let room = layout.label_room(layout.right_label_px, BAR_FONT_PX);
-    let ticks = linear_ticks(
-        vmin,
-        vmax,
-        f64::from(bar_px),
-        BAR_FONT_PX,
-        Side::Vertical,
-        room,
-    );
-    let mut cb = layout
-        .builder(&bar, "")
-        .build_cartesian_2d(0.0..1.0, LinearAxis::new(vmin, vmax, &ticks))
+    let (lo, hi) = (scale.lo, scale.hi);
+    let (_, bar_px) = LAYOUT.plot_dim(area.dim_in_pixel());
+    let room = LAYOUT.label_room(LAYOUT.right_label_px, FONT_PX);
+    let ticks = linear_ticks(lo, hi, f64::from(bar_px), FONT_PX, Side::Vertical, room);
+    let mut cb = LAYOUT
+        .builder(area, "")
+        .build_cartesian_2d(0.0..1.0, LinearAxis::new(lo, hi, &ticks))
         .map_err(err(path))?;
     cb.configure_mesh()
         .disable_mesh()
         .disable_x_axis()
-        .y_desc(bar_label)
+        .y_desc(label)
         // The bar is narrower than plotters' 5% tick default can see: ticks 5 pixels long.
         .set_tick_mark_size(LabelAreaPosition::Right, 5)
-        .label_style(("sans-serif", BAR_FONT_PX))
+        .label_style(("sans-serif", FONT_PX))
         .y_label_formatter(&|v| ticks.label(*v))
         .draw()
         .map_err(err(path))?;
     let n = 100;
     for k in 0..n {
-        let a = vmin + (vmax - vmin) * k as f64 / n as f64;
-        let b = vmin + (vmax - vmin) * (k + 1) as f64 / n as f64;
+        let a = lo + (hi - lo) * k as f64 / n as f64;
+        let b = lo + (hi - lo) * (k + 1) as f64 / n as f64;
         cb.draw_series(std::iter::once(Rectangle::new(
             [(0.0, a), (1.0, b)],
             colormap((k as f64 + 0.5) / n as f64).filled(),
         )))
         .map_err(err(path))?;
     }
-    root.present().map_err(err(path))?;
+    Ok(())
+}
+
+/// A triangle filled with `fill`, then its outline in each of `outlines` in turn.
+fn draw_triangle(
+    chart: &mut Square<'_, '_>,
+    t: &[[f64; 2]; 3],
+    fill: RGBColor,
+    outlines: &[ShapeStyle],
+    path: &Path,
+) -> Result<()> {
+    let pts: Vec<(f64, f64)> = t.iter().map(|v| (v[0], v[1])).collect();
+    let mut closed = pts.clone();
+    closed.push(closed[0]);
+    chart
+        .draw_series(std::iter::once(Polygon::new(pts, fill.filled())))
+        .map_err(err(path))?;
+    for style in outlines {
+        chart
+            .draw_series(std::iter::once(PathElement::new(closed.clone(), *style)))
+            .map_err(err(path))?;
+    }
+    Ok(())
+}
+
+/// Each of `segments` as a line in `style`.
+fn draw_segments(
+    chart: &mut Square<'_, '_>,
+    segments: &[[[f64; 2]; 2]],
+    style: ShapeStyle,
+    path: &Path,
+) -> Result<()> {
+    for s in segments {
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(s[0][0], s[0][1]), (s[1][0], s[1][1])],
+                style,
+            )))
+            .map_err(err(path))?;
+    }
     Ok(())
 }
 
@@ -1314,118 +1428,91 @@ pub struct MeshPanel {
     pub highlight: Vec<[[f64; 2]; 2]>,
     /// Interface nodes of body 1 (drawn as circles) and body 2 (drawn as crosses).
     pub nodes: [Vec<[f64; 2]>; 2],
-    /// Undeformed outline segments to draw dashed (empty for none).
+    /// Undeformed outline segments, drawn thin and grey (empty for none).
     pub outline: Vec<[[f64; 2]; 2]>,
 }
+
+/// The legend entries of a [`MeshPanel`]'s interface nodes.
+const NODE_LABELS: [&str; 2] = ["body 1 interface nodes", "body 2 interface nodes"];
 
 /// Mesh panels side by side; each legend where it covers the least mesh (the contact line
 /// and interface nodes counting most).
 pub fn mesh_panels(path: &Path, title: &str, panels: &[MeshPanel]) -> Result<()> {
-    register();
-    const LEGEND_FONT_PX: f64 = 13.0;
-    let w = 600 * panels.len() as u32;
-    let root = BitMapBackend::new(path, (w, 640)).into_drawing_area();
-    root.fill(&WHITE).map_err(err(path))?;
-    let root = root.titled(title, ("sans-serif", 20)).map_err(err(path))?;
+    let root = titled_figure(path, (600 * panels.len() as u32, 640), title)?;
     let areas = root.split_evenly((1, panels.len()));
-    let fills = [RGBColor(198, 219, 239), RGBColor(253, 208, 162)];
     for (p, area) in panels.iter().zip(areas.iter()) {
         let mut chart = square_chart(area, &p.title, 16, &p.triangles, path)?;
-        for (i, t) in p.triangles.iter().enumerate() {
-            let pts: Vec<(f64, f64)> = t.iter().map(|v| (v[0], v[1])).collect();
-            let fill = fills[(p.body[i].max(1) - 1) as usize % 2];
-            chart
-                .draw_series(std::iter::once(Polygon::new(pts.clone(), fill.filled())))
-                .map_err(err(path))?;
-            let mut closed = pts;
-            closed.push(closed[0]);
-            chart
-                .draw_series(std::iter::once(PathElement::new(
-                    closed,
-                    BLACK.mix(0.5).stroke_width(1),
-                )))
-                .map_err(err(path))?;
-        }
-        for s in &p.outline {
-            chart
-                .draw_series(std::iter::once(PathElement::new(
-                    vec![(s[0][0], s[0][1]), (s[1][0], s[1][1])],
-                    RGBColor(120, 120, 120).stroke_width(1),
-                )))
-                .map_err(err(path))?;
-        }
-        for s in &p.highlight {
-            chart
-                .draw_series(std::iter::once(PathElement::new(
-                    vec![(s[0][0], s[0][1]), (s[1][0], s[1][1])],
-                    RED.stroke_width(2),
-                )))
-                .map_err(err(path))?;
-        }
-        chart
-            .draw_series(
-                p.nodes[0]
-                    .iter()
-                    .map(|v| Circle::new((v[0], v[1]), 4, COLORS[0].stroke_width(2))),
-            )
-            .map_err(err(path))?
-            .label("body 1 interface nodes")
-            .legend(|(x, y)| Circle::new((x + 8, y), 4, COLORS[0].stroke_width(2)));
-        chart
-            .draw_series(
-                p.nodes[1]
-                    .iter()
-                    .map(|v| Cross::new((v[0], v[1]), 4, COLORS[1].stroke_width(2))),
-            )
-            .map_err(err(path))?
-            .label("body 2 interface nodes")
-            .legend(|(x, y)| Cross::new((x + 8, y), 4, COLORS[1].stroke_width(2)));
-        let plot = chart.plotting_area();
-        let base = plot.get_base_pixel();
-        let px = |x: f64, y: f64| {
-            let q = plot.map_coordinate(&(x, y));
-            (f64::from(q.0 - base.0), f64::from(q.1 - base.1))
-        };
-        let mut samples: Vec<((f64, f64), f64)> = p
-            .triangles
-            .iter()
-            .flat_map(|t| t.iter().map(|v| (px(v[0], v[1]), 1.0)))
-            .collect();
-        for s in &p.highlight {
-            for k in 0..=8 {
-                let t = f64::from(k) / 8.0;
-                let q = px(
-                    s[0][0] + t * (s[1][0] - s[0][0]),
-                    s[0][1] + t * (s[1][1] - s[0][1]),
-                );
-                samples.push((q, 50.0));
-            }
-        }
-        samples.extend(p.nodes.iter().flatten().map(|v| (px(v[0], v[1]), 50.0)));
-        let dim = plot.dim_in_pixel();
-        let size = legend_size(
-            &["body 1 interface nodes", "body 2 interface nodes"],
-            LEGEND_FONT_PX,
-        );
-        let order = [
-            SeriesLabelPosition::LowerRight,
-            SeriesLabelPosition::LowerLeft,
-            SeriesLabelPosition::UpperRight,
-            SeriesLabelPosition::UpperLeft,
-        ];
-        let (dw, dh) = (f64::from(dim.0), f64::from(dim.1));
-        let (pos, _) = place_box(size, (dw, dh), &samples, &[], 5.0, &order);
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font(("sans-serif", LEGEND_FONT_PX))
-            .position(pos)
-            .draw()
-            .map_err(err(path))?;
+        draw_mesh(&mut chart, p, path)?;
+        mesh_legend(&mut chart, p, path)?;
     }
-    root.present().map_err(err(path))?;
+    root.present().map_err(err(path))
+}
+
+/// The cells filled by body with thin edges, the undeformed outline, the contact line and
+/// the interface nodes (with their legend entries) of one mesh panel.
+fn draw_mesh(chart: &mut Square<'_, '_>, p: &MeshPanel, path: &Path) -> Result<()> {
+    let fills = [RGBColor(198, 219, 239), RGBColor(253, 208, 162)];
+    for (i, t) in p.triangles.iter().enumerate() {
+        let fill = fills[(p.body[i].max(1) - 1) as usize % 2];
+        draw_triangle(chart, t, fill, &[BLACK.mix(0.5).stroke_width(1)], path)?;
+    }
+    let grey = RGBColor(120, 120, 120);
+    draw_segments(chart, &p.outline, grey.stroke_width(1), path)?;
+    draw_segments(chart, &p.highlight, RED.stroke_width(2), path)?;
+    let (circle, cross) = (COLORS[0].stroke_width(2), COLORS[1].stroke_width(2));
+    chart
+        .draw_series(
+            p.nodes[0]
+                .iter()
+                .map(|v| Circle::new((v[0], v[1]), 4, circle)),
+        )
+        .map_err(err(path))?
+        .label(NODE_LABELS[0])
+        .legend(move |(x, y)| Circle::new((x + 8, y), 4, circle));
+    chart
+        .draw_series(
+            p.nodes[1]
+                .iter()
+                .map(|v| Cross::new((v[0], v[1]), 4, cross)),
+        )
+        .map_err(err(path))?
+        .label(NODE_LABELS[1])
+        .legend(move |(x, y)| Cross::new((x + 8, y), 4, cross));
     Ok(())
+}
+
+/// The node legend of a mesh panel in the lower or upper corner where it covers the least
+/// weight: 1 per triangle vertex, 50 per interface node and per ninth of a contact segment.
+fn mesh_legend<'a, 'b: 'a>(chart: &mut Square<'a, 'b>, p: &MeshPanel, path: &Path) -> Result<()> {
+    const FONT_PX: f64 = 13.0;
+    const ORDER: [SeriesLabelPosition; 4] = [
+        SeriesLabelPosition::LowerRight,
+        SeriesLabelPosition::LowerLeft,
+        SeriesLabelPosition::UpperRight,
+        SeriesLabelPosition::UpperLeft,
+    ];
+    let plot = chart.plotting_area();
+    let px = |x: f64, y: f64| relative_px(plot, (x, y));
+    let mut samples: Vec<((f64, f64), f64)> = p
+        .triangles
+        .iter()
+        .flat_map(|t| t.iter().map(|v| (px(v[0], v[1]), 1.0)))
+        .collect();
+    for s in &p.highlight {
+        for k in 0..=8 {
+            let t = f64::from(k) / 8.0;
+            let q = px(
+                s[0][0] + t * (s[1][0] - s[0][0]),
+                s[0][1] + t * (s[1][1] - s[0][1]),
+            );
+            samples.push((q, 50.0));
+        }
+    }
+    samples.extend(p.nodes.iter().flatten().map(|v| (px(v[0], v[1]), 50.0)));
+    let size = legend_size(&NODE_LABELS, FONT_PX);
+    let dim = pixels_f64(plot.dim_in_pixel());
+    let (pos, _) = place_box(size, dim, &samples, &[], 5.0, &ORDER);
+    draw_legend(chart, pos, FONT_PX, 0.9, path)
 }
 
 /// One panel of a map over a grid of (x, y) cells: a value per cell, lines on top.
@@ -1446,7 +1533,8 @@ pub struct GridPanel {
 /// cell at zero or round-off, which stays off the scale.
 pub fn cell_shades(panel: &GridPanel) -> Vec<Option<f64>> {
     let above = |v: f64| v > panel.roundoff || v.is_nan();
-    let (v0, v1) = range(
+    // `range` pads, so the scale's span is never zero.
+    let (lo, hi) = range(
         panel
             .cells
             .iter()
@@ -1454,16 +1542,21 @@ pub fn cell_shades(panel: &GridPanel) -> Vec<Option<f64>> {
             .map(|c| c.2.log10()),
         false,
     );
+    let scale = ColourScale { lo, hi };
     panel
         .cells
         .iter()
-        .map(|c| above(c.2).then(|| (c.2.log10() - v0) / (v1 - v0).max(f64::MIN_POSITIVE)))
+        .map(|c| above(c.2).then(|| scale.fraction(c.2.log10())))
         .collect()
 }
 
 /// Hatched grey: the cells of a [`GridPanel`] at zero or round-off.
 const ROUNDOFF_FILL: RGBColor = RGBColor(215, 215, 215);
 const ROUNDOFF_HATCH: RGBColor = RGBColor(150, 150, 150);
+
+/// Font sizes of a [`GridPanel`]'s cell values (and round-off note) and line labels.
+const CELL_FONT_PX: f64 = 12.0;
+const LINE_FONT_PX: f64 = 11.0;
 
 /// Diagonal hatching of the box [x0, x1] × [y0, y1] (pixels or data units alike): segments
 /// of the lines y - y0 = (x - x0) + c, c a multiple of `pitch`, inside the box.
@@ -1480,6 +1573,43 @@ fn hatch(x0: f64, x1: f64, y0: f64, y1: f64, pitch: f64) -> Vec<[(f64, f64); 2]>
         .collect()
 }
 
+/// The box from pixel `a` to pixel `b` of `area` filled grey and hatched, lines `pitch`
+/// pixels apart: the mark of zero or round-off.
+fn draw_roundoff_box(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    a: (f64, f64),
+    b: (f64, f64),
+    pitch: f64,
+    path: &Path,
+) -> Result<()> {
+    area.draw(&Rectangle::new(
+        [nearest_px(a), nearest_px(b)],
+        ROUNDOFF_FILL.filled(),
+    ))
+    .map_err(err(path))?;
+    for s in hatch(a.0, b.0, a.1, b.1, pitch) {
+        area.draw(&PathElement::new(
+            vec![nearest_px(s[0]), nearest_px(s[1])],
+            ROUNDOFF_HATCH.stroke_width(1),
+        ))
+        .map_err(err(path))?;
+    }
+    Ok(())
+}
+
+/// The plotting area of a grid panel, in cell coordinates.
+type GridArea<'b> = DrawingArea<BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// A cell's value as it is to be written: text, centre and the box of its patch (pixels
+/// from the plotting area's corner), patch and ink colours.
+struct CellText {
+    text: String,
+    centre: (f64, f64),
+    rect: Rect,
+    fill: RGBColor,
+    ink: RGBColor,
+}
+
 /// Maps side by side (two per row), each with its own colour scale on log10 of the values
 /// above the panel's round-off level, the value written in every cell; cells at zero or
 /// round-off hatched grey (noted above the panel), the lines labelled where the label
@@ -1491,89 +1621,14 @@ pub fn grid_panels(
     ylabel: &str,
     panels: &[GridPanel],
 ) -> Result<()> {
-    register();
-    const CELL_FONT_PX: f64 = 12.0;
-    const LINE_FONT_PX: f64 = 11.0;
     let rows = panels.len().div_ceil(2) as u32;
-    let root = BitMapBackend::new(path, (1100, 520 * rows + 40)).into_drawing_area();
-    root.fill(&WHITE).map_err(err(path))?;
-    let root = root.titled(title, ("sans-serif", 20)).map_err(err(path))?;
+    let root = titled_figure(path, (1100, 520 * rows + 40), title)?;
     let areas = root.split_evenly((rows as usize, 2));
-    let layout = Layout {
-        margin: [10; 4],
-        title_px: 16.0,
-        x_label_px: 35,
-        y_label_px: 45,
-        right_label_px: 0,
-    };
     for (p, area) in panels.iter().zip(areas.iter()) {
-        let (x0, x1) = range(p.cells.iter().map(|c| c.0), false);
-        let (y0, y1) = range(p.cells.iter().map(|c| c.1), false);
-        let marked = |v: f64| v <= p.roundoff;
-        let shades = cell_shades(p);
-        let mut chart = layout
-            .builder(area, &p.title)
-            .build_cartesian_2d(x0 - 0.5..x1 + 0.5, y0 - 0.5..y1 + 0.5)
-            .map_err(err(path))?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_desc(xlabel)
-            .y_desc(ylabel)
-            .x_labels((x1 - x0) as usize + 1)
-            .y_labels((y1 - y0) as usize + 1)
-            .x_label_formatter(&|v| format!("{v:.0}"))
-            .y_label_formatter(&|v| format!("{v:.0}"))
-            .label_style(("sans-serif", 12))
-            .draw()
-            .map_err(err(path))?;
-        let data = chart.plotting_area().clone();
-        let plot = data.strip_coord_spec();
-        let base = data.get_base_pixel();
-        let px = |x: f64, y: f64| {
-            let q = data.map_coordinate(&(x, y));
-            (f64::from(q.0 - base.0), f64::from(q.1 - base.1))
-        };
-        let centred = |size: f64| {
-            TextStyle::from(("sans-serif", size).into_font())
-                .pos(Pos::new(HPos::Center, VPos::Center))
-        };
-        let as_i = |p: (f64, f64)| (p.0.round() as i32, p.1.round() as i32);
-        // The cells and the boxes of their values (pixels), which line labels must not cover.
-        // The cells first, then the lines, then each value on a patch of its cell's colour
-        // (the lines pass under the numbers), then the lines' labels.
-        let mut values = Vec::new();
-        for (c, shade) in p.cells.iter().zip(&shades) {
-            let (a, b) = (px(c.0 - 0.5, c.1 + 0.5), px(c.0 + 0.5, c.1 - 0.5));
-            let text = match c.2 {
-                0.0 => "0".to_string(),
-                v => format!("{v:.2e}"),
-            };
-            let (tw, th) = text_size(&text, CELL_FONT_PX);
-            let centre = px(c.0, c.1);
-            let text_box = Rect {
-                x0: centre.0 - 0.5 * tw - 2.0,
-                y0: centre.1 - 0.5 * th - 2.0,
-                x1: centre.0 + 0.5 * tw + 2.0,
-                y1: centre.1 + 0.5 * th + 2.0,
-            };
-            let (fill, ink) = match *shade {
-                Some(t) => (colormap(t), if t > 0.6 { BLACK } else { WHITE }),
-                None => (ROUNDOFF_FILL, BLACK),
-            };
-            plot.draw(&Rectangle::new([as_i(a), as_i(b)], fill.filled()))
-                .map_err(err(path))?;
-            if shade.is_none() {
-                for s in hatch(a.0, b.0, a.1, b.1, 12.0) {
-                    plot.draw(&PathElement::new(
-                        vec![as_i(s[0]), as_i(s[1])],
-                        ROUNDOFF_HATCH.stroke_width(1),
-                    ))
-                    .map_err(err(path))?;
-                }
-            }
-            values.push((text, centre, text_box, fill, ink));
-        }
+        let data = grid_axes(area, p, (xlabel, ylabel), path)?;
+        // The cells, then the lines, then each value on a patch of its cell's colour (the
+        // lines pass under the numbers), then the lines' labels clear of the values.
+        let values = draw_cells(&data, p, path)?;
         for (_, pts) in &p.lines {
             data.draw(&PathElement::new(
                 pts.clone(),
@@ -1581,93 +1636,191 @@ pub fn grid_panels(
             ))
             .map_err(err(path))?;
         }
-        let mut taken: Vec<Rect> = Vec::new();
-        for (text, centre, r, fill, ink) in values {
-            plot.draw(&Rectangle::new(
-                [as_i((r.x0, r.y0)), as_i((r.x1, r.y1))],
-                fill.filled(),
-            ))
-            .map_err(err(path))?;
-            plot.draw(&Text::new(
-                text,
-                as_i(centre),
-                centred(CELL_FONT_PX).color(&ink),
-            ))
-            .map_err(err(path))?;
-            taken.push(r);
-        }
-        let (dw, dh) = plot.dim_in_pixel();
-        let inside = Rect {
-            x0: 0.0,
-            y0: 0.0,
-            x1: f64::from(dw),
-            y1: f64::from(dh),
-        };
-        for (label, pts) in &p.lines {
-            // On the line, nearest its end, where it covers no cell's value, no other label
-            // and stays inside the plot.
-            let (tw, th) = text_size(label, LINE_FONT_PX);
-            let (hw, hh) = (0.5 * tw + 3.0, 0.5 * th + 2.0);
-            let best = pts
-                .iter()
-                .map(|q| px(q.0, q.1))
-                .map(|c| {
-                    let r = Rect {
-                        x0: c.0 - hw,
-                        y0: c.1 - hh,
-                        x1: c.0 + hw,
-                        y1: c.1 + hh,
-                    };
-                    let out = r.area() - r.overlap(&inside);
-                    let covered: f64 = taken.iter().map(|t| t.overlap(&r)).sum();
-                    (covered + 1e3 * out, c, r)
-                })
-                .rev()
-                .min_by(|a, b| a.0.total_cmp(&b.0));
-            if let Some((_, c, r)) = best {
-                plot.draw(&Rectangle::new(
-                    [as_i((r.x0, r.y0)), as_i((r.x1, r.y1))],
-                    WHITE.mix(0.85).filled(),
-                ))
-                .map_err(err(path))?;
-                plot.draw(&Text::new(
-                    label.clone(),
-                    as_i(c),
-                    centred(LINE_FONT_PX).color(&RED),
-                ))
-                .map_err(err(path))?;
-                taken.push(r);
-            }
-        }
-        if p.cells.iter().any(|c| marked(c.2)) {
-            // The note in the panel's title row, right-aligned: a hatched swatch and its meaning.
-            let note = format!("0 / round-off (≤ {:.0e})", p.roundoff);
-            let (tw, th) = text_size(&note, CELL_FONT_PX);
-            let (aw, _) = area.dim_in_pixel();
-            let x = f64::from(aw) - tw - 14.0;
-            let (s0, s1) = ((x - 22.0, 8.0), (x - 6.0, 8.0 + 16.0));
-            area.draw(&Rectangle::new(
-                [as_i(s0), as_i(s1)],
-                ROUNDOFF_FILL.filled(),
-            ))
-            .map_err(err(path))?;
-            for s in hatch(s0.0, s1.0, s0.1, s1.1, 6.0) {
-                area.draw(&PathElement::new(
-                    vec![as_i(s[0]), as_i(s[1])],
-                    ROUNDOFF_HATCH.stroke_width(1),
-                ))
-                .map_err(err(path))?;
-            }
-            area.draw(&Rectangle::new([as_i(s0), as_i(s1)], BLACK.stroke_width(1)))
-                .map_err(err(path))?;
-            area.draw(&Text::new(
-                note,
-                as_i((x, 8.0 + 8.0 - 0.5 * th)),
-                ("sans-serif", CELL_FONT_PX).into_font(),
-            ))
-            .map_err(err(path))?;
+        let taken = write_values(&data.strip_coord_spec(), values, path)?;
+        label_lines(&data, &p.lines, taken, path)?;
+        if p.cells.iter().any(|c| c.2 <= p.roundoff) {
+            roundoff_note(area, p.roundoff, path)?;
         }
     }
-    root.present().map_err(err(path))?;
+    root.present().map_err(err(path))
+}
+
+/// The axes of a grid panel, a tick at every whole x and y its cells span; its plotting area.
+fn grid_axes<'b>(
+    area: &DrawingArea<BitMapBackend<'b>, Shift>,
+    p: &GridPanel,
+    (xlabel, ylabel): (&str, &str),
+    path: &Path,
+) -> Result<GridArea<'b>> {
+    const LAYOUT: Layout = Layout {
+        margin: [10; 4],
+        title_px: 16.0,
+        x_label_px: 35,
+        y_label_px: 45,
+        right_label_px: 0,
+    };
+    let (x0, x1) = range(p.cells.iter().map(|c| c.0), false);
+    let (y0, y1) = range(p.cells.iter().map(|c| c.1), false);
+    let mut chart = LAYOUT
+        .builder(area, &p.title)
+        .build_cartesian_2d(x0 - 0.5..x1 + 0.5, y0 - 0.5..y1 + 0.5)
+        .map_err(err(path))?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(xlabel)
+        .y_desc(ylabel)
+        .x_labels((x1 - x0) as usize + 1)
+        .y_labels((y1 - y0) as usize + 1)
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| format!("{v:.0}"))
+        .label_style(("sans-serif", 12))
+        .draw()
+        .map_err(err(path))?;
+    Ok(chart.plotting_area().clone())
+}
+
+/// The cells of `p` in their colours (zero or round-off hatched grey); their values, still
+/// to be written.
+fn draw_cells(data: &GridArea<'_>, p: &GridPanel, path: &Path) -> Result<Vec<CellText>> {
+    let plot = data.strip_coord_spec();
+    let px = |x: f64, y: f64| relative_px(data, (x, y));
+    let mut values = Vec::new();
+    for (c, shade) in p.cells.iter().zip(cell_shades(p)) {
+        let (a, b) = (px(c.0 - 0.5, c.1 + 0.5), px(c.0 + 0.5, c.1 - 0.5));
+        let (fill, ink) = match shade {
+            Some(t) => (colormap(t), if t > 0.6 { BLACK } else { WHITE }),
+            None => (ROUNDOFF_FILL, BLACK),
+        };
+        match shade {
+            Some(_) => plot
+                .draw(&Rectangle::new(
+                    [nearest_px(a), nearest_px(b)],
+                    fill.filled(),
+                ))
+                .map_err(err(path))?,
+            None => draw_roundoff_box(&plot, a, b, 12.0, path)?,
+        }
+        let text = match c.2 {
+            0.0 => "0".to_string(),
+            v => format!("{v:.2e}"),
+        };
+        let (tw, th) = text_size(&text, CELL_FONT_PX);
+        let centre = px(c.0, c.1);
+        let rect = Rect::around(centre, 0.5 * tw + 2.0, 0.5 * th + 2.0);
+        values.push(CellText {
+            text,
+            centre,
+            rect,
+            fill,
+            ink,
+        });
+    }
+    Ok(values)
+}
+
+/// Each cell's value on a patch of its cell's colour; the patches, which line labels must
+/// not cover.
+fn write_values(
+    plot: &DrawingArea<BitMapBackend<'_>, Shift>,
+    values: Vec<CellText>,
+    path: &Path,
+) -> Result<Vec<Rect>> {
+    let mut taken = Vec::new();
+    for v in values {
+        let style = centred(CELL_FONT_PX).color(&v.ink);
+        draw_text_patch(plot, v.text, v.centre, v.rect, v.fill.filled(), style, path)?;
+        taken.push(v.rect);
+    }
+    Ok(taken)
+}
+
+/// Each line's label on the line, nearest its end, where it covers none of the `taken`
+/// boxes (nor another label) and stays inside the plot.
+fn label_lines(
+    data: &GridArea<'_>,
+    lines: &[(String, Vec<(f64, f64)>)],
+    mut taken: Vec<Rect>,
+    path: &Path,
+) -> Result<()> {
+    let plot = data.strip_coord_spec();
+    let (dw, dh) = pixels_f64(plot.dim_in_pixel());
+    let inside = Rect {
+        x0: 0.0,
+        y0: 0.0,
+        x1: dw,
+        y1: dh,
+    };
+    for (label, pts) in lines {
+        let (tw, th) = text_size(label, LINE_FONT_PX);
+        let (hw, hh) = (0.5 * tw + 3.0, 0.5 * th + 2.0);
+        let best = pts
+            .iter()
+            .map(|q| relative_px(data, *q))
+            .map(|c| {
+                let r = Rect::around(c, hw, hh);
+                let out = r.area() - r.overlap(&inside);
+                let covered: f64 = taken.iter().map(|t| t.overlap(&r)).sum();
+                (covered + 1e3 * out, c, r)
+            })
+            .rev()
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        if let Some((_, c, r)) = best {
+            let style = centred(LINE_FONT_PX).color(&RED);
+            let fill = WHITE.mix(0.85).filled();
+            draw_text_patch(&plot, label.clone(), c, r, fill, style, path)?;
+            taken.push(r);
+        }
+    }
+    Ok(())
+}
+
+/// The round-off note in a grid panel's title row, right-aligned: a hatched swatch and its
+/// meaning.
+fn roundoff_note(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    roundoff: f64,
+    path: &Path,
+) -> Result<()> {
+    let note = format!("0 / round-off (≤ {roundoff:.0e})");
+    let (tw, th) = text_size(&note, CELL_FONT_PX);
+    let (aw, _) = area.dim_in_pixel();
+    let x = f64::from(aw) - tw - 14.0;
+    let (s0, s1) = ((x - 22.0, 8.0), (x - 6.0, 8.0 + 16.0));
+    draw_roundoff_box(area, s0, s1, 6.0, path)?;
+    area.draw(&Rectangle::new(
+        [nearest_px(s0), nearest_px(s1)],
+        BLACK.stroke_width(1),
+    ))
+    .map_err(err(path))?;
+    area.draw(&Text::new(
+        note,
+        nearest_px((x, 8.0 + 8.0 - 0.5 * th)),
+        ("sans-serif", CELL_FONT_PX).into_font(),
+    ))
+    .map_err(err(path))?;
+    Ok(())
+}
+
+/// A text style `font_px` high centred on its position.
+fn centred(font_px: f64) -> TextStyle<'static> {
+    TextStyle::from(("sans-serif", font_px).into_font()).pos(Pos::new(HPos::Center, VPos::Center))
+}
+
+/// `text` centred at `centre` on the box `r` filled in `fill` (pixels of `area`).
+fn draw_text_patch(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    text: String,
+    centre: (f64, f64),
+    r: Rect,
+    fill: ShapeStyle,
+    style: TextStyle<'_>,
+    path: &Path,
+) -> Result<()> {
+    let corners = [nearest_px((r.x0, r.y0)), nearest_px((r.x1, r.y1))];
+    area.draw(&Rectangle::new(corners, fill))
+        .map_err(err(path))?;
+    area.draw(&Text::new(text, nearest_px(centre), style))
+        .map_err(err(path))?;
     Ok(())
 }
