@@ -33,20 +33,6 @@ pub const KIND: Kind = Kind {
     },
 };
 
-impl Outcome for StudyResult {
-    fn write(&self, dir: &Path) -> Result<()> {
-        report::write_study(self, dir)
-    }
-    fn console(&self, dir: &Path) -> String {
-        report::console(self, dir)
-    }
-    fn warnings(&self) -> &[String] {
-        &self.warnings
-    }
-    fn failures(&self) -> Vec<String> {
-        StudyResult::failures(self)
-    }
-}
 
 use crate::analytical::Exact;
 use crate::case::Case;

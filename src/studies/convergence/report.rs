@@ -15,6 +15,7 @@ use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
+use crate::verify::kind::Outcome;
 
 /// One row of variants.csv: a variant family's error.
 #[derive(Serialize)]
@@ -1028,5 +1029,21 @@ fn verdict_text(r: &RateRow) -> String {
         (Verdict::NotConverging, _) => "does not converge".into(),
         (Verdict::FixedByEquilibrium, _) => "fixed by equilibrium".into(),
         _ => "no fit".into(),
+    }
+}
+
+/// The kind's outcome writes this report.
+impl Outcome for StudyResult {
+    fn write(&self, dir: &Path) -> Result<()> {
+        write_study(self, dir)
+    }
+    fn console(&self, dir: &Path) -> String {
+        console(self, dir)
+    }
+    fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+    fn failures(&self) -> Vec<String> {
+        StudyResult::failures(self)
     }
 }

@@ -8,6 +8,7 @@ use crate::report::plot::{self, MeshPanel, Panel, Series};
 use crate::studies::paper::{PaperResult, Run};
 use std::fmt::Write as _;
 use std::path::Path;
+use crate::verify::kind::Outcome;
 
 fn magnification(runs: &[&Run]) -> f64 {
     let mut umax = 0.0f64;
@@ -343,4 +344,14 @@ pub fn console(res: &PaperResult, dir: &Path) -> String {
     }
     let _ = writeln!(s, "wrote {} ({:.1} s)", dir.display(), res.wall_s);
     s
+}
+
+/// The kind's outcome writes this report.
+impl Outcome for PaperResult {
+    fn write(&self, dir: &Path) -> Result<()> {
+        write_paper(self, dir)
+    }
+    fn console(&self, dir: &Path) -> String {
+        console(self, dir)
+    }
 }

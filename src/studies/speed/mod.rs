@@ -5,7 +5,7 @@
 
 pub mod report;
 
-use crate::verify::kind::{Found, Kind, Outcome};
+use crate::verify::kind::{Found, Kind};
 
 /// The kind: one built-in study, `study speed`.
 pub const KIND: Kind = Kind {
@@ -16,14 +16,6 @@ pub const KIND: Kind = Kind {
     run: |_, _| Ok(Some(Box::new(run()?))),
 };
 
-impl Outcome for SpeedResult {
-    fn write(&self, dir: &std::path::Path) -> Result<()> {
-        report::write_speed(self, dir)
-    }
-    fn console(&self, dir: &std::path::Path) -> String {
-        report::console(self, dir)
-    }
-}
 
 use crate::case::{Case, PeakMemory, RunSummary, release_free_heap};
 use crate::contact::Method;

@@ -11,6 +11,7 @@ use crate::solve::SolverKind;
 use crate::studies::speed::{FAMILIES, Family, SpeedResult, SpeedRun};
 use serde::Serialize;
 use std::path::Path;
+use crate::verify::kind::Outcome;
 
 /// One row of speed.csv: one run against its floor.
 #[derive(Debug, Serialize, serde::Deserialize)]
@@ -490,4 +491,14 @@ fn seconds(v: f64) -> String {
         (2 - v.abs().max(1e-300).log10().floor() as i32).max(0) as usize,
         v
     )
+}
+
+/// The kind's outcome writes this report.
+impl Outcome for SpeedResult {
+    fn write(&self, dir: &Path) -> Result<()> {
+        write_speed(self, dir)
+    }
+    fn console(&self, dir: &Path) -> String {
+        console(self, dir)
+    }
 }

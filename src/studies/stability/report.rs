@@ -11,6 +11,7 @@ use crate::solve::SolverKind;
 use crate::studies::stability::{HardCase, StabilityResult};
 use std::fmt::Write as _;
 use std::path::Path;
+use crate::verify::kind::Outcome;
 
 /// Write the report of `study stability`.
 pub fn write_stability(res: &StabilityResult, dir: &Path) -> Result<()> {
@@ -186,4 +187,14 @@ pub fn console(res: &StabilityResult, dir: &Path) -> String {
     }
     let _ = writeln!(s, "wrote {} ({:.1} s)", dir.display(), res.wall_s);
     s
+}
+
+/// The kind's outcome writes this report.
+impl Outcome for StabilityResult {
+    fn write(&self, dir: &Path) -> Result<()> {
+        write_stability(self, dir)
+    }
+    fn console(&self, dir: &Path) -> String {
+        console(self, dir)
+    }
 }

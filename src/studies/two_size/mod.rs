@@ -18,8 +18,7 @@
 
 pub mod report;
 
-use crate::verify::kind::{Found, Kind, Outcome};
-use std::path::Path;
+use crate::verify::kind::{Found, Kind};
 
 /// The kind: study files with a `[two_size]` table.
 pub const KIND: Kind = Kind {
@@ -38,20 +37,6 @@ pub const KIND: Kind = Kind {
     },
 };
 
-impl Outcome for TwoSizeResult {
-    fn write(&self, dir: &Path) -> Result<()> {
-        report::write_two_size(self, dir)
-    }
-    fn console(&self, dir: &Path) -> String {
-        report::console(self, dir)
-    }
-    fn warnings(&self) -> &[String] {
-        &self.warnings
-    }
-    fn failures(&self) -> Vec<String> {
-        TwoSizeResult::failures(self)
-    }
-}
 
 use crate::case::Case;
 use crate::contact::Method;

@@ -16,6 +16,7 @@ use crate::verify::table::{ErrorRecord, join};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
+use crate::verify::kind::Outcome;
 
 /// The quantities drawn as maps.
 const MAPPED: [Quantity; 4] = [
@@ -696,4 +697,20 @@ pub fn console(res: &TwoSizeResult, dir: &Path) -> String {
     }
     let _ = writeln!(s, "study {:.1} s\nwrote {}", res.wall_s, dir.display());
     s
+}
+
+/// The kind's outcome writes this report.
+impl Outcome for TwoSizeResult {
+    fn write(&self, dir: &Path) -> Result<()> {
+        write_two_size(self, dir)
+    }
+    fn console(&self, dir: &Path) -> String {
+        console(self, dir)
+    }
+    fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+    fn failures(&self) -> Vec<String> {
+        TwoSizeResult::failures(self)
+    }
 }
