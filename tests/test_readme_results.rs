@@ -59,6 +59,13 @@ fn readme_headline_matches_the_committed_reports() {
     assert!(readme.find("```sh").unwrap() < what_it_is && what_it_is < start);
 }
 
+/// The headline table's row of study `name`.
+fn headline_row<'a>(text: &'a str, name: &str) -> &'a str {
+    text.lines()
+        .find(|l| l.starts_with(&format!("| [`{name}`]")))
+        .unwrap_or_else(|| panic!("no headline row for {name}"))
+}
+
 /// Every number with a decimal point in the headline table's rows is a rate (to 2 or 3
 /// decimals) of a fitted or drifting row of that study, or its standard error: no rate a
 /// verdict does not support is printed.
@@ -67,10 +74,7 @@ fn headline_prints_only_rates_the_verdicts_support() {
     let text = headline(&root().join("reports")).unwrap();
     let mut checked = 0;
     for (name, _) in HEADLINE {
-        let row = text
-            .lines()
-            .find(|l| l.starts_with(&format!("| [`{name}`]")))
-            .unwrap_or_else(|| panic!("no headline row for {name}"));
+        let row = headline_row(&text, name);
         let path = root().join("reports").join(name).join("rates.csv");
         let rows: Vec<RateRecord> = read(&path).unwrap();
         let mut allowed = Vec::new();
@@ -219,10 +223,7 @@ fn headline_cells_state_their_own_rows_rates() {
     let text = headline(&root().join("reports")).unwrap();
     let mut checked = 0;
     for (name, _) in HEADLINE {
-        let row = text
-            .lines()
-            .find(|l| l.starts_with(&format!("| [`{name}`]")))
-            .unwrap_or_else(|| panic!("no headline row for {name}"));
+        let row = headline_row(&text, name);
         let rates: Vec<RateRecord> =
             read(&root().join("reports").join(name).join("rates.csv")).unwrap();
         let wrong = unsupported(row, &rates);

@@ -10,3 +10,16 @@ pub mod plot;
 pub mod solve_output;
 
 pub use folder::{Output, Staging, check_writable, remove_live, reports_dir, write_folder};
+
+/// A study report's opening: the title `Study `name``, the study's description and its
+/// scene's name and description, each a paragraph.
+pub fn study_heading(
+    doc: &mut markdown::Doc,
+    name: &str,
+    description: &str,
+    scene: &crate::scene::Scene,
+) {
+    doc.heading(1, format!("Study `{name}`"))
+        .paragraph(description)
+        .paragraph(format!("Scene `{}`: {}", scene.name, scene.description));
+}

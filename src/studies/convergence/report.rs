@@ -416,13 +416,8 @@ fn readme(res: &StudyResult) -> String {
 
 /// The title, the study's and the scene's descriptions, and how to regenerate the report.
 fn title(doc: &mut Doc, res: &StudyResult) {
-    doc.heading(1, format!("Study `{}`", res.name))
-        .paragraph(&res.description)
-        .paragraph(format!(
-            "Scene `{}`: {}",
-            res.scene.name, res.scene.description
-        ))
-        .paragraph(format!(
+    crate::report::study_heading(doc, &res.name, &res.description, &res.scene);
+    doc.paragraph(format!(
             "Regenerate with `cargo run --release -- study {}` ({:.0} s on this machine, {} cores). Solver `{}`, {} uniform time steps over [0, {}].",
             res.name,
             res.wall_s,

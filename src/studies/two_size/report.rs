@@ -515,13 +515,8 @@ fn readme(res: &TwoSizeResult) -> String {
 
 /// The title, the study's and the scene's descriptions, the grid and how to regenerate it.
 fn title(doc: &mut Doc, res: &TwoSizeResult) {
-    doc.heading(1, format!("Study `{}`", res.name))
-        .paragraph(&res.description)
-        .paragraph(format!(
-            "Scene `{}`: {}",
-            res.scene.name, res.scene.description
-        ))
-        .paragraph(format!(
+    crate::report::study_heading(doc, &res.name, &res.description, &res.scene);
+    doc.paragraph(format!(
             "Regenerate with `cargo run --release -- study {}` ({:.0} s on this machine, {} cores). Grid: every pair of levels {} of the slave (body 1) and the master (body 2); one-sided sweeps: each body over those levels with the other at level {fixed}; and (level {fixed}, level {fixed}) as their floor. Slave choices: {}. {} time steps.",
             res.name,
             res.wall_s,
