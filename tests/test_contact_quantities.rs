@@ -14,25 +14,29 @@ use contact_rates::verify::contact_error::{
     TruthPressure, band, contact_step, edges, penetration_l2,
 };
 use contact_rates::verify::exact_error::ExactComparison;
+use contact_rates::verify::field::P1Field;
 
 #[test]
 fn weighted_norm_resultant_and_variation_of_a_linear_pressure() {
     let case = common::case("contact-mms", 2, Method::Mortar, &[]);
     let p = &case.problem;
-    // A discrete pressure p_h(x) = 1 - x at the body-1 nodes, against a zero truth.
-    let mut s = contact_rates::solve::State {
-        time: 1.0,
-        u: vec![0.0; 2 * p.model.n_nodes],
-        sigma: vec![Stress::zeros(); p.model.elements.len()],
-        lambda: vec![0.0; p.rows.len()],
-    };
+    // A discrete pressure p_h(x) = 1 - x at the nodes, given as an outside code gives it
+    // (nodal values, no multipliers), against a zero truth.
+    let pressure = (0..p.model.n_nodes)
+        .map(|n| 1.0 - p.model.position(n)[0])
+        .collect();
+    let s = P1Field::from_nodal(
+        &p.model,
+        &p.interface,
+        1.0,
+        vec![0.0; 2 * p.model.n_nodes],
+        Some(vec![Stress::zeros(); p.model.elements.len()]),
+        Some(pressure),
+    )
+    .unwrap();
     let piece = &p.interface.pieces[0];
-    for (k, row) in p.rows.iter().enumerate() {
-        let x = piece.a[0] + piece.slave_s[row.i] * piece.tangent[0];
-        s.lambda[k] = row.weight * (1.0 - x);
-    }
     let zero = TruthPressure::Profile(vec![vec![(0.0, 0.0), (1.0, 0.0)]], vec![vec![]]);
-    let c = contact_step(p, &s, &zero);
+    let c = contact_step(&p.interface, &s, &zero).pressure.unwrap();
     // sum_e h_e int_e (1 - x)^2 = sum_e h_e ((1 - a)^3 - (1 - b)^3) / 3.
     let xs: Vec<f64> = piece
         .slave_s
@@ -88,13 +92,16 @@ fn band_stress_error_of_a_known_stress_is_the_band_area() {
     let p = &case.problem;
     let scene = contact_rates::scene::Scene::load("patch").unwrap();
     let cmp = ExactComparison::new(scene.exact.as_deref().unwrap(), 2);
-    let s = contact_rates::solve::State {
-        time: 1.0,
-        u: vec![0.0; 2 * p.model.n_nodes],
-        sigma: vec![Stress::zeros(); p.model.elements.len()],
-        lambda: vec![0.0; p.rows.len()],
-    };
-    let d = cmp.difference(p, &s);
+    let s = P1Field::from_nodal(
+        &p.model,
+        &p.interface,
+        1.0,
+        vec![0.0; 2 * p.model.n_nodes],
+        Some(vec![Stress::zeros(); p.model.elements.len()]),
+        None,
+    )
+    .unwrap();
+    let d = cmp.difference(&p.model, &p.interface, &s);
     let area: f64 = p
         .model
         .elements
@@ -113,7 +120,7 @@ fn band_stress_error_of_a_known_stress_is_the_band_area() {
         100.0 * area
     );
     assert_eq!(
-        band(p).iter().filter(|&&b| b).count(),
+        band(&p.model, &p.interface).iter().filter(|&&b| b).count(),
         p.model
             .elements
             .iter()

@@ -10,6 +10,7 @@ mod common;
 use contact_rates::contact::Method;
 use contact_rates::material::Stress;
 use contact_rates::solve::{self, Settings, State};
+use contact_rates::verify::field::P1Field;
 use contact_rates::verify::intersect::{Tri, barycentric, clip};
 use contact_rates::verify::norms::{Comparison, norms};
 
@@ -125,18 +126,23 @@ fn nested_meshes_give_the_direct_sum() {
     let sf = solve::solve(&fine.problem, &Settings::default(), 2, false).unwrap();
     let (mc, mf) = (&coarse.problem.model, &fine.problem.model);
     let cmp = Comparison::new(mc, mf);
-    let via = cmp.difference(mc, sc.last(), mf, sf.last());
+    let via = cmp.difference(
+        mc,
+        &P1Field::of_state(&coarse.problem, sc.last()),
+        mf,
+        &P1Field::of_state(&fine.problem, sf.last()),
+    );
     let pro = prolong(mc, sc.last(), mf);
-    let d = State {
+    let d = P1Field {
         time: 1.0,
         u: pro.u.iter().zip(&sf.last().u).map(|(a, b)| a - b).collect(),
-        sigma: pro
+        stress: pro
             .sigma
             .iter()
             .zip(&sf.last().sigma)
             .map(|(a, b)| a - b)
             .collect(),
-        lambda: Vec::new(),
+        pressure: None,
     };
     let direct = norms(mf, &d);
     println!("via intersection: {via:?}\ndirect on the fine mesh: {direct:?}");

@@ -12,11 +12,12 @@
 //! with 8 Gauss points per piece: exact for the piecewise-linear truth of a reference, and
 //! far below the errors measured for a smooth exact pressure.
 
-use super::norms::{eval_pl, on_piece, pressure_profile, project};
+use super::field::{P1Field, PressureProfile};
+use super::norms::{eval_pl, on_piece, project};
 use crate::analytical::Exact;
 use crate::contact::{Interface, Piece};
+use crate::fe::Model;
 use crate::quadrature::gauss_legendre;
-use crate::solve::{Problem, State};
 
 /// The truth's pressure on the study's pieces of Gamma_C.
 pub enum TruthPressure<'a> {
@@ -27,9 +28,18 @@ pub enum TruthPressure<'a> {
     Exact(&'a Exact, f64),
 }
 
-/// What one state measured on Gamma_C (squared norms where a norm is named).
+/// What one field measured on Gamma_C (squared norms where a norm is named).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct ContactStep {
+    /// What its pressure measured; `None` when the field gives no pressure.
+    pub pressure: Option<PressureStep>,
+    /// ||[u.nu]^+||^2 in L2(Gamma_C) (length^3).
+    pub penetration_l2: f64,
+}
+
+/// What one field's pressure measured on Gamma_C (squared norms where a norm is named).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct PressureStep {
     /// sum_e h_e ||p_h - p||^2_e over the study's body-1 segments e.
     pub pressure_weighted: f64,
     /// (int p_h - int p, int |p|).
@@ -41,20 +51,20 @@ pub struct ContactStep {
     /// Largest distance of a truth's contact edge to the nearest discrete one (length;
     /// the length of Gamma_C when the discrete solution has none, 0 when neither has).
     pub edge: f64,
-    /// ||[u.nu]^+||^2 in L2(Gamma_C) (length^3).
-    pub penetration_l2: f64,
 }
 
-/// The reference's nodal pressure and gap projected on each study piece (points within 1e-9
-/// of the piece's length), sorted and deduplicated.
+/// A reference's nodal pressure and gap projected on each study piece (points within 1e-9
+/// of the piece's length), sorted and deduplicated: the reference's displacement `u` and
+/// pressure on its Gamma_C `reference`.
 pub fn reference_profile(
     study: &Interface,
-    reference: &Problem,
-    r: &State,
+    reference: &Interface,
+    u: &[f64],
+    pressure: &PressureProfile,
 ) -> TruthPressure<'static> {
-    let jumps = crate::contact::normal_jumps(&reference.interface, &r.u);
-    let pressure = project(study, &pressure_profile(reference, r).concat());
-    let gap = project(study, &slave_gaps(&reference.interface, &jumps, &r.u));
+    let jumps = crate::contact::normal_jumps(reference, u);
+    let pressure = project(study, &pressure.concat());
+    let gap = project(study, &slave_gaps(reference, &jumps, u));
     TruthPressure::Profile(pressure, gap)
 }
 
@@ -207,21 +217,34 @@ impl TruthPressure<'_> {
     }
 }
 
-/// Everything one state of the study measures on Gamma_C against the truth.
-pub fn contact_step(p: &Problem, s: &State, truth: &TruthPressure) -> ContactStep {
+/// Everything one field of the study on Gamma_C `interface` measures there against the
+/// truth.
+pub fn contact_step(interface: &Interface, s: &P1Field, truth: &TruthPressure) -> ContactStep {
+    let jumps = crate::contact::normal_jumps(interface, &s.u);
+    ContactStep {
+        pressure: s
+            .pressure
+            .as_ref()
+            .map(|p| pressure_step(interface, p, &jumps, &s.u, truth)),
+        penetration_l2: positive_jump_l2(interface.pieces.len(), &jumps),
+    }
+}
+
+/// What the pressure `profile` of a field with displacement `u` (normal jumps `jumps`)
+/// measures against the truth.
+fn pressure_step(
+    interface: &Interface,
+    profile: &PressureProfile,
+    jumps: &[(usize, f64, f64)],
+    u: &[f64],
+    truth: &TruthPressure,
+) -> PressureStep {
     let gauss = gauss_legendre(8);
-    let mut out = ContactStep::default();
-    let total: f64 = p.interface.length();
+    let mut out = PressureStep::default();
+    let total: f64 = interface.length();
     let mut worst_edge = 0.0f64;
-    let jumps = crate::contact::normal_jumps(&p.interface, &s.u);
-    let gaps = project(&p.interface, &slave_gaps(&p.interface, &jumps, &s.u));
-    for (i, (piece, profile)) in p
-        .interface
-        .pieces
-        .iter()
-        .zip(pressure_profile(p, s))
-        .enumerate()
-    {
+    let gaps = project(interface, &slave_gaps(interface, jumps, u));
+    for (i, (piece, profile)) in interface.pieces.iter().zip(profile).enumerate() {
         let ph: Vec<(f64, f64)> = profile
             .iter()
             .map(|&(x, v)| (on_piece(piece, x).0, v))
@@ -269,7 +292,6 @@ pub fn contact_step(p: &Problem, s: &State, truth: &TruthPressure) -> ContactSte
         }
     }
     out.edge = worst_edge;
-    out.penetration_l2 = positive_jump_l2(p.interface.pieces.len(), &jumps);
     out
 }
 
@@ -315,14 +337,14 @@ fn positive_jump_l2(pieces: usize, jumps: &[(usize, f64, f64)]) -> f64 {
 
 /// The triangles of both bodies with a node on Gamma_C: the band where node-on-segment's
 /// consistency error lives.
-pub fn band(p: &Problem) -> Vec<bool> {
-    let mut on = vec![false; p.model.n_nodes];
-    for piece in &p.interface.pieces {
+pub fn band(model: &Model, interface: &Interface) -> Vec<bool> {
+    let mut on = vec![false; model.n_nodes];
+    for piece in &interface.pieces {
         for &n in piece.slave_nodes.iter().chain(&piece.master_nodes) {
             on[n] = true;
         }
     }
-    p.model
+    model
         .elements
         .iter()
         .map(|e| e.nodes.iter().any(|&n| on[n]))

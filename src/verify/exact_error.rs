@@ -6,12 +6,13 @@
 //! `abs` changing branch) is split along it and the rule applied on each piece, as the
 //! loads are ([`crate::quadrature::triangle_rule`]): one implementation for both.
 
-use super::norms::{SquaredNorms, pressure_profile};
+use super::field::{P1Field, PressureProfile};
+use super::norms::SquaredNorms;
 use crate::analytical::Exact;
+use crate::contact::Interface;
 use crate::expr::kink_functions;
 use crate::fe::Model;
 use crate::quadrature;
-use crate::solve::{Problem, State};
 
 /// Gauss points per direction of the default rule (16 points per triangle, degree 6).
 pub const DEFAULT_POINTS: usize = quadrature::DEFAULT_POINTS;
@@ -23,15 +24,15 @@ pub struct ExactComparison<'a> {
     segment: Vec<(f64, f64)>,
 }
 
-/// What one state measured against the exact solution at its time.
+/// What one field measured against the exact solution at its time.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct ExactDifference {
     /// Squared norms of (solution - exact).
     pub difference: SquaredNorms,
     /// Squared norms of the exact solution.
     pub exact: SquaredNorms,
-    /// (||p_h - p||^2, ||p||^2) on Gamma_C.
-    pub pressure: (f64, f64),
+    /// (||p_h - p||^2, ||p||^2) on Gamma_C; `None` when the field gives no pressure.
+    pub pressure: Option<(f64, f64)>,
     /// Largest |u| component of the exact solution at the mesh's nodes.
     pub max_displacement: f64,
     /// ||sigma - sigma_ex||^2 on the band of triangles touching Gamma_C.
@@ -53,14 +54,18 @@ impl<'a> ExactComparison<'a> {
         }
     }
 
-    /// Everything one state measures against the exact solution at the state's time.
-    pub fn difference(&self, p: &Problem, s: &State) -> ExactDifference {
-        let (m, ex, t) = (&p.model, self.exact, s.time);
+    /// Everything one field on `m` (with Gamma_C `interface`) measures against the exact
+    /// solution at the field's time.
+    pub fn difference(&self, m: &Model, interface: &Interface, s: &P1Field) -> ExactDifference {
+        let (ex, t) = (self.exact, s.time);
         let mut out = ExactDifference {
-            pressure: self.pressure_difference(p, s),
+            pressure: s
+                .pressure
+                .as_ref()
+                .map(|p| self.pressure_difference(interface, p, t)),
             ..Default::default()
         };
-        let band = super::contact_error::band(p);
+        let band = super::contact_error::band(m, interface);
         let kinks = [0, 1].map(|b| kink_functions(&ex.kinks(b), t));
         for (i, el) in m.elements.iter().enumerate() {
             let b = el.body;
@@ -74,7 +79,7 @@ impl<'a> ExactComparison<'a> {
                     }
                 }
             }
-            let sh = [s.sigma[i][0], s.sigma[i][1], s.sigma[i][2]];
+            let sh = [s.stress[i][0], s.stress[i][1], s.stress[i][2]];
             let rule = quadrature::triangle_rule(pos, &kinks[b], &self.triangle);
             for &(l1, l2, w) in rule.iter() {
                 let lam = [1.0 - l1 - l2, l1, l2];
@@ -111,11 +116,15 @@ impl<'a> ExactComparison<'a> {
     }
 
     /// (||p_h - p||^2, ||p||^2) in L2(Gamma_C), p_h linear between the slave nodes.
-    fn pressure_difference(&self, p: &Problem, s: &State) -> (f64, f64) {
-        let t = s.time;
+    fn pressure_difference(
+        &self,
+        interface: &Interface,
+        pressure: &PressureProfile,
+        t: f64,
+    ) -> (f64, f64) {
         let (mut diff, mut norm) = (0.0, 0.0);
         let kinks = kink_functions(&self.exact.contact_kinks(), t);
-        for (piece, profile) in p.interface.pieces.iter().zip(pressure_profile(p, s)) {
+        for (piece, profile) in interface.pieces.iter().zip(pressure) {
             for w in profile.windows(2) {
                 let ((xa, pa), (xb, pb)) = (w[0], w[1]);
                 let len = (xb[0] - xa[0]).hypot(xb[1] - xa[1]);
@@ -137,9 +146,9 @@ impl<'a> ExactComparison<'a> {
 
 /// The exact pressure and gap along Gamma_C at time `t`, at 401 points per piece:
 /// (x, y, pressure, gap); a field the solution does not give is NaN.
-pub fn exact_profiles(p: &Problem, exact: &Exact, t: f64) -> Vec<([f64; 2], f64, f64)> {
+pub fn exact_profiles(interface: &Interface, exact: &Exact, t: f64) -> Vec<([f64; 2], f64, f64)> {
     let mut out = Vec::new();
-    for piece in &p.interface.pieces {
+    for piece in &interface.pieces {
         let n = piece.normal;
         for k in 0..=400 {
             let s = piece.length * k as f64 / 400.0;

@@ -1,11 +1,13 @@
-//! The verification toolkit that every study kind shares: errors between meshes
-//! ([`norms`] over [`intersect`]ions, [`contact_error`] on Gamma_C) and against exact
-//! solutions ([`exact_error`]), the [`quantity`] names, [`rates`] and their verdicts, the
+//! The verification toolkit that every study kind shares: errors of a discrete solution
+//! ([`field`]: plain P1 displacements and P0 stresses, whoever computed them) against
+//! another mesh's ([`norms`] over [`intersect`]ions, [`contact_error`] on Gamma_C) and
+//! against exact solutions ([`exact_error`]), the [`quantity`] names, [`rates`] and their verdicts, the
 //! study file ([`study_file`]), the independent solves of a study ([`jobs`]), and what a
 //! study kind is ([`kind`]). Nothing here knows any particular kind.
 
 pub mod contact_error;
 pub mod exact_error;
+pub mod field;
 pub mod intersect;
 pub mod jobs;
 pub mod kind;
@@ -19,6 +21,7 @@ pub mod truth;
 use crate::case::Case;
 use crate::error::Result;
 use crate::solve::{self, Settings, Solution, SolverKind};
+use field::P1History;
 use norms::Comparison;
 use std::time::Instant;
 
@@ -40,22 +43,21 @@ pub fn solve_case(case: &Case, kind: SolverKind, steps: usize) -> Result<(Soluti
 
 /// Theorem-quantity distance of two solutions with the same time grid, relative to `b`.
 pub fn theorem_distance(ca: &Case, sa: &Solution, cb: &Case, sb: &Solution) -> f64 {
-    let cmp = Comparison::new(&ca.problem.model, &cb.problem.model);
-    let d = sa
-        .states
+    let (a, b) = (
+        P1History::of_solution(ca, sa),
+        P1History::of_solution(cb, sb),
+    );
+    let cmp = Comparison::new(a.model, b.model);
+    let d = a
+        .steps
         .iter()
-        .zip(&sb.states)
-        .skip(1)
-        .map(|(x, y)| {
-            cmp.difference(&ca.problem.model, x, &cb.problem.model, y)
-                .theorem()
-        })
+        .zip(&b.steps)
+        .map(|(x, y)| cmp.difference(a.model, x, b.model, y).theorem())
         .fold(0.0f64, f64::max);
-    let n = sb
-        .states
+    let n = b
+        .steps
         .iter()
-        .skip(1)
-        .map(|y| norms::norms(&cb.problem.model, y).theorem())
+        .map(|y| norms::norms(b.model, y).theorem())
         .fold(0.0f64, f64::max);
     d / n
 }

@@ -1,10 +1,10 @@
 //! Errors between a study solution and a reference solution on different meshes of the
 //! same bodies, integrated exactly over the intersection of the two triangulations.
 
+use super::field::{P1Field, PressureProfile};
 use super::intersect::{Overlap, Tri, intersect};
 use crate::contact::{Interface, Piece};
 use crate::fe::Model;
-use crate::solve::{Problem, State};
 use nalgebra::Matrix2;
 
 /// The overlaps of a study model with a reference model, per body, with global element
@@ -64,8 +64,8 @@ fn grad(m: &Model, e: usize, u: &[f64]) -> Matrix2<f64> {
     g
 }
 
-/// Norms of a state on its own mesh (exact P1 mass integrals).
-pub fn norms(m: &Model, s: &State) -> SquaredNorms {
+/// Norms of a field on its own mesh (exact P1 mass integrals).
+pub fn norms(m: &Model, s: &P1Field) -> SquaredNorms {
     let mut n = SquaredNorms::default();
     for (i, e) in m.elements.iter().enumerate() {
         for c in 0..2 {
@@ -75,7 +75,7 @@ pub fn norms(m: &Model, s: &State) -> SquaredNorms {
             n.l2_u += e.area / 12.0 * (sq + sum * sum);
         }
         n.semi_u += e.area * grad(m, i, &s.u).norm_squared();
-        n.stress += e.area * tensor_norm2(&s.sigma[i]);
+        n.stress += e.area * tensor_norm2(&s.stress[i]);
     }
     n
 }
@@ -106,9 +106,9 @@ impl Comparison {
     pub fn difference(
         &self,
         study: &Model,
-        s: &State,
+        s: &P1Field,
         reference: &Model,
-        r: &State,
+        r: &P1Field,
     ) -> SquaredNorms {
         let gs: Vec<Matrix2<f64>> = (0..study.elements.len())
             .map(|e| grad(study, e, &s.u))
@@ -133,17 +133,17 @@ impl Comparison {
             }
             n.l2_u += o.area / 3.0 * l2;
             n.semi_u += o.area * (gs[o.a] - gr[o.b]).norm_squared();
-            n.stress += o.area * tensor_norm2(&(s.sigma[o.a] - r.sigma[o.b]));
+            n.stress += o.area * tensor_norm2(&(s.stress[o.a] - r.stress[o.b]));
         }
         n
     }
 
     /// ||sigma - sigma_ref||^2 over the overlaps of the study triangles marked in `band`.
-    pub fn band_stress(&self, s: &State, r: &State, band: &[bool]) -> f64 {
+    pub fn band_stress(&self, s: &P1Field, r: &P1Field, band: &[bool]) -> f64 {
         self.overlaps
             .iter()
             .filter(|o| band[o.a])
-            .map(|o| o.area * tensor_norm2(&(s.sigma[o.a] - r.sigma[o.b])))
+            .map(|o| o.area * tensor_norm2(&(s.stress[o.a] - r.stress[o.b])))
             .sum()
     }
 
@@ -166,17 +166,6 @@ impl Comparison {
             })
             .sum()
     }
-}
-
-/// Contact pressure along Gamma_C as (position, pressure) per piece, pressure = nodal
-/// multiplier / lumped weight (force per length), at the body-1 trace nodes.
-pub fn pressure_profile(p: &Problem, s: &State) -> Vec<Vec<([f64; 2], f64)>> {
-    let mut out: Vec<Vec<([f64; 2], f64)>> = vec![Vec::new(); p.interface.pieces.len()];
-    for (row, l) in p.rows.iter().zip(&s.lambda) {
-        let piece = &p.interface.pieces[row.piece];
-        out[row.piece].push((piece.point(piece.slave_s[row.i]), row.pressure(*l)));
-    }
-    out
 }
 
 fn profile_on(interface: &Interface, piece: usize, profile: &[([f64; 2], f64)]) -> Vec<(f64, f64)> {
@@ -241,20 +230,19 @@ pub fn project(study: &Interface, points: &[([f64; 2], f64)]) -> Vec<Vec<(f64, f
         .collect()
 }
 
-/// (||p - p_ref||^2, ||p_ref||^2) in L2(Gamma_C), exact for the piecewise-linear profiles.
-/// Pieces of the reference are matched to the study's by their geometry.
+/// (||p - p_ref||^2, ||p_ref||^2) in L2(Gamma_C), exact for the piecewise-linear profiles
+/// `study` on the pieces of `interface` and `reference` (anywhere on Gamma_C: its points are
+/// matched to the study's pieces by their geometry).
 pub fn pressure_difference(
-    study: &Problem,
-    s: &State,
-    reference: &Problem,
-    r: &State,
+    interface: &Interface,
+    study: &PressureProfile,
+    reference: &PressureProfile,
 ) -> (f64, f64) {
-    let ps = pressure_profile(study, s);
     // The reference's points that lie on each study piece.
-    let references = project(&study.interface, &pressure_profile(reference, r).concat());
+    let references = project(interface, &reference.concat());
     let (mut diff, mut norm) = (0.0, 0.0);
-    for (i, piece) in study.interface.pieces.iter().enumerate() {
-        let fs = profile_on(&study.interface, i, &ps[i]);
+    for (i, piece) in interface.pieces.iter().enumerate() {
+        let fs = profile_on(interface, i, &study[i]);
         let fr = &references[i];
         if fs.len() < 2 || fr.len() < 2 {
             continue;
@@ -274,13 +262,18 @@ pub fn pressure_difference(
     (diff, norm)
 }
 
-/// Norms of the difference `a - b` of two states on the same mesh (a time study's error).
-pub fn norms_of_difference(m: &Model, a: &State, b: &State) -> SquaredNorms {
-    let d = State {
+/// Norms of the difference `a - b` of two fields on the same mesh (a time study's error).
+pub fn norms_of_difference(m: &Model, a: &P1Field, b: &P1Field) -> SquaredNorms {
+    let d = P1Field {
         time: a.time,
-        u: a.u.iter().zip(&b.u).map(|(x, y)| x - y).collect(),
-        sigma: a.sigma.iter().zip(&b.sigma).map(|(x, y)| x - y).collect(),
-        lambda: Vec::new(),
+        u: a.u.iter().zip(b.u.iter()).map(|(x, y)| x - y).collect(),
+        stress: a
+            .stress
+            .iter()
+            .zip(b.stress.iter())
+            .map(|(x, y)| x - y)
+            .collect(),
+        pressure: None,
     };
     norms(m, &d)
 }

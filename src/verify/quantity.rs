@@ -1,7 +1,7 @@
 //! The quantities a convergence study measures, each a relative error of one time history
 //! against the reference's (max over the time steps).
 
-use super::contact_error::ContactStep;
+use super::contact_error::{ContactStep, PressureStep};
 use super::norms::SquaredNorms;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -132,8 +132,9 @@ pub struct Differences<'a> {
     pub fields: &'a [SquaredNorms],
     /// Squared norms of the reference per step.
     pub reference: &'a [SquaredNorms],
-    /// (||p - p_ref||^2, ||p_ref||^2) on Gamma_C per step.
-    pub pressure: &'a [(f64, f64)],
+    /// (||p - p_ref||^2, ||p_ref||^2) on Gamma_C per step; `None` when the solution gives
+    /// no pressure (the pressure quantities are then not measured).
+    pub pressure: Option<&'a [(f64, f64)]>,
     /// Largest interpenetration over the history (length).
     pub penetration: f64,
     /// Largest |u_ref| over the history (length).
@@ -148,7 +149,7 @@ pub struct Differences<'a> {
 
 impl Differences<'_> {
     /// Every quantity's relative error (max over the steps, relative to the reference's
-    /// max over the steps).
+    /// max over the steps); the pressure quantities only when the solution gives a pressure.
     pub fn relative(&self) -> BTreeMap<Quantity, f64> {
         let max_over = |f: &dyn Fn(&SquaredNorms) -> f64, v: &[SquaredNorms]| {
             v.iter().map(f).fold(0.0f64, f64::max)
@@ -156,30 +157,52 @@ impl Differences<'_> {
         let rel = |f: &dyn Fn(&SquaredNorms) -> f64| {
             max_over(f, self.fields) / max_over(f, self.reference).max(f64::MIN_POSITIVE)
         };
-        let pressure_diff = self
-            .pressure
-            .iter()
-            .map(|p| p.0.sqrt())
-            .fold(0.0f64, f64::max);
-        let pressure_ref = self
-            .pressure
-            .iter()
-            .map(|p| p.1.sqrt())
-            .fold(0.0f64, f64::max);
         let max =
             |f: &dyn Fn(&ContactStep) -> f64| self.contact.iter().map(f).fold(0.0f64, f64::max);
-        let ratio = |a: f64, b: f64| a / b.max(f64::MIN_POSITIVE);
         let band = self
             .band_stress
             .iter()
             .map(|b| b.sqrt())
             .fold(0.0f64, f64::max);
-        let p_norm = pressure_ref * self.contact_length.sqrt();
-        BTreeMap::from([
+        let mut out = BTreeMap::from([
             (
                 Quantity::BandStress,
                 ratio(band, max_over(&|n| n.stress.sqrt(), self.reference)),
             ),
+            (
+                Quantity::L2Penetration,
+                ratio(
+                    max(&|c| c.penetration_l2.sqrt()),
+                    self.contact_length.sqrt() * self.reference_displacement,
+                ),
+            ),
+            (Quantity::Theorem, rel(&|n| n.theorem())),
+            (Quantity::H1U, rel(&|n| n.h1())),
+            (Quantity::L2U, rel(&|n| n.l2_u.sqrt())),
+            (Quantity::L2Stress, rel(&|n| n.stress.sqrt())),
+            (
+                Quantity::MaxPenetration,
+                self.penetration / self.reference_displacement.max(f64::MIN_POSITIVE),
+            ),
+        ]);
+        if let Some(pressure) = self.pressure {
+            out.extend(self.pressure_quantities(pressure));
+        }
+        out
+    }
+
+    /// The quantities of the pressure on Gamma_C.
+    fn pressure_quantities(&self, pressure: &[(f64, f64)]) -> [(Quantity, f64); 5] {
+        let pressure_diff = pressure.iter().map(|p| p.0.sqrt()).fold(0.0f64, f64::max);
+        let pressure_ref = pressure.iter().map(|p| p.1.sqrt()).fold(0.0f64, f64::max);
+        let max = |f: &dyn Fn(&PressureStep) -> f64| {
+            self.contact
+                .iter()
+                .filter_map(|c| c.pressure.as_ref().map(f))
+                .fold(0.0f64, f64::max)
+        };
+        let p_norm = pressure_ref * self.contact_length.sqrt();
+        [
             (
                 Quantity::ContactEdge,
                 max(&|c| c.edge) / self.contact_length,
@@ -200,24 +223,14 @@ impl Differences<'_> {
                 ),
             ),
             (
-                Quantity::L2Penetration,
-                ratio(
-                    max(&|c| c.penetration_l2.sqrt()),
-                    self.contact_length.sqrt() * self.reference_displacement,
-                ),
-            ),
-            (Quantity::Theorem, rel(&|n| n.theorem())),
-            (Quantity::H1U, rel(&|n| n.h1())),
-            (Quantity::L2U, rel(&|n| n.l2_u.sqrt())),
-            (Quantity::L2Stress, rel(&|n| n.stress.sqrt())),
-            (
                 Quantity::L2Pressure,
                 pressure_diff / pressure_ref.max(f64::MIN_POSITIVE),
             ),
-            (
-                Quantity::MaxPenetration,
-                self.penetration / self.reference_displacement.max(f64::MIN_POSITIVE),
-            ),
-        ])
+        ]
     }
+}
+
+/// a / b, with b kept off 0.
+fn ratio(a: f64, b: f64) -> f64 {
+    a / b.max(f64::MIN_POSITIVE)
 }

@@ -4,12 +4,12 @@
 
 use crate::analytical::Exact;
 use crate::case::Case;
-use crate::metrics;
 use crate::solve::{Solution, inf_norm};
 use crate::verify::contact_error::{
     self, ContactStep, TruthPressure, contact_step, reference_profile,
 };
 use crate::verify::exact_error::{ExactComparison, ExactDifference};
+use crate::verify::field::{P1Field, P1History};
 use crate::verify::jobs::{JobId, Solved};
 use crate::verify::norms::{self, Comparison, SquaredNorms};
 use crate::verify::quantity::{Differences, Quantity};
@@ -64,10 +64,9 @@ pub fn estimated_reference_error(d1: f64, d2: f64) -> (f64, f64) {
 pub fn reference(ids: [JobId; 3], solved: &mut Solved, level: usize) -> ReferenceSolution {
     let [coarser2, coarser1, finest] = ids.map(|id| solved.take(id));
     let (case, solution) = finest;
-    let norms = solution
-        .states
+    let norms = P1History::of_solution(&case, &solution)
+        .steps
         .iter()
-        .skip(1)
         .map(|s| norms::norms(&case.problem.model, s))
         .collect();
     let max_displacement = solution
@@ -92,8 +91,14 @@ pub fn reference(ids: [JobId; 3], solved: &mut Solved, level: usize) -> Referenc
         quantity_errors: BTreeMap::new(),
     };
     // Every quantity's distances of the two coarser levels to the reference.
-    let d1 = relative_errors(&coarser1.0, &coarser1.1, &reference);
-    let d2 = relative_errors(&coarser2.0, &coarser2.1, &reference);
+    let d1 = relative_errors(
+        &P1History::of_solution(&coarser1.0, &coarser1.1),
+        &reference,
+    );
+    let d2 = relative_errors(
+        &P1History::of_solution(&coarser2.0, &coarser2.1),
+        &reference,
+    );
     for q in Quantity::ALL {
         let (error, rate) = estimated_reference_error(d1[&q], d2[&q]);
         if q == Quantity::Theorem {
@@ -117,9 +122,15 @@ pub enum Truth<'s> {
 impl Truth<'_> {
     /// Every quantity's relative error of one solved level.
     pub fn relative_errors(&self, case: &Case, sol: &Solution) -> BTreeMap<Quantity, f64> {
+        self.errors(&P1History::of_solution(case, sol))
+    }
+
+    /// Every quantity's relative error of a discrete solution, whoever computed it (the
+    /// pressure quantities only when it gives a pressure).
+    pub fn errors(&self, history: &P1History) -> BTreeMap<Quantity, f64> {
         match self {
-            Truth::Solved(reference) => relative_errors(case, sol, reference),
-            Truth::Exact(exact, points) => exact_errors(case, sol, exact, *points),
+            Truth::Solved(reference) => relative_errors(history, reference),
+            Truth::Exact(exact, points) => exact_errors(history, exact, *points),
         }
     }
 
@@ -137,93 +148,101 @@ impl Truth<'_> {
     }
 }
 
-/// Every quantity's relative error of one solved level against the exact solution.
-pub fn exact_errors(
-    case: &Case,
-    sol: &Solution,
-    exact: &Exact,
-    points: usize,
-) -> BTreeMap<Quantity, f64> {
+/// Every quantity's relative error of a discrete solution against the exact solution.
+pub fn exact_errors(history: &P1History, exact: &Exact, points: usize) -> BTreeMap<Quantity, f64> {
+    let (model, interface) = (history.model, history.interface);
     let cmp = ExactComparison::new(exact, points);
-    let diffs: Vec<ExactDifference> = sol
-        .states
+    let diffs: Vec<ExactDifference> = history
+        .steps
         .iter()
-        .skip(1)
-        .map(|s| cmp.difference(&case.problem, s))
+        .map(|s| cmp.difference(model, interface, s))
         .collect();
     let fields: Vec<SquaredNorms> = diffs.iter().map(|d| d.difference).collect();
     let reference: Vec<SquaredNorms> = diffs.iter().map(|d| d.exact).collect();
-    let pressure: Vec<(f64, f64)> = diffs.iter().map(|d| d.pressure).collect();
+    let pressure: Option<Vec<(f64, f64)>> = diffs.iter().map(|d| d.pressure).collect();
     let band_stress: Vec<f64> = diffs.iter().map(|d| d.band_stress).collect();
-    let contact: Vec<ContactStep> = sol
-        .states
+    let contact: Vec<ContactStep> = history
+        .steps
         .iter()
-        .skip(1)
-        .map(|s| contact_step(&case.problem, s, &TruthPressure::Exact(exact, s.time)))
+        .map(|s| contact_step(interface, s, &TruthPressure::Exact(exact, s.time)))
         .collect();
-    let penetration = history_penetration(case, sol);
     Differences {
         fields: &fields,
         reference: &reference,
-        pressure: &pressure,
-        penetration,
+        pressure: pressure.as_deref(),
+        penetration: history_penetration(history),
         reference_displacement: match exact.displacement {
             Some(_) => diffs.iter().map(|d| d.max_displacement).fold(0.0, f64::max),
-            None => sol
-                .states
+            None => history
+                .steps
                 .iter()
                 .map(|s| inf_norm(&s.u))
                 .fold(0.0, f64::max),
         },
         contact: &contact,
         band_stress: &band_stress,
-        contact_length: case.problem.interface.length(),
+        contact_length: interface.length(),
     }
     .relative()
 }
 
 /// The largest interpenetration over a solution's history (length).
-pub fn history_penetration(case: &Case, sol: &Solution) -> f64 {
-    sol.states
+pub fn history_penetration(history: &P1History) -> f64 {
+    history
+        .steps
         .iter()
-        .map(|s| metrics::max_penetration(&case.problem, s))
+        .flat_map(|s| crate::contact::normal_jumps(history.interface, &s.u))
+        .map(|j| j.2)
         .fold(0.0f64, f64::max)
 }
 
-/// Every quantity's relative error of one solved level against the reference.
+/// Every quantity's relative error of a discrete solution against the reference.
 pub fn relative_errors(
-    case: &Case,
-    sol: &Solution,
+    history: &P1History,
     reference: &ReferenceSolution,
 ) -> BTreeMap<Quantity, f64> {
-    let (rcase, rsol) = (&reference.case, &reference.solution);
-    let (model, rmodel) = (&case.problem.model, &rcase.problem.model);
+    let (model, interface) = (history.model, history.interface);
+    let rproblem = &reference.case.problem;
+    let (rmodel, rinterface) = (&rproblem.model, &rproblem.interface);
+    let references = P1History::of_solution(&reference.case, &reference.solution);
     let cmp = Comparison::new(model, rmodel);
-    let steps = || sol.states.iter().zip(&rsol.states).skip(1);
+    let steps = || history.steps.iter().zip(&references.steps);
     let fields: Vec<SquaredNorms> = steps()
         .map(|(s, r)| cmp.difference(model, s, rmodel, r))
         .collect();
-    let pressure: Vec<(f64, f64)> = steps()
-        .map(|(s, r)| norms::pressure_difference(&case.problem, s, &rcase.problem, r))
+    let pressure: Option<Vec<(f64, f64)>> = steps()
+        .map(|(s, r)| {
+            Some(norms::pressure_difference(
+                interface,
+                s.pressure.as_ref()?,
+                reference_pressure(r),
+            ))
+        })
         .collect();
-    let band = contact_error::band(&case.problem);
+    let band = contact_error::band(model, interface);
     let band_stress: Vec<f64> = steps().map(|(s, r)| cmp.band_stress(s, r, &band)).collect();
     let contact: Vec<ContactStep> = steps()
         .map(|(s, r)| {
-            let truth = reference_profile(&case.problem.interface, &rcase.problem, r);
-            contact_step(&case.problem, s, &truth)
+            let truth = reference_profile(interface, rinterface, &r.u, reference_pressure(r));
+            contact_step(interface, s, &truth)
         })
         .collect();
-    let penetration = history_penetration(case, sol);
     Differences {
         fields: &fields,
         reference: &reference.norms,
-        pressure: &pressure,
-        penetration,
+        pressure: pressure.as_deref(),
+        penetration: history_penetration(history),
         reference_displacement: reference.max_displacement,
         contact: &contact,
         band_stress: &band_stress,
-        contact_length: case.problem.interface.length(),
+        contact_length: interface.length(),
     }
     .relative()
+}
+
+/// A reference solve's pressure (this project's solver always gives one).
+fn reference_pressure<'a>(r: &'a P1Field) -> &'a crate::verify::field::PressureProfile {
+    r.pressure
+        .as_ref()
+        .expect("a reference solve gives a pressure")
 }

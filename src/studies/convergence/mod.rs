@@ -46,7 +46,8 @@ use crate::verify::exact_error::{
     ExactComparison, exact_profiles, max_exact_displacement,
 };
 use crate::verify::jobs::{self, Job, JobId, Mode, Solved};
-use crate::verify::norms::{self};
+use crate::verify::field::{P1Field, pressure_profile};
+use crate::verify::norms;
 use crate::verify::quantity::Quantity;
 use crate::verify::rates::{self, Assessment, LevelError, Verdict};
 use crate::verify::study_file::{LoadedStudy, StudyFile, Threshold, provenance};
@@ -624,7 +625,7 @@ fn measure_variants(
 
 /// The exact pressure and gap along Gamma_C at time `t`, where the solution gives them.
 fn exact_profile_points(case: &Case, exact: &Exact, t: f64, out: &mut Measured) {
-    for (x, pressure, gap) in exact_profiles(&case.problem, exact, t) {
+    for (x, pressure, gap) in exact_profiles(&case.problem.interface, exact, t) {
         if pressure.is_finite() {
             out.pressure.push(ProfilePoint {
                 label: Source::Exact,
@@ -667,7 +668,7 @@ fn level_info(case: &Case, sol: &Solution, method: Method, flagged: bool) -> Lev
 fn profiles(case: &Case, sol: &Solution, label: Source, out: &mut Measured) {
     let p = &case.problem;
     let s = sol.last();
-    for profile in norms::pressure_profile(p, s) {
+    for profile in pressure_profile(p, s) {
         for (x, value) in profile {
             out.pressure.push(ProfilePoint {
                 label,
@@ -858,7 +859,8 @@ fn time_exact_errors(
     let norms: Vec<(usize, f64, f64)> = states
         .par_iter()
         .map(|&(r, s)| {
-            let d = cmp.difference(&runs[r].1.problem, s);
+            let p = &runs[r].1.problem;
+            let d = cmp.difference(&p.model, &p.interface, &P1Field::of_state(p, s));
             (r, d.difference.theorem(), d.exact.theorem())
         })
         .collect();
@@ -882,13 +884,16 @@ fn time_reference_error(
     reference: &Solution,
     steps: usize,
 ) -> (f64, f64) {
-    let model = &case.problem.model;
+    let (p, model) = (&case.problem, &case.problem.model);
     let stride = (reference.states.len() - 1) / steps;
     let (mut error, mut norm) = (0.0f64, 0.0f64);
     for (i, state) in sol.states.iter().enumerate().skip(1) {
-        let r = &reference.states[i * stride];
-        error = error.max(norms::norms_of_difference(model, state, r).theorem());
-        norm = norm.max(norms::norms(model, r).theorem());
+        let (s, r) = (
+            P1Field::of_state(p, state),
+            P1Field::of_state(p, &reference.states[i * stride]),
+        );
+        error = error.max(norms::norms_of_difference(model, &s, &r).theorem());
+        norm = norm.max(norms::norms(model, &r).theorem());
     }
     (error / norm, norm)
 }
