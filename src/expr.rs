@@ -108,6 +108,21 @@ impl Expr {
         }
     }
 
+    /// The expression in the syntax scenes are written in (x, y, t, pi, numbers, + - * / ^,
+    /// functions), its branches written out: derived fields (a derivative, a combination)
+    /// have no source text of their own. Each `abs(z)` differentiated on its branch appears
+    /// as `signum(z)` (+1 at z = 0, as [`Expr::eval`] takes it).
+    pub fn plain_text(&self) -> String {
+        let mut body = plain_numbers(&self.flat.unparse());
+        for (k, z) in self.signs.iter().enumerate() {
+            body = body.replace(&format!("{{s{k}}}"), &format!("signum({})", z.plain_text()));
+        }
+        for name in NAMED {
+            body = body.replace(&format!("{{{name}}}"), name);
+        }
+        body
+    }
+
     /// The sum of `terms`, each a coefficient times an expression. Sign variables whose
     /// arguments have the same text become one: a derived field evaluates each kink once
     /// per point (a manufactured body force of `contact-mms` went from 12 sign evaluations

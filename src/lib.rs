@@ -14,6 +14,7 @@ pub mod case;
 pub mod contact;
 pub mod error;
 pub mod expr;
+pub mod external;
 pub mod fe;
 pub mod interrupt;
 pub mod io;

@@ -4,6 +4,7 @@ use anyhow::Context;
 use clap::{Parser, Subcommand};
 use contact_rates::case::{Case, PeakMemory, RunSummary};
 use contact_rates::contact::Method;
+use contact_rates::external::export::{self, Source};
 use contact_rates::progress::Progress;
 use contact_rates::report::{self, Output, Staging};
 use contact_rates::scene::Scene;
@@ -59,6 +60,40 @@ enum Command {
     /// Solve one scene on one mesh level and write its time series (binary VTU), contact.csv
     /// and summary.csv into --out, all or nothing.
     Solve(SolveArgs),
+    /// Export a manufactured contact problem for another code: meshes (MSH 4.1 and 2.2),
+    /// problem.toml, problem.py, nodal loads per level and step, README.md; all or nothing.
+    Export {
+        #[command(flatten)]
+        source: SourceArgs,
+        /// Mesh levels, A-B (e.g. 0-3).
+        #[arg(long, value_name = "A-B")]
+        levels: String,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+    },
+}
+
+/// Where an exported or graded problem comes from: a study or a scene.
+#[derive(clap::Args)]
+#[group(required = true, multiple = false)]
+struct SourceArgs {
+    /// A study (studies/NAME.toml or a path): its scene, mesh family and steps.
+    #[arg(long)]
+    study: Option<String>,
+    /// A scene (built-in name or a path), with its own mesh sizes and steps.
+    #[arg(long)]
+    scene: Option<String>,
+}
+
+impl SourceArgs {
+    fn source(&self) -> Source {
+        match (&self.study, &self.scene) {
+            (Some(study), _) => Source::Study(study.clone()),
+            (None, Some(scene)) => Source::Scene(scene.clone()),
+            (None, None) => unreachable!("clap requires --study or --scene"),
+        }
+    }
 }
 
 /// The arguments of `solve`.
@@ -150,6 +185,19 @@ fn run() -> anyhow::Result<()> {
             Ok(())
         }
         Command::Solve(args) => solve_one(&args.request()?),
+        Command::Export {
+            source,
+            levels,
+            out,
+        } => {
+            let levels = export::parse_levels(&levels).map_err(anyhow::Error::msg)?;
+            let done = export::export(&source.source(), &levels, &out)?;
+            for (level, h, nodes, triangles) in &done.levels {
+                println!("level {level}: h = {h:.6}, {nodes} nodes, {triangles} triangles");
+            }
+            println!("wrote {} files to {}", done.files, out.display());
+            Ok(())
+        }
     }
 }
 

@@ -26,6 +26,8 @@ pub enum Output {
     Report,
     /// The output of `solve` (summary.csv).
     Solve,
+    /// An exported problem (problem.toml).
+    Export,
 }
 
 impl Output {
@@ -34,13 +36,14 @@ impl Output {
         match self {
             Output::Report => "README.md",
             Output::Solve => "summary.csv",
+            Output::Export => "problem.toml",
         }
     }
 
     fn what(self) -> &'static str {
         match self {
             Output::Report => "reports folder",
-            Output::Solve => "--out",
+            Output::Solve | Output::Export => "--out",
         }
     }
 }

@@ -1,0 +1,305 @@
+//! `export`: a scene's manufactured contact problem on a family of meshes, as files another
+//! code can solve: the meshes (MSH 4.1 and 2.2), the physics (problem.toml, problem.py), the
+//! nodal loads and constitutive sources per level and step (CSV), and a README that says
+//! what to solve and what to write back for `grade`.
+
+use super::msh_write::ExportMesh;
+use super::problem::{Origin, ProblemFile, problem_file, problem_py};
+use crate::case::Case;
+use crate::contact::Method;
+use crate::error::{Error, Result};
+use crate::io::csv_bytes;
+use crate::report::folder::write;
+use crate::report::{Output, Staging};
+use crate::scene::Scene;
+use crate::verify::study_file::LoadedStudy;
+use serde::Serialize;
+use std::path::Path;
+
+/// Where the problem comes from.
+#[derive(Debug, Clone)]
+pub enum Source {
+    /// A study: its scene, mesh family and steps, so the meshes are those of its report.
+    Study(String),
+    /// A scene with its own mesh sizes and steps.
+    Scene(String),
+}
+
+/// A scene's problem on a mesh family: what export and grade share.
+pub struct Family {
+    /// The scene.
+    pub scene: Scene,
+    /// The study, if the family is a study's.
+    pub study: Option<String>,
+    /// gmsh parameters of level 0 (the scene's own where empty).
+    pub params: Vec<(String, f64)>,
+    /// Time steps.
+    pub steps: usize,
+    /// The command-line option that named the source, for errors.
+    pub option: &'static str,
+}
+
+impl Family {
+    /// The study's or the scene's family; a scene without an exact solution is refused.
+    pub fn resolve(source: &Source) -> Result<Self> {
+        let family = match source {
+            Source::Study(name) => {
+                let study = LoadedStudy::load(name)?;
+                Family {
+                    params: study.file.family_parameters(),
+                    steps: study.file.steps,
+                    study: Some(study.name),
+                    scene: study.scene,
+                    option: "--study",
+                }
+            }
+            Source::Scene(name) => {
+                let scene = Scene::load(name)?;
+                Family {
+                    params: Vec::new(),
+                    steps: scene.steps,
+                    study: None,
+                    scene,
+                    option: "--scene",
+                }
+            }
+        };
+        if family.scene.exact.is_none() {
+            let with: Vec<String> = crate::scene::builtin_names()
+                .into_iter()
+                .filter(|n| Scene::load(n).is_ok_and(|s| s.exact.is_some()))
+                .collect();
+            return Err(Error::input(
+                &family.scene.file,
+                "exact",
+                format!(
+                    "scene '{}' has no exact solution, so a solution of it cannot be graded; use a scene with one ({}), or a study on one",
+                    family.scene.name,
+                    with.join(", ")
+                ),
+            ));
+        }
+        Ok(family)
+    }
+
+    /// The case of `level` (mortar's constraint rows; only the mesh, model and interface
+    /// are used), with the mesh as gmsh wrote it.
+    pub fn case(&self, level: usize) -> Result<(Case, crate::mesh::RawMesh)> {
+        let (generated, raw) = Case::mesh(&self.scene, level, &self.params)?;
+        let case = Case::on_mesh(&self.scene, level, Method::Mortar, generated, raw.clone())?;
+        Ok((case, raw))
+    }
+
+    /// t_1 .. t_N.
+    pub fn times(&self) -> Vec<f64> {
+        (1..=self.steps)
+            .map(|n| self.scene.final_time * n as f64 / self.steps as f64)
+            .collect()
+    }
+
+    /// `contact-rates solve` of `level` on this family's mesh and steps.
+    pub fn solve_command(&self, level: usize) -> String {
+        let sets: String = self
+            .params
+            .iter()
+            .map(|(k, v)| format!(" --set {k}={v}"))
+            .collect();
+        format!(
+            "contact-rates solve --scene {} --level {level} --steps {}{sets}",
+            self.scene.name, self.steps
+        )
+    }
+}
+
+/// One row of loads_L.csv: the P1-consistent nodal load (force) at one node and step.
+#[derive(Serialize)]
+struct LoadRow {
+    step: usize,
+    t: f64,
+    node: usize,
+    fx: f64,
+    fy: f64,
+}
+
+/// One row of source_L.csv: the constitutive source's mean over one triangle at t_n
+/// (stress per time).
+#[derive(Serialize)]
+struct SourceRow {
+    step: usize,
+    t: f64,
+    element: usize,
+    s11: f64,
+    s22: f64,
+    s12: f64,
+}
+
+/// What an export wrote.
+pub struct Exported {
+    /// Per level: (level, h, nodes, triangles).
+    pub levels: Vec<(usize, f64, usize, usize)>,
+    /// Files written.
+    pub files: usize,
+}
+
+/// Export `source` at `levels` into `out`, all or nothing.
+pub fn export(source: &Source, levels: &[usize], out: &Path) -> Result<Exported> {
+    let family = Family::resolve(source)?;
+    let (staging, notes) = Staging::begin(out, Output::Export)?;
+    for n in notes {
+        eprintln!("note: {n}");
+    }
+    let dir = staging.path().to_path_buf();
+    let mut exported = Exported {
+        levels: Vec::new(),
+        files: 0,
+    };
+    let mut first: Option<(ProblemFile, String)> = None;
+    for &level in levels {
+        let (case, raw) = family.case(level)?;
+        let model = &case.problem.model;
+        let mesh = ExportMesh::new(model, &raw);
+        write(&dir, &format!("mesh_{level}.msh"), mesh.msh41().as_bytes())?;
+        write(
+            &dir,
+            &format!("mesh_{level}.msh22.msh"),
+            mesh.msh22().as_bytes(),
+        )?;
+        exported.files += 2 + write_loads(&family, model, level, &dir)?;
+        if first.is_none() {
+            let origin = Origin {
+                scene: &family.scene,
+                study: family.study.as_deref(),
+                levels,
+                steps: family.steps,
+            };
+            let problem = problem_file(&origin, model, &case.problem.interface, &mesh);
+            let derived = derived_stress(&family.scene);
+            let python = problem_py(&problem, &samples(model), derived);
+            first = Some((problem, python));
+        }
+        exported
+            .levels
+            .push((level, case.h, model.n_nodes, model.elements.len()));
+    }
+    let (problem, python) = first.ok_or_else(|| {
+        Error::input(
+            out,
+            "--levels",
+            "no level to export; give --levels A-B with A <= B",
+        )
+    })?;
+    let toml = toml::to_string_pretty(&problem).map_err(|e| {
+        Error::input(
+            out,
+            "problem.toml",
+            format!("cannot write it ({e}); this is a bug"),
+        )
+    })?;
+    let toml = format!("{}{toml}", header_comment(&family));
+    write(&dir, "problem.toml", toml.as_bytes())?;
+    write(&dir, "problem.py", python.as_bytes())?;
+    write(
+        &dir,
+        "README.md",
+        super::readme::export_readme(&family, &exported.levels).as_bytes(),
+    )?;
+    exported.files += 3;
+    staging.commit()?;
+    Ok(exported)
+}
+
+fn header_comment(family: &Family) -> String {
+    let what = match &family.study {
+        Some(s) => format!("study {s} (scene {})", family.scene.name),
+        None => format!("scene {}", family.scene.name),
+    };
+    format!(
+        "# The physics of {what}, exported by contact-rates: numbers, and expressions in the\n# syntax of `syntax`. README.md says what to solve and what to write back.\n\n"
+    )
+}
+
+/// loads_L.csv at every step and, where the law needs one, source_L.csv; the files written.
+fn write_loads(
+    family: &Family,
+    model: &crate::fe::Model,
+    level: usize,
+    dir: &Path,
+) -> Result<usize> {
+    let mut loads = Vec::new();
+    let mut sources = Vec::new();
+    for (n, t) in family.times().into_iter().enumerate() {
+        let f = model.load(t)?;
+        for node in 0..model.n_nodes {
+            loads.push(LoadRow {
+                step: n + 1,
+                t,
+                node: node + 1,
+                fx: f[2 * node],
+                fy: f[2 * node + 1],
+            });
+        }
+        if let Some(s) = model.constitutive_source(t)? {
+            for (e, v) in s.iter().enumerate() {
+                sources.push(SourceRow {
+                    step: n + 1,
+                    t,
+                    element: e + 1,
+                    s11: v[0],
+                    s22: v[1],
+                    s12: v[2],
+                });
+            }
+        }
+    }
+    write(dir, &format!("loads_{level}.csv"), &csv_bytes(&loads)?)?;
+    if sources.is_empty() {
+        return Ok(1);
+    }
+    write(dir, &format!("source_{level}.csv"), &csv_bytes(&sources)?)?;
+    Ok(2)
+}
+
+/// Whether each body's exact stress is E eps(u), derived from the displacement (an elastic
+/// body of a scene that gives no stress of its own).
+fn derived_stress(scene: &Scene) -> [bool; 2] {
+    let exact = scene.exact.as_deref();
+    [0, 1].map(|b| {
+        exact
+            .and_then(|e| e.stress.as_ref())
+            .is_some_and(|s| s[b].iter().any(|c| c.text.contains("d/d")))
+    })
+}
+
+/// Up to 12 triangle centroids per body, spread over its elements: where problem.py's
+/// check compares.
+fn samples(model: &crate::fe::Model) -> [Vec<[f64; 2]>; 2] {
+    [0, 1].map(|b| {
+        let range = model.body_elements(b);
+        let step = range.len().div_ceil(12).max(1);
+        model.elements[range]
+            .iter()
+            .step_by(step)
+            .map(|e| {
+                let p = e.nodes.map(|n| model.position(n));
+                [0, 1].map(|c| (p[0][c] + p[1][c] + p[2][c]) / 3.0)
+            })
+            .collect()
+    })
+}
+
+/// The levels A-B of a `--levels` argument.
+pub fn parse_levels(text: &str) -> std::result::Result<Vec<usize>, String> {
+    let (a, b) = text.split_once('-').unwrap_or((text, text));
+    let parse = |s: &str| {
+        s.trim()
+            .parse::<usize>()
+            .map_err(|_| format!("--levels {text}: '{s}' is not a level; write A-B, e.g. 0-3"))
+    };
+    let (a, b) = (parse(a)?, parse(b)?);
+    if a > b {
+        return Err(format!(
+            "--levels {text}: {a} > {b}; write A-B with A <= B, e.g. 0-3"
+        ));
+    }
+    Ok((a..=b).collect())
+}

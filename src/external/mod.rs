@@ -1,0 +1,9 @@
+//! Grading contact codes this project did not write: [`export`] writes a scene's
+//! manufactured problem on a mesh family as files any code can solve (meshes, physics,
+//! loads); [`grade`] reads the solutions back and measures them with the same error
+//! integrals and rate verdicts as the studies, beside this project's two cones.
+
+pub mod export;
+pub mod msh_write;
+pub mod problem;
+mod readme;
