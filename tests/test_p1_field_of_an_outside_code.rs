@@ -114,7 +114,10 @@ fn a_field_that_cannot_be_measured_is_refused_with_its_reason() {
     u[7] = f64::NAN;
     let stress = vec![nalgebra::Vector3::zeros(); triangles];
     let e = P1Field::from_nodal(m, i, 1.0, u, Some(stress.clone()), None).unwrap_err();
-    assert_eq!(e.to_string(), "the displacement is not finite at node 3");
+    assert_eq!(
+        e.to_string(),
+        "the displacement is not finite at node 3: write finite values (a diverged solve is not graded)"
+    );
     let e = P1Field::from_nodal(m, i, 1.0, zeros(), Some(stress), Some(vec![0.0; 3])).unwrap_err();
     assert_eq!(e, FieldError::PressureLength { got: 3, nodes });
 }

@@ -39,10 +39,12 @@ pub enum FieldError {
     #[error("the pressure has {got} values; the mesh has {nodes} nodes, one value each")]
     PressureLength { got: usize, nodes: usize },
     #[error(
-        "body {body} is viscoplastic, so its stress does not follow from the displacement: give the stress per triangle"
+        "body {body} {why}, so its stress does not follow from the displacement: give the stress per triangle"
     )]
-    StressNeeded { body: usize },
-    #[error("{field} is not finite at {what} {index}")]
+    StressNeeded { body: usize, why: &'static str },
+    #[error(
+        "{field} is not finite at {what} {index}: write finite values (a diverged solve is not graded)"
+    )]
     NotFinite {
         field: &'static str,
         what: &'static str,
@@ -138,10 +140,26 @@ fn finite(
     }
 }
 
-/// C eps(u) per triangle, for a displacement of elastic bodies.
+/// C eps(u) per triangle, for a displacement of elastic bodies whose law has no
+/// constitutive source (with one, sigma_n = sigma_(n-1) + E (eps_n - eps_(n-1)) + k s_n is
+/// not E eps(u_n)).
 fn elastic_stress(model: &Model, u: &[f64]) -> Result<Vec<Stress>, FieldError> {
     if let Some(body) = (0..2).find(|&b| model.materials[b].viscoplastic.is_some()) {
-        return Err(FieldError::StressNeeded { body: body + 1 });
+        return Err(FieldError::StressNeeded {
+            body: body + 1,
+            why: "is viscoplastic",
+        });
+    }
+    if model
+        .scene
+        .exact
+        .as_deref()
+        .is_some_and(|e| e.source_rate.is_some())
+    {
+        return Err(FieldError::StressNeeded {
+            body: 1,
+            why: "has a constitutive source (the scene gives its exact stress)",
+        });
     }
     Ok(model
         .elements
