@@ -112,6 +112,11 @@ impl BodyMesh {
             .collect()
     }
 
+    /// This body's number of raw mesh node `raw`, if the node is on the body.
+    pub fn local_of_raw(&self, raw: usize) -> Option<usize> {
+        self.local_of_raw.get(raw).copied().filter(|&l| l != ABSENT)
+    }
+
     /// Area of triangle `t`.
     pub fn area(&self, t: usize) -> f64 {
         let [a, b, c] = self.triangles[t];

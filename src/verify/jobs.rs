@@ -187,3 +187,28 @@ impl Solved {
         self.0[id].take().expect("each job is taken once")
     }
 }
+
+/// Build `job`'s case on `scene` and solve it with `kind`, or load the solution a previous
+/// call stored: the record is keyed by everything the solve depends on (code commit, scene,
+/// .geo, cone, levels, parameters, steps, and `context`), so a stale one is never found.
+pub fn solve_cached(
+    job: &Job,
+    scene: &Scene,
+    kind: SolverKind,
+    context: &str,
+) -> Result<(Case, Solution)> {
+    let case = Case::build_sizes(scene, job.body_levels, job.method, &job.params)?;
+    let path = records_dir().join(format!("{}.rec", key(job, scene, kind, context)?));
+    if let Ok(bytes) = std::fs::read(&path)
+        && let Ok(sol) = decode(&bytes, &path)
+    {
+        return Ok((case, sol));
+    }
+    let settings = Settings {
+        kind,
+        ..Settings::default()
+    };
+    let sol = solve::solve(&case.problem, &settings, job.steps, true)?;
+    crate::io::write_atomic(&path, &encode(&sol))?;
+    Ok((case, sol))
+}

@@ -1,5 +1,7 @@
 //! Convergence rates: least-squares slopes with standard errors, and successive rates.
 
+use super::quantity::Quantity;
+
 /// A fitted rate: error ~ C h^rate.
 #[derive(Debug, Clone, Copy)]
 pub struct Fit {
@@ -564,6 +566,25 @@ pub fn fit_power_sum(points: &[(f64, f64, f64)]) -> Option<PowerSumFit> {
         points: n,
     };
     (fit.a.iter().chain(&fit.c).all(|v| v.is_finite())).then_some(fit)
+}
+
+/// [`assess`] of one quantity; where equilibrium fixes the contact resultant
+/// (`resultant_fixed`) and the quantity is its error, that error measures the load
+/// quadrature, not the discretization: it is named so and never fitted.
+pub fn judge(
+    levels: &[LevelError],
+    truth_error: f64,
+    quantity: Quantity,
+    resultant_fixed: bool,
+) -> Result<Assessment, EqualH> {
+    let mut a = assess(levels, truth_error)?;
+    if quantity == Quantity::PressureResultant && resultant_fixed {
+        a.verdict = Verdict::FixedByEquilibrium;
+        (a.fit, a.fit_dofs, a.fit_all, a.celik, a.asymptotic_ratio) =
+            (None, None, None, None, None);
+        a.used.clear();
+    }
+    Ok(a)
 }
 
 /// Judge a rate in the time step k as a rate in h is judged ([`assess`] with k in place of

@@ -103,6 +103,19 @@ impl Threshold {
             Threshold::Rate(v) | Threshold::Exact(v) => v,
         }
     }
+
+    /// Whether errors judged as `a`, the largest `max_error`, meet it: a rate fitted on at
+    /// least [`super::rates::MIN_FIT_LEVELS`] levels at or above the required one, or every
+    /// error within the bound.
+    pub fn passes(self, a: &super::rates::Assessment, max_error: f64) -> bool {
+        match self {
+            Threshold::Exact(bound) => max_error <= bound,
+            Threshold::Rate(rate) => {
+                a.used.len() >= super::rates::MIN_FIT_LEVELS
+                    && a.fit.is_some_and(|f| f.rate >= rate)
+            }
+        }
+    }
 }
 
 impl ThresholdSpec {
@@ -586,7 +599,7 @@ impl LoadedStudy {
 }
 
 /// What the exact solution must give for quantity `q`.
-fn needs(q: Quantity) -> &'static [Field] {
+pub fn needs(q: Quantity) -> &'static [Field] {
     match q {
         Quantity::Theorem => &[Field::Displacement, Field::Stress],
         Quantity::H1U | Quantity::L2U => &[Field::Displacement],

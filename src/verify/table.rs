@@ -110,8 +110,8 @@ pub struct ErrorRecord {
     pub quantity: Quantity,
     /// Relative error (max over time steps).
     pub error: f64,
-    /// Wall time of the solve (s).
-    pub wall_s: f64,
+    /// Wall time of the solve (s); empty for a graded code's solution (not timed here).
+    pub wall_s: Option<f64>,
     /// The scene family's parameter, for a study over a family of scenes.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub parameter: Option<f64>,

@@ -49,7 +49,7 @@ use crate::verify::jobs::{self, Job, JobId, Mode, Solved};
 use crate::verify::field::{P1Field, pressure_profile};
 use crate::verify::norms;
 use crate::verify::quantity::Quantity;
-use crate::verify::rates::{self, Assessment, LevelError, Verdict};
+use crate::verify::rates::{self, Assessment, LevelError};
 use crate::verify::study_file::{LoadedStudy, StudyFile, Threshold, provenance};
 pub use crate::verify::truth::{Reference, estimated_reference_error};
 use crate::verify::truth::{Truth, reference};
@@ -567,7 +567,7 @@ fn error_rows(
                 steps: sf.steps,
                 quantity,
                 error,
-                wall_s: sol.wall_s,
+                wall_s: Some(sol.wall_s),
                 parameter: None,
             })
         })
@@ -739,24 +739,13 @@ fn fit_rates(
                     error: r.error,
                 })
                 .collect();
-            let mut a = rates::assess(&levels, truth.quantity_error(quantity)).map_err(|e| {
-                Error::input(path, "mesh.levels", format!("{method} {quantity}: {e}"))
-            })?;
-            if quantity == Quantity::PressureResultant && resultant_fixed {
-                a.verdict = Verdict::FixedByEquilibrium;
-                (a.fit, a.fit_dofs, a.fit_all, a.celik, a.asymptotic_ratio) =
-                    (None, None, None, None, None);
-                a.used.clear();
-            }
+            let a = rates::judge(&levels, truth.quantity_error(quantity), quantity, resultant_fixed)
+                .map_err(|e| {
+                    Error::input(path, "mesh.levels", format!("{method} {quantity}: {e}"))
+                })?;
             let threshold = (quantity == sf.thresholds.quantity).then_some(threshold);
-            let pass = threshold.map(|t| match t {
-                Threshold::Exact(bound) => {
-                    rows.iter().map(|r| r.error).fold(0.0f64, f64::max) <= bound
-                }
-                Threshold::Rate(rate) => {
-                    a.used.len() >= rates::MIN_FIT_LEVELS && a.fit.is_some_and(|f| f.rate >= rate)
-                }
-            });
+            let max_error = rows.iter().map(|r| r.error).fold(0.0f64, f64::max);
+            let pass = threshold.map(|t| t.passes(&a, max_error));
             out.push(RateRow {
                 method,
                 quantity,

@@ -286,7 +286,7 @@ fn error_vs_time(res: &StudyResult, d: &Path) -> Result<()> {
                 .errors
                 .iter()
                 .filter(|r| r.method == m && r.quantity == key)
-                .map(|r| (r.wall_s.max(1e-4), r.error))
+                .filter_map(|r| Some((r.wall_s?.max(1e-4), r.error)))
                 .collect(),
             markers: true,
             line: true,
@@ -637,7 +637,12 @@ fn errors_table(doc: &mut Doc, res: &StudyResult) {
                 })
                 .unwrap_or_default()
         };
-        let wall = res.errors.iter().find(at_level).map_or(0.0, |r| r.wall_s);
+        let wall = res
+            .errors
+            .iter()
+            .find(at_level)
+            .and_then(|r| r.wall_s)
+            .unwrap_or(0.0);
         table.row([
             l.method.to_string(),
             l.level.to_string(),
@@ -918,7 +923,12 @@ pub fn console(res: &StudyResult, dir: &Path) -> String {
         let _ = writeln!(
             s,
             "{} level {} h {:.4} dofs {} error {:.4e} ({:.2} s)",
-            e.method, e.level, e.h, e.dofs, e.error, e.wall_s
+            e.method,
+            e.level,
+            e.h,
+            e.dofs,
+            e.error,
+            e.wall_s.unwrap_or(0.0)
         );
     }
     if let Some(ts) = &res.time_study {

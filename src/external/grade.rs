@@ -1,0 +1,514 @@
+//! `grade`: the solutions of a contact code this project did not write, one per mesh level,
+//! measured against the scene's exact solution with the studies' error integrals, judged by
+//! the studies' rate verdicts, beside this project's mortar and nts on the family's meshes.
+
+use super::export::{Family, Source};
+use super::mesh_in::OutsideModel;
+use crate::contact::Method;
+use crate::error::{Error, Result};
+use crate::io::solution::{FieldNames, SolutionStep, read_msh_solution, read_pvd, read_vtu};
+use crate::solve::SolverKind;
+use crate::verify::field::P1History;
+use crate::verify::jobs::{self, Job};
+use crate::verify::quantity::Quantity;
+use crate::verify::rates::{self, LevelError, MIN_FIT_LEVELS};
+use crate::verify::study_file::{LoadedStudy, needs};
+use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord};
+use crate::verify::truth::Truth;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// What `grade` was asked.
+pub struct GradeRequest {
+    /// The study or scene whose problem was solved.
+    pub source: Source,
+    /// The folder of level_L.{vtu,pvd,msh}.
+    pub solutions: PathBuf,
+    /// The levels to grade (default: every level with a file).
+    pub levels: Option<Vec<usize>>,
+    /// The graded code's label in the report.
+    pub name: String,
+    /// The rate the graded code's key quantity must reach.
+    pub threshold: Option<f64>,
+    /// The field names.
+    pub names: FieldNames,
+    /// Solve mortar and nts on the family's meshes beside it.
+    pub compare: bool,
+}
+
+/// How a level's solution is stored.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Storage {
+    /// One .vtu: the state at T.
+    Vtu,
+    /// A .pvd series.
+    Pvd,
+    /// An MSH file with views.
+    Msh,
+}
+
+impl Storage {
+    const ALL: [(Storage, &'static str); 3] =
+        [(Storage::Vtu, "vtu"), (Storage::Pvd, "pvd"), (Storage::Msh, "msh")];
+}
+
+/// One level's measured solution.
+pub struct GradedLevel {
+    pub level: usize,
+    pub file: PathBuf,
+    pub storage: Storage,
+    /// The times graded (t_1..t_N, or T alone).
+    pub times: Vec<f64>,
+    /// Whether the file gave stresses (otherwise E eps(u_h) of the elastic bodies).
+    pub stress_given: bool,
+    pub pressure_given: bool,
+    pub h: f64,
+    pub dofs: usize,
+    pub triangles: usize,
+}
+
+/// What `grade` measured.
+pub struct Graded {
+    /// The scene's name, and the study's if the family is one.
+    pub scene: String,
+    pub study: Option<String>,
+    pub label: String,
+    pub levels: Vec<GradedLevel>,
+    pub errors: Vec<ErrorRecord>,
+    pub rates: Vec<RateRecord>,
+    /// The quantity the threshold applies to.
+    pub key: Quantity,
+    /// The time steps of the problem.
+    pub steps: usize,
+    /// The solves of this project's cones were compared.
+    pub compared: bool,
+    /// Sentences for the user: what was graded how.
+    pub notes: Vec<String>,
+    /// Why the threshold failed (empty: passed or none given).
+    pub failures: Vec<String>,
+}
+
+/// The solution files of `dir`, per level: exactly one each.
+fn level_files(dir: &Path, wanted: Option<&[usize]>) -> Result<BTreeMap<usize, (Storage, PathBuf)>> {
+    let entries = std::fs::read_dir(dir).map_err(|e| {
+        Error::input(dir, "--solutions", format!("cannot read the folder ({e}); pass the folder that holds level_L.vtu, level_L.pvd or level_L.msh"))
+    })?;
+    let mut found: BTreeMap<usize, Vec<(Storage, PathBuf)>> = BTreeMap::new();
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().to_string();
+        let Some(rest) = name.strip_prefix("level_") else { continue };
+        let Some((level, ext)) = rest.split_once('.') else { continue };
+        let (Ok(level), Some(storage)) = (
+            level.parse::<usize>(),
+            Storage::ALL.iter().find(|(_, e)| *e == ext).map(|s| s.0),
+        ) else {
+            continue;
+        };
+        found.entry(level).or_default().push((storage, entry.path()));
+    }
+    if let Some((level, files)) = found.iter().find(|(_, f)| f.len() > 1) {
+        let names: Vec<String> = files.iter().map(|f| f.1.display().to_string()).collect();
+        return Err(Error::input(
+            dir,
+            format!("level_{level}"),
+            format!("level {level} has {} solutions ({}); keep one of them", files.len(), names.join(", ")),
+        ));
+    }
+    let mut out: BTreeMap<usize, (Storage, PathBuf)> =
+        found.into_iter().map(|(l, mut f)| (l, f.remove(0))).collect();
+    if let Some(wanted) = wanted {
+        if let Some(missing) = wanted.iter().find(|l| !out.contains_key(l)) {
+            return Err(Error::input(
+                dir,
+                format!("level_{missing}"),
+                format!("--levels asks for level {missing}, but the folder has no level_{missing}.vtu, .pvd or .msh; write it, or leave the level out of --levels"),
+            ));
+        }
+        out.retain(|l, _| wanted.contains(l));
+    }
+    if out.is_empty() {
+        return Err(Error::input(
+            dir,
+            "--solutions",
+            "holds no level_L.vtu, level_L.pvd or level_L.msh; write one per mesh level (README.md of the export says how)",
+        ));
+    }
+    Ok(out)
+}
+
+/// The states of one level's file, with their times.
+fn read_level(
+    storage: Storage,
+    path: &Path,
+    names: &FieldNames,
+    family: &Family,
+) -> Result<Vec<(f64, SolutionStep)>> {
+    let times = family.times();
+    let final_time = family.scene.final_time;
+    let steps = match storage {
+        Storage::Vtu => return Ok(vec![(final_time, read_vtu(path, names)?)]),
+        Storage::Pvd => read_pvd(path)?
+            .into_iter()
+            .map(|(t, file)| Ok((t, read_vtu(&file, names)?)))
+            .collect::<Result<Vec<_>>>()?,
+        Storage::Msh => read_msh_solution(
+            path,
+            names,
+            [&family.scene.bodies[0].surface, &family.scene.bodies[1].surface],
+        )?,
+    };
+    // t_0 = 0 is the unloaded state, not graded.
+    let steps: Vec<(f64, SolutionStep)> = steps
+        .into_iter()
+        .filter(|(t, _)| t.abs() > 1e-9 * final_time)
+        .collect();
+    let matches = steps.len() == times.len()
+        && steps
+            .iter()
+            .zip(&times)
+            .all(|((t, _), tn)| (t - tn).abs() <= 1e-9 * final_time);
+    if !matches {
+        let given: Vec<String> = steps.iter().map(|(t, _)| format!("{t}")).collect();
+        let want: Vec<String> = times.iter().map(|t| format!("{t}")).collect();
+        return Err(Error::input(
+            path,
+            "time",
+            format!(
+                "the steps' times are [{}]; the problem's are t_n = [{}] (problem.toml's time.times): write one state per t_n, or the final state alone as level_L.vtu",
+                given.join(", "),
+                want.join(", ")
+            ),
+        ));
+    }
+    if let Some((_, first)) = steps.first()
+        && steps.iter().any(|(_, s)| s.mesh != first.mesh)
+    {
+        return Err(Error::input(
+            path,
+            "Cells",
+            "the steps are on different meshes; write every step on the same mesh",
+        ));
+    }
+    Ok(steps)
+}
+
+/// The quantities measured: the study's, or for a scene every one its exact solution
+/// gives; the pressure ones only where the solutions give a pressure.
+fn quantities(family: &Family, study: Option<&LoadedStudy>, pressure: bool) -> Vec<Quantity> {
+    let exact = family.scene.exact.as_deref().expect("a graded family has an exact solution");
+    let all: Vec<Quantity> = match study {
+        Some(s) => s.file.quantities.clone(),
+        None => Quantity::ALL
+            .into_iter()
+            .filter(|q| needs(*q).iter().all(|f| exact.gives(*f)))
+            .collect(),
+    };
+    all.into_iter()
+        .filter(|q| pressure || !is_pressure(*q))
+        .collect()
+}
+
+/// The quantities that need the discrete pressure.
+pub fn is_pressure(q: Quantity) -> bool {
+    matches!(
+        q,
+        Quantity::L2Pressure
+            | Quantity::PressureWeighted
+            | Quantity::PressureResultant
+            | Quantity::PressureOscillation
+            | Quantity::ContactEdge
+    )
+}
+
+/// The rows of errors.csv of one level's errors.
+fn rows(
+    label: &MethodLabel,
+    level: usize,
+    h: f64,
+    dofs: usize,
+    steps: usize,
+    wall_s: Option<f64>,
+    quantities: &[Quantity],
+    errors: &BTreeMap<Quantity, f64>,
+    file: &Path,
+) -> Result<Vec<ErrorRecord>> {
+    quantities
+        .iter()
+        .map(|&quantity| {
+            let error = errors[&quantity];
+            if !error.is_finite() {
+                return Err(Error::input(
+                    file,
+                    quantity.name(),
+                    format!("the {quantity} error is not finite; check the solution's values"),
+                ));
+            }
+            Ok(ErrorRecord {
+                method: label.clone(),
+                level,
+                h,
+                dofs,
+                steps,
+                quantity,
+                error,
+                wall_s,
+                parameter: None,
+            })
+        })
+        .collect()
+}
+
+/// Grade the solutions of `req`.
+pub fn grade(req: &GradeRequest) -> Result<Graded> {
+    let label = check_label(&req.name)?;
+    let family = Family::resolve(&req.source)?;
+    let study = match &req.source {
+        Source::Study(name) => Some(LoadedStudy::load(name)?),
+        Source::Scene(_) => None,
+    };
+    let exact = family.scene.exact.as_deref().expect("resolve refuses a scene without one");
+    let points = study
+        .as_ref()
+        .map_or(crate::verify::exact_error::DEFAULT_POINTS, |s| s.file.reference.quadrature);
+    let truth = Truth::Exact(exact, points);
+    let files = level_files(&req.solutions, req.levels.as_deref())?;
+    let mut levels = Vec::new();
+    let mut measured = Vec::new();
+    let mut resultant_fixed = false;
+    for (&level, (storage, path)) in &files {
+        let steps = read_level(*storage, path, &req.names, &family)?;
+        let (reference, raw) = family.case(level)?;
+        let mesh = &steps[0].1.mesh;
+        let outside = OutsideModel::new(&family.scene, mesh, &reference.problem.model, &raw, path)?;
+        let history = P1History {
+            model: &outside.model,
+            interface: &outside.interface,
+            steps: steps
+                .iter()
+                .map(|(t, s)| outside.field(*t, s, path))
+                .collect::<Result<Vec<_>>>()?,
+        };
+        if levels.is_empty() {
+            resultant_fixed = outside
+                .interface
+                .resultant_fixed_by_equilibrium(&outside.model);
+        }
+        measured.push(truth.errors(&history));
+        levels.push(GradedLevel {
+            level,
+            file: path.clone(),
+            storage: *storage,
+            times: steps.iter().map(|s| s.0).collect(),
+            stress_given: steps[0].1.stress.is_some(),
+            pressure_given: steps.iter().all(|s| s.1.pressure.is_some()),
+            h: outside.model.h(),
+            dofs: outside.model.n_free,
+            triangles: outside.model.elements.len(),
+        });
+    }
+    check_distinct_h(&levels, &req.solutions)?;
+    let pressure = levels.iter().all(|l| l.pressure_given);
+    let quantities = quantities(&family, study.as_ref(), pressure);
+    let mut errors = Vec::new();
+    for (l, e) in levels.iter().zip(&measured) {
+        let steps = l.times.len();
+        errors.extend(rows(&label, l.level, l.h, l.dofs, steps, None, &quantities, e, &l.file)?);
+    }
+    let compared = req.compare;
+    if compared {
+        let cone_quantities = match &study {
+            Some(s) => s.file.quantities.clone(),
+            None => self::quantities(&family, None, true),
+        };
+        for method in [Method::Mortar, Method::Nts] {
+            for l in &levels {
+                errors.extend(cone_rows(&family, method, l.level, &truth, &cone_quantities)?);
+            }
+        }
+    }
+    let key = key_quantity(exact);
+    let (rates, failures) = judge_all(&errors, &label, key, req.threshold, resultant_fixed, &req.solutions)?;
+    let notes = notes(&levels, &family, pressure);
+    Ok(Graded {
+        scene: family.scene.name.clone(),
+        study: family.study.clone(),
+        label: label.name().to_string(),
+        levels,
+        errors,
+        rates,
+        key,
+        steps: family.steps,
+        compared,
+        notes,
+        failures,
+    })
+}
+
+/// The graded code's label: any name but a cone's.
+fn check_label(name: &str) -> Result<MethodLabel> {
+    let ok = !name.trim().is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_alphanumeric() || "-_.+".contains(c));
+    if !ok {
+        return Err(Error::input(
+            "--name",
+            "name",
+            format!("'{name}' is not a label; use letters, digits and - _ . + (e.g. getfem-nitsche)"),
+        ));
+    }
+    match MethodLabel::parse(name) {
+        MethodLabel::Cone(m) => Err(Error::input(
+            "--name",
+            "name",
+            format!("'{m}' names this project's own cone, which grade puts beside yours; choose another label"),
+        )),
+        label => Ok(label),
+    }
+}
+
+/// Two levels with the same h cannot give a rate: refused.
+fn check_distinct_h(levels: &[GradedLevel], dir: &Path) -> Result<()> {
+    for (i, a) in levels.iter().enumerate() {
+        if let Some(b) = levels[i + 1..].iter().find(|b| (a.h - b.h).abs() <= 1e-12 * a.h) {
+            return Err(Error::input(
+                dir,
+                format!("level_{}", b.level),
+                format!(
+                    "levels {} and {} have the same h = {} ({} and {}): each level must be a finer mesh than the one before; write level L on the family's level-L mesh",
+                    a.level,
+                    b.level,
+                    a.h,
+                    a.file.display(),
+                    b.file.display()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The quantity a threshold applies to: the theorem norm, or l2_stress where the exact
+/// solution gives no displacement (`patch`).
+pub fn key_quantity(exact: &crate::analytical::Exact) -> Quantity {
+    if exact.displacement.is_some() {
+        Quantity::Theorem
+    } else {
+        Quantity::L2Stress
+    }
+}
+
+/// This project's `method` on the family's level `level`, solved once and kept as a
+/// record (the studies' job records, keyed by everything the solve depends on).
+fn cone_rows(
+    family: &Family,
+    method: Method,
+    level: usize,
+    truth: &Truth,
+    quantities: &[Quantity],
+) -> Result<Vec<ErrorRecord>> {
+    let job = Job {
+        id: 0,
+        label: format!("{method} level {level}"),
+        method,
+        level,
+        body_levels: [level, level],
+        params: family.params.clone(),
+        steps: family.steps,
+        scene: 0,
+    };
+    let (case, solution) = jobs::solve_cached(&job, &family.scene, SolverKind::Newton, "grade")?;
+    let errors = truth.relative_errors(&case, &solution);
+    rows(
+        &method.into(),
+        level,
+        case.h,
+        case.problem.model.n_free,
+        family.steps,
+        Some(solution.wall_s),
+        quantities,
+        &errors,
+        &family.scene.file,
+    )
+}
+
+/// Every method's every quantity judged as the studies judge it; the graded code's key
+/// quantity against `threshold`. Returns the rows and the failures.
+fn judge_all(
+    errors: &[ErrorRecord],
+    label: &MethodLabel,
+    key: Quantity,
+    threshold: Option<f64>,
+    resultant_fixed: bool,
+    dir: &Path,
+) -> Result<(Vec<RateRecord>, Vec<String>)> {
+    let mut methods: Vec<MethodLabel> = Vec::new();
+    let mut quantities: Vec<Quantity> = Vec::new();
+    for r in errors {
+        if !methods.contains(&r.method) {
+            methods.push(r.method.clone());
+        }
+        if !quantities.contains(&r.quantity) {
+            quantities.push(r.quantity);
+        }
+    }
+    let (mut out, mut failures) = (Vec::new(), Vec::new());
+    for method in &methods {
+        for &quantity in &quantities {
+            let rows: Vec<&ErrorRecord> = errors
+                .iter()
+                .filter(|r| &r.method == method && r.quantity == quantity)
+                .collect();
+            if rows.is_empty() {
+                continue;
+            }
+            let levels: Vec<LevelError> = rows
+                .iter()
+                .map(|r| LevelError {
+                    level: r.level,
+                    h: r.h,
+                    dofs: r.dofs as f64,
+                    error: r.error,
+                })
+                .collect();
+            let a = rates::judge(&levels, 0.0, quantity, resultant_fixed)
+                .map_err(|e| Error::input(dir, "levels", format!("{method} {quantity}: {e}")))?;
+            let required = threshold.filter(|_| method == label && quantity == key);
+            let pass = required.map(|r| a.used.len() >= MIN_FIT_LEVELS && a.fit.is_some_and(|f| f.rate >= r));
+            if pass == Some(false) {
+                failures.push(match a.fit {
+                    Some(f) if a.used.len() >= MIN_FIT_LEVELS => format!(
+                        "{method}'s {quantity} rate {:.3} is below the threshold {}",
+                        f.rate,
+                        required.unwrap_or(0.0)
+                    ),
+                    _ => format!(
+                        "{method}'s {quantity} errors support no rate ({}), so the threshold {} is not met",
+                        a.verdict.name(),
+                        required.unwrap_or(0.0)
+                    ),
+                });
+            }
+            out.push(RateRecord::new(method.clone(), quantity, &a, required, pass));
+        }
+    }
+    Ok((out, failures))
+}
+
+/// What the report says about how the solutions were graded.
+fn notes(levels: &[GradedLevel], family: &Family, pressure: bool) -> Vec<String> {
+    let mut out = Vec::new();
+    if levels.iter().any(|l| l.storage == Storage::Vtu) {
+        out.push(format!(
+            "Levels given as one .vtu are graded at t = T only: their theorem norm is the error at T, not the maximum over the {} steps.",
+            family.steps
+        ));
+    }
+    if levels.iter().any(|l| !l.stress_given) {
+        out.push("Where a file gives no stress, the stress graded is E eps(u_h) per triangle (elastic bodies).".into());
+    }
+    if !pressure {
+        out.push("Not every level gives a pressure: the pressure quantities (l2_pressure, pressure_weighted, pressure_resultant, pressure_oscillation, contact_edge) are not measured.".into());
+    }
+    out
+}
