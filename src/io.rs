@@ -1,7 +1,9 @@
 //! Writing results: ParaView VTU of a state ([`vtu`]), the .pvd collection of a time
 //! series, and CSVs. Single files are written to a temporary name and renamed, so a failed
-//! run never leaves half a file.
+//! run never leaves half a file. Reading the solutions other codes write (.vtu, .pvd,
+//! gmsh's .msh with views) for grading: [`solution`].
 
+pub mod solution;
 pub mod vtu;
 
 use crate::error::{Error, Result};
