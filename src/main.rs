@@ -5,6 +5,8 @@ use clap::{Parser, Subcommand};
 use contact_rates::case::{Case, PeakMemory, RunSummary};
 use contact_rates::contact::Method;
 use contact_rates::external::export::{self, Source};
+use contact_rates::external::grade;
+use contact_rates::io::solution::FieldNames;
 use contact_rates::progress::Progress;
 use contact_rates::report::{self, Output, Staging};
 use contact_rates::scene::Scene;
@@ -60,6 +62,9 @@ enum Command {
     /// Solve one scene on one mesh level and write its time series (binary VTU), contact.csv
     /// and summary.csv into --out, all or nothing.
     Solve(SolveArgs),
+    /// Grade another code's solutions of an exported problem against the exact solution:
+    /// errors, rates and verdicts beside this project's mortar and nts (reports/grade-NAME).
+    Grade(GradeArgs),
     /// Export a manufactured contact problem for another code: meshes (MSH 4.1 and 2.2),
     /// problem.toml, problem.py, nodal loads per level and step, README.md; all or nothing.
     Export {
@@ -72,6 +77,42 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+}
+
+/// The arguments of `grade`.
+#[derive(clap::Args)]
+struct GradeArgs {
+    #[command(flatten)]
+    source: SourceArgs,
+    /// The folder of the solutions: level_L.vtu (the state at T), level_L.pvd (a series)
+    /// or level_L.msh, one per level.
+    #[arg(long)]
+    solutions: PathBuf,
+    /// Levels to grade, A-B (default: every level with a file).
+    #[arg(long, value_name = "A-B")]
+    levels: Option<String>,
+    /// The graded code's label in the report (not mortar or nts).
+    #[arg(long, default_value = "graded")]
+    name: String,
+    /// Exit non-zero when the graded code's theorem-norm rate (l2_stress where the exact
+    /// solution gives no displacement) is below R, or when no rate can be fitted.
+    #[arg(long, value_name = "R")]
+    threshold: Option<f64>,
+    /// Report folder (default: reports/grade-NAME).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Do not solve this project's mortar and nts beside it.
+    #[arg(long)]
+    no_compare: bool,
+    /// The name of the displacement point data.
+    #[arg(long, default_value = "displacement")]
+    displacement: String,
+    /// The name of the stress cell data.
+    #[arg(long, default_value = "stress")]
+    stress: String,
+    /// The name of the pressure point data.
+    #[arg(long, default_value = "pressure")]
+    pressure: String,
 }
 
 /// Where an exported or graded problem comes from: a study or a scene.
@@ -185,6 +226,7 @@ fn run() -> anyhow::Result<()> {
             Ok(())
         }
         Command::Solve(args) => solve_one(&args.request()?),
+        Command::Grade(args) => grade(args),
         Command::Export {
             source,
             levels,
@@ -234,6 +276,41 @@ fn study(name: &str, out: Option<PathBuf>, shard: Option<&str>, merge: bool) -> 
     let failures = outcome.failures();
     if !failures.is_empty() {
         anyhow::bail!("rate below threshold: {}", failures.join("; "));
+    }
+    Ok(())
+}
+
+/// `grade`: check the report folder, measure, write the report; an error when the
+/// threshold is missed.
+fn grade(args: GradeArgs) -> anyhow::Result<()> {
+    let levels = match &args.levels {
+        Some(l) => Some(export::parse_levels(l).map_err(anyhow::Error::msg)?),
+        None => None,
+    };
+    let dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| report::reports_dir().join(format!("grade-{}", args.name)));
+    for n in report::check_writable(&dir, Output::Report)? {
+        eprintln!("note: {n}");
+    }
+    let graded = grade::grade(&grade::GradeRequest {
+        source: args.source.source(),
+        solutions: args.solutions,
+        levels,
+        name: args.name,
+        threshold: args.threshold,
+        names: FieldNames {
+            displacement: args.displacement,
+            stress: args.stress,
+            pressure: args.pressure,
+        },
+        compare: !args.no_compare,
+    })?;
+    graded.write(&dir)?;
+    print!("{}", graded.console(&dir));
+    if !graded.failures.is_empty() {
+        anyhow::bail!("{}", graded.failures.join("; "));
     }
     Ok(())
 }

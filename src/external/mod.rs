@@ -7,5 +7,6 @@ pub mod export;
 pub mod msh_write;
 pub mod problem;
 mod readme;
-// pub mod grade;
-// pub mod mesh_in;
+pub mod grade;
+pub mod mesh_in;
+pub mod grade_report;

@@ -1,0 +1,291 @@
+//! The report of `grade`: errors.csv and rates.csv in the studies' columns (the graded
+//! code's label in `method`), error_vs_h.png with the fitted slopes in the legend, and a
+//! README.md that leads with how the graded code compares with this project's cones.
+
+use super::grade::{Graded, Storage};
+use crate::error::Result;
+use crate::io::csv_bytes;
+use crate::report::folder::{write, write_folder};
+use crate::report::markdown::{Doc, Table};
+use crate::report::plot::{self, Series};
+use crate::verify::quantity::Quantity;
+use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord};
+use std::path::Path;
+
+impl Graded {
+    /// The methods in the order of the report: the graded code first.
+    fn methods(&self) -> Vec<MethodLabel> {
+        let mut out: Vec<MethodLabel> = Vec::new();
+        for r in &self.errors {
+            if !out.contains(&r.method) {
+                out.push(r.method.clone());
+            }
+        }
+        out
+    }
+
+    fn rate(&self, method: &MethodLabel, q: Quantity) -> Option<&RateRecord> {
+        self.rates
+            .iter()
+            .find(|r| &r.method == method && r.quantity == q)
+    }
+
+    fn error(&self, method: &MethodLabel, level: usize, q: Quantity) -> Option<&ErrorRecord> {
+        self.errors
+            .iter()
+            .find(|r| &r.method == method && r.level == level && r.quantity == q)
+    }
+
+    /// Write the report folder `dir`, all or nothing.
+    pub fn write(&self, dir: &Path) -> Result<()> {
+        write_folder(dir, |d| {
+            write(d, "errors.csv", &csv_bytes(&self.errors)?)?;
+            write(d, "rates.csv", &csv_bytes(&self.rates)?)?;
+            self.plot(d)?;
+            write(d, "README.md", self.readme().as_bytes())
+        })
+    }
+
+    /// The key quantity's error against h per method, with each fitted slope.
+    fn plot(&self, d: &Path) -> Result<()> {
+        let mut series = Vec::new();
+        for (i, m) in self.methods().iter().enumerate() {
+            let rows: Vec<&ErrorRecord> = self
+                .errors
+                .iter()
+                .filter(|r| &r.method == m && r.quantity == self.key)
+                .collect();
+            series.push(Series {
+                label: format!("{m}"),
+                points: rows.iter().map(|r| (r.h, r.error)).collect(),
+                markers: true,
+                line: false,
+                color: i,
+                thin: false,
+            });
+            if let Some(line) = self.rate(m, self.key).and_then(|r| fit_line(r, &rows)) {
+                series.push(Series {
+                    label: format!(
+                        "{m} fit: slope {:.2} ± {:.2}",
+                        line.0,
+                        line.1
+                    ),
+                    points: line.2,
+                    markers: false,
+                    line: true,
+                    color: i,
+                    thin: false,
+                });
+            }
+        }
+        plot::loglog(
+            &d.join("error_vs_h.png"),
+            &format!("{}: error against h", self.label),
+            "h (max element diameter)",
+            &format!("relative error ({})", self.key),
+            &series,
+            &[(0.5, "1/2"), (0.75, "3/4"), (1.0, "1")],
+        )
+    }
+
+    /// README.md.
+    fn readme(&self) -> String {
+        let mut doc = Doc::new();
+        let what = match &self.study {
+            Some(s) => format!("study `{s}` (scene `{}`)", self.scene),
+            None => format!("scene `{}`", self.scene),
+        };
+        doc.heading(1, format!("Grade of `{}` on {what}", self.label));
+        doc.paragraph(self.lead());
+        if !self.failures.is_empty() {
+            doc.paragraph(format!("**Threshold missed**: {}.", self.failures.join("; ")));
+        }
+        doc.list(&self.notes);
+        doc.image("error against h", "error_vs_h.png");
+        doc.heading(2, format!("{} per level", self.key));
+        doc.table(&self.key_table());
+        doc.heading(2, "Rates");
+        doc.paragraph("Every quantity judged as the studies judge it (docs/studies.md): a rate only over a trailing window of levels whose successive rates agree; `drifting`, `pre-asymptotic` and `too few levels` say why a rate is flagged or missing.");
+        doc.table(&self.rate_table());
+        doc.heading(2, "The graded files");
+        doc.table(&self.level_table());
+        doc.finish()
+    }
+
+    /// The first paragraph: the graded code's key rate and verdict beside the cones'.
+    fn lead(&self) -> String {
+        let rate = |m: &MethodLabel| {
+            self.rate(m, self.key).map_or("no rate".into(), |r| match r.rate {
+                Some(v) => format!("{v:.3} ± {:.3} ({})", r.stderr.unwrap_or(0.0), r.verdict.name()),
+                None => format!("no rate ({})", r.verdict.name()),
+            })
+        };
+        let label = MethodLabel::External(self.label.clone());
+        let norm = match self.key {
+            Quantity::Theorem => "Theorem 3.1's norm (||u - u_h||_H1 + ||sigma - sigma_h||_L2, max over the steps, relative)".to_string(),
+            q => format!("{q} (relative)"),
+        };
+        let mut text = format!(
+            "Against the exact solution, `{}`'s error in {norm} falls at rate {} in h",
+            self.label,
+            rate(&label)
+        );
+        if self.compared {
+            let cones: Vec<String> = self
+                .methods()
+                .iter()
+                .filter(|m| m.cone().is_some())
+                .map(|m| format!("{m} {}", rate(m)))
+                .collect();
+            text.push_str(&format!(
+                "; this project's cones on the same problem and levels: {}",
+                cones.join(", ")
+            ));
+            if let Some(ratio) = self.finest_ratios() {
+                text.push_str(&format!(". On the finest level its error is {ratio}"));
+            }
+        }
+        text.push('.');
+        text
+    }
+
+    /// "x times mortar's and y times nts's" on the finest level, if all three have it.
+    fn finest_ratios(&self) -> Option<String> {
+        let level = self.levels.last()?.level;
+        let label = MethodLabel::External(self.label.clone());
+        let mine = self.error(&label, level, self.key)?.error;
+        let parts: Vec<String> = self
+            .methods()
+            .iter()
+            .filter(|m| m.cone().is_some())
+            .filter_map(|m| {
+                let e = self.error(m, level, self.key)?.error;
+                Some(format!("{:.3} times {m}'s", mine / e))
+            })
+            .collect();
+        (!parts.is_empty()).then(|| parts.join(" and "))
+    }
+
+    fn key_table(&self) -> Table {
+        let methods = self.methods();
+        let label = MethodLabel::External(self.label.clone());
+        let mut header = vec!["level".to_string(), "h".into()];
+        header.extend(methods.iter().map(|m| format!("{m}")));
+        for m in methods.iter().filter(|m| m.cone().is_some()) {
+            header.push(format!("{} / {m}", self.label));
+        }
+        let mut table = Table::new(header);
+        for l in &self.levels {
+            let mut row = vec![l.level.to_string(), format!("{:.5}", l.h)];
+            for m in &methods {
+                row.push(
+                    self.error(m, l.level, self.key)
+                        .map_or("-".into(), |r| format!("{:.4e}", r.error)),
+                );
+            }
+            let mine = self.error(&label, l.level, self.key).map(|r| r.error);
+            for m in methods.iter().filter(|m| m.cone().is_some()) {
+                let theirs = self.error(m, l.level, self.key).map(|r| r.error);
+                row.push(match (mine, theirs) {
+                    (Some(a), Some(b)) => format!("{:.3}", a / b),
+                    _ => "-".into(),
+                });
+            }
+            table.row(row);
+        }
+        table
+    }
+
+    fn rate_table(&self) -> Table {
+        let mut table = Table::new([
+            "method",
+            "quantity",
+            "rate in h",
+            "verdict",
+            "levels fitted",
+            "successive rates",
+            "threshold",
+        ]);
+        for r in &self.rates {
+            table.row([
+                format!("{}", r.method),
+                format!("{}", r.quantity),
+                r.rate.map_or("-".into(), |v| {
+                    format!("{v:.3} ± {:.3}", r.stderr.unwrap_or(0.0))
+                }),
+                r.verdict.name().to_string(),
+                if r.levels_used.is_empty() { "-".into() } else { r.levels_used.clone() },
+                r.successive.clone(),
+                match (r.threshold, r.pass) {
+                    (Some(t), Some(true)) => format!(">= {t}: pass"),
+                    (Some(t), _) => format!(">= {t}: FAIL"),
+                    _ => "-".into(),
+                },
+            ]);
+        }
+        table
+    }
+
+    fn level_table(&self) -> Table {
+        let mut table = Table::new([
+            "level", "file", "h", "dofs", "triangles", "steps graded", "stress", "pressure",
+        ]);
+        for l in &self.levels {
+            table.row([
+                l.level.to_string(),
+                format!(
+                    "`{}`",
+                    l.file.file_name().map_or(String::new(), |f| f.to_string_lossy().to_string())
+                ),
+                format!("{:.5}", l.h),
+                l.dofs.to_string(),
+                l.triangles.to_string(),
+                match l.storage {
+                    Storage::Vtu => "T only".into(),
+                    _ => format!("{} of {}", l.times.len(), self.steps),
+                },
+                if l.stress_given { "given".into() } else { "E eps(u_h)".into() },
+                if l.pressure_given { "given".into() } else { "-".into() },
+            ]);
+        }
+        table
+    }
+
+    /// The console summary.
+    pub fn console(&self, dir: &Path) -> String {
+        let mut out = String::new();
+        out.push_str(&self.lead());
+        out.push('\n');
+        for n in &self.notes {
+            out.push_str(&format!("note: {n}\n"));
+        }
+        out.push_str(&format!("wrote {}\n", dir.display()));
+        out
+    }
+}
+
+/// The least-squares line of a rate over its fitted levels (slope, its standard error,
+/// the line's ends): the intercept is the mean of log e - rate log h over those levels.
+fn fit_line(r: &RateRecord, rows: &[&ErrorRecord]) -> Option<(f64, f64, Vec<(f64, f64)>)> {
+    let rate = r.rate?;
+    let used: Vec<usize> = r
+        .levels_used
+        .split_whitespace()
+        .filter_map(|s| s.parse().ok())
+        .collect();
+    let points: Vec<(f64, f64)> = rows
+        .iter()
+        .filter(|e| used.contains(&e.level))
+        .map(|e| (e.h, e.error))
+        .collect();
+    if points.len() < 2 {
+        return None;
+    }
+    let n = points.len() as f64;
+    let intercept = points.iter().map(|p| p.1.ln() - rate * p.0.ln()).sum::<f64>() / n;
+    let (lo, hi) = points
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.0), b.max(p.0)));
+    let at = |h: f64| (h, (intercept + rate * h.ln()).exp());
+    Some((rate, r.stderr.unwrap_or(0.0), vec![at(lo), at(hi)]))
+}
