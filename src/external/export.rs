@@ -90,6 +90,14 @@ impl Family {
         Ok((case, raw))
     }
 
+    /// The model of `level`'s mesh alone (no contact rows, no checks of the exact solution:
+    /// what grade needs of the scene's own mesh), with the mesh as gmsh wrote it.
+    pub fn model(&self, level: usize) -> Result<(crate::fe::Model, crate::mesh::RawMesh)> {
+        let (generated, raw) = Case::mesh(&self.scene, level, &self.params)?;
+        let model = crate::fe::Model::new(&self.scene, &raw, &generated.path)?;
+        Ok((model, raw))
+    }
+
     /// t_1 .. t_N.
     pub fn times(&self) -> Vec<f64> {
         (1..=self.steps)
@@ -134,6 +142,7 @@ struct SourceRow {
 }
 
 /// What an export wrote.
+#[derive(Debug)]
 pub struct Exported {
     /// Per level: (level, h, nodes, triangles).
     pub levels: Vec<(usize, f64, usize, usize)>,

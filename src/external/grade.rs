@@ -15,6 +15,7 @@ use crate::verify::rates::{self, LevelError, MIN_FIT_LEVELS};
 use crate::verify::study_file::{LoadedStudy, needs};
 use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord};
 use crate::verify::truth::Truth;
+use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -272,40 +273,14 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
         .map_or(crate::verify::exact_error::DEFAULT_POINTS, |s| s.file.reference.quadrature);
     let truth = Truth::Exact(exact, points);
     let files = level_files(&req.solutions, req.levels.as_deref())?;
-    let mut levels = Vec::new();
-    let mut measured = Vec::new();
-    let mut resultant_fixed = false;
-    for (&level, (storage, path)) in &files {
-        let steps = read_level(*storage, path, &req.names, &family)?;
-        let (reference, raw) = family.case(level)?;
-        let mesh = &steps[0].1.mesh;
-        let outside = OutsideModel::new(&family.scene, mesh, &reference.problem.model, &raw, path)?;
-        let history = P1History {
-            model: &outside.model,
-            interface: &outside.interface,
-            steps: steps
-                .iter()
-                .map(|(t, s)| outside.field(*t, s, path))
-                .collect::<Result<Vec<_>>>()?,
-        };
-        if levels.is_empty() {
-            resultant_fixed = outside
-                .interface
-                .resultant_fixed_by_equilibrium(&outside.model);
-        }
-        measured.push(truth.errors(&history));
-        levels.push(GradedLevel {
-            level,
-            file: path.clone(),
-            storage: *storage,
-            times: steps.iter().map(|s| s.0).collect(),
-            stress_given: steps[0].1.stress.is_some(),
-            pressure_given: steps.iter().all(|s| s.1.pressure.is_some()),
-            h: outside.model.h(),
-            dofs: outside.model.n_free,
-            triangles: outside.model.elements.len(),
-        });
-    }
+    // The levels are independent: measured in parallel, in level order.
+    let graded: Vec<(GradedLevel, BTreeMap<Quantity, f64>, bool)> = files
+        .par_iter()
+        .map(|(&level, (storage, path))| grade_level(level, *storage, path, &req.names, &family, &truth))
+        .collect::<Result<Vec<_>>>()?;
+    let resultant_fixed = graded.first().is_some_and(|g| g.2);
+    let (levels, measured): (Vec<GradedLevel>, Vec<BTreeMap<Quantity, f64>>) =
+        graded.into_iter().map(|(l, m, _)| (l, m)).unzip();
     check_distinct_h(&levels, &req.solutions)?;
     let pressure = levels.iter().all(|l| l.pressure_given);
     let quantities = quantities(&family, study.as_ref(), pressure);
@@ -320,11 +295,15 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
             Some(s) => s.file.quantities.clone(),
             None => self::quantities(&family, None, true),
         };
-        for method in [Method::Mortar, Method::Nts] {
-            for l in &levels {
-                errors.extend(cone_rows(&family, method, l.level, &truth, &cone_quantities)?);
-            }
-        }
+        let jobs: Vec<(Method, usize)> = [Method::Mortar, Method::Nts]
+            .into_iter()
+            .flat_map(|m| levels.iter().map(move |l| (m, l.level)))
+            .collect();
+        let cones = jobs
+            .par_iter()
+            .map(|&(method, level)| cone_rows(&family, method, level, &truth, &cone_quantities))
+            .collect::<Result<Vec<_>>>()?;
+        errors.extend(cones.into_iter().flatten());
     }
     let key = key_quantity(exact);
     let (rates, failures) = judge_all(&errors, &label, key, req.threshold, resultant_fixed, &req.solutions)?;
@@ -342,6 +321,46 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
         notes,
         failures,
     })
+}
+
+/// One level's file read, put on a model of the scene and measured against `truth`; with
+/// whether equilibrium fixes the contact resultant on it.
+fn grade_level(
+    level: usize,
+    storage: Storage,
+    path: &Path,
+    names: &FieldNames,
+    family: &Family,
+    truth: &Truth,
+) -> Result<(GradedLevel, BTreeMap<Quantity, f64>, bool)> {
+    let steps = read_level(storage, path, names, family)?;
+    let (reference, raw) = family.model(level)?;
+    let mesh = &steps[0].1.mesh;
+    let outside = OutsideModel::new(&family.scene, mesh, &reference, &raw, path)?;
+    let history = P1History {
+        model: &outside.model,
+        interface: &outside.interface,
+        steps: steps
+            .iter()
+            .map(|(t, s)| outside.field(*t, s, path))
+            .collect::<Result<Vec<_>>>()?,
+    };
+    let resultant_fixed = outside
+        .interface
+        .resultant_fixed_by_equilibrium(&outside.model);
+    let errors = truth.errors(&history);
+    let graded = GradedLevel {
+        level,
+        file: path.to_path_buf(),
+        storage,
+        times: steps.iter().map(|s| s.0).collect(),
+        stress_given: steps[0].1.stress.is_some(),
+        pressure_given: steps.iter().all(|s| s.1.pressure.is_some()),
+        h: outside.model.h(),
+        dofs: outside.model.n_free,
+        triangles: outside.model.elements.len(),
+    };
+    Ok((graded, errors, resultant_fixed))
 }
 
 /// The graded code's label: any name but a cone's.

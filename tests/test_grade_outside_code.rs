@@ -1,0 +1,281 @@
+//! Reference: issue 48 (grade a contact code this project did not write); the parallelogram
+//! law of the H1 inner product.
+//! Goal:
+//! - round trip: this project's own solves of `rates-exact` levels 0-2, handed to `grade`
+//!   as VTU series an outside code would write, give the study's errors to 1e-10 relative
+//!   and the same verdicts as grade's own mortar beside them;
+//! - a known perturbation: u_h + delta b and u_h - delta b (b a P1 hat function of one
+//!   interior node) graded at T satisfy E(+)^2 + E(-)^2 = 2 E^2 + 2 delta^2 |b|^2_H1 (H1
+//!   parts, absolute), |b| computed here by hand, to 1e-8;
+//! - bad solution folders and labels are refused with a message naming the file and the
+//!   field, and no report is left behind;
+//! - the threshold: met and missed.
+//!
+//! Geometry: contact-mms (two elastic blocks, Gamma_C: y = 1) on the rates-exact family.
+//! Data: the scene's; 4 steps (1 for the perturbation).
+
+mod common;
+#[path = "common/solution_files.rs"]
+mod solution_files;
+
+use contact_rates::case::Case;
+use contact_rates::contact::Method;
+use contact_rates::external::export::Source;
+use contact_rates::external::grade::{GradeRequest, Graded, grade};
+use contact_rates::io::solution::FieldNames;
+use contact_rates::scene::Scene;
+use contact_rates::solve::{Solution as Solved, SolverKind, State};
+use contact_rates::verify::exact_error::ExactComparison;
+use contact_rates::verify::field::P1Field;
+use contact_rates::verify::quantity::Quantity;
+use contact_rates::verify::solve_case;
+use contact_rates::verify::study_file::LoadedStudy;
+use contact_rates::verify::table::{ErrorRecord, RateRecord, read};
+use solution_files::{Encoding, Options, Solution};
+use std::path::Path;
+
+/// A solver state as an outside code writes it: the mesh of both bodies, the displacement,
+/// the P0 stress and the nodal pressure at the slave nodes (0 elsewhere).
+fn outside(case: &Case, state: &State, u: &[f64]) -> Solution {
+    let p = &case.problem;
+    let m = &p.model;
+    let mut pressure = vec![0.0; m.n_nodes];
+    for (row, l) in p.rows.iter().zip(&state.lambda) {
+        pressure[p.interface.pieces[row.piece].slave_nodes[row.i]] = row.pressure(*l);
+    }
+    Solution {
+        points: (0..m.n_nodes).map(|g| m.position(g)).collect(),
+        triangles: m.elements.iter().map(|e| e.nodes).collect(),
+        body: m.elements.iter().map(|e| e.body as u8 + 1).collect(),
+        displacement: (0..m.n_nodes).map(|g| [u[2 * g], u[2 * g + 1]]).collect(),
+        stress: state.sigma.iter().map(|s| [s[0], s[1], s[2]]).collect(),
+        pressure,
+    }
+}
+
+fn write_vtu(path: &Path, s: &Solution) {
+    let mut o = Options::new(Encoding::AppendedRaw);
+    o.compressed = true;
+    o.block_bytes = 1 << 15;
+    std::fs::write(path, s.vtu("Float64").write(&o)).unwrap();
+}
+
+/// A solve's steps t_1..t_N as `dir/level_L.pvd` with one .vtu per step.
+fn write_series(dir: &Path, level: usize, case: &Case, sol: &Solved) {
+    let mut pvd = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n");
+    for (n, s) in sol.states.iter().enumerate().skip(1) {
+        let name = format!("level_{level}_step_{n}.vtu");
+        write_vtu(&dir.join(&name), &outside(case, s, &s.u));
+        pvd.push_str(&format!("<DataSet timestep=\"{:e}\" file=\"{name}\"/>\n", s.time));
+    }
+    pvd.push_str("</Collection>\n</VTKFile>\n");
+    std::fs::write(dir.join(format!("level_{level}.pvd")), pvd).unwrap();
+}
+
+fn request(source: Source, dir: &Path, compare: bool) -> GradeRequest {
+    GradeRequest {
+        source,
+        solutions: dir.to_path_buf(),
+        levels: None,
+        name: "outside".into(),
+        threshold: None,
+        names: FieldNames::default(),
+        compare,
+    }
+}
+
+fn errors_of<'a>(g: &'a Graded, method: &str) -> Vec<&'a ErrorRecord> {
+    g.errors.iter().filter(|r| r.method.name() == method).collect()
+}
+
+#[test]
+fn round_trip_of_this_projects_solves_gives_the_study_errors() {
+    common::case("contact-mms", 0, Method::Mortar, &[]);
+    let study = LoadedStudy::load("rates-exact").unwrap();
+    let params = study.file.family_parameters();
+    let dir = tempfile::tempdir().unwrap();
+    for level in 0..=2 {
+        let case = Case::build(&study.scene, level, Method::Mortar, &params).unwrap();
+        let (sol, _) = solve_case(&case, SolverKind::Newton, study.file.steps).unwrap();
+        write_series(dir.path(), level, &case, &sol);
+    }
+    let g = grade(&request(Source::Study("rates-exact".into()), dir.path(), true)).unwrap();
+    // Against the committed study (reports/rates-exact, levels 0-5).
+    let committed: Vec<ErrorRecord> =
+        read(Path::new(env!("CARGO_MANIFEST_DIR")).join("reports/rates-exact/errors.csv").as_path())
+            .unwrap();
+    let mine = errors_of(&g, "outside");
+    assert_eq!(mine.len(), 3 * study.file.quantities.len());
+    let mut worst = 0.0f64;
+    for r in &mine {
+        let s = committed
+            .iter()
+            .find(|c| c.method.name() == "mortar" && c.level == r.level && c.quantity == r.quantity)
+            .expect("the study has the row");
+        worst = worst.max((r.error - s.error).abs() / s.error.abs());
+        assert!((r.h - s.h).abs() <= 1e-15 * s.h && r.dofs == s.dofs, "{r:?} vs {s:?}");
+    }
+    println!("round trip: {} errors, largest relative difference to the study {worst:.2e}", mine.len());
+    assert!(worst <= 1e-10, "{worst}");
+    // Rates and verdicts against grade's own mortar on the same levels.
+    let rate = |m: &str, q: Quantity| -> &RateRecord {
+        g.rates.iter().find(|r| r.method.name() == m && r.quantity == q).unwrap()
+    };
+    for &q in &study.file.quantities {
+        let (a, b) = (rate("outside", q), rate("mortar", q));
+        assert_eq!(a.verdict, b.verdict, "{q}");
+        assert_eq!(a.levels_used, b.levels_used, "{q}");
+        match (a.rate, b.rate) {
+            (Some(x), Some(y)) => assert!((x - y).abs() <= 1e-9 * y.abs(), "{q}: {x} vs {y}"),
+            (x, y) => assert_eq!(x, y, "{q}"),
+        }
+    }
+}
+
+#[test]
+fn a_known_perturbation_obeys_the_parallelogram_law() {
+    let scene = Scene::load("contact-mms").unwrap();
+    let exact = scene.exact.as_deref().unwrap();
+    let case = common::case("contact-mms", 1, Method::Mortar, &[]);
+    let (sol, _) = solve_case(&case, SolverKind::Newton, 1).unwrap();
+    let last = sol.states.last().unwrap();
+    let m = &case.problem.model;
+    // An interior node of body 1 (no boundary curve touches it: every triangle around it
+    // closes a fan).
+    let on_boundary = {
+        let mut count = std::collections::HashMap::new();
+        for e in &m.elements {
+            for k in 0..3 {
+                let (a, b) = (e.nodes[k], e.nodes[(k + 1) % 3]);
+                *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            }
+        }
+        let mut on = vec![false; m.n_nodes];
+        for ((a, b), n) in count {
+            if n == 1 {
+                on[a] = true;
+                on[b] = true;
+            }
+        }
+        on
+    };
+    let node = (0..m.node_offset[1]).find(|&g| !on_boundary[g]).unwrap();
+    // |b|^2_H1 of the hat function by hand: int phi^2 = |T| / 6, |grad phi|^2 constant.
+    let (mut l2, mut semi) = (0.0, 0.0);
+    for e in m.elements.iter().filter(|e| e.nodes.contains(&node)) {
+        let a = e.nodes.iter().position(|&n| n == node).unwrap();
+        l2 += e.area / 6.0;
+        semi += e.area * (e.grads[a][0].powi(2) + e.grads[a][1].powi(2));
+    }
+    let b2 = l2 + semi;
+    let delta = 1e-3 * last.u.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let norm_exact = {
+        let cmp = ExactComparison::new(exact, contact_rates::verify::exact_error::DEFAULT_POINTS);
+        let d = cmp.difference(m, &case.problem.interface, &P1Field::of_state(&case.problem, last));
+        (d.exact.l2_u + d.exact.semi_u).sqrt()
+    };
+    let graded = |shift: f64| -> f64 {
+        let dir = tempfile::tempdir().unwrap();
+        let mut u = last.u.clone();
+        u[2 * node] += shift;
+        write_vtu(&dir.path().join("level_1.vtu"), &outside(&case, last, &u));
+        let g = grade(&request(Source::Scene("contact-mms".into()), dir.path(), false)).unwrap();
+        let e = errors_of(&g, "outside")
+            .into_iter()
+            .find(|r| r.quantity == Quantity::H1U)
+            .unwrap()
+            .error;
+        e * norm_exact
+    };
+    let (e0, plus, minus) = (graded(0.0), graded(delta), graded(-delta));
+    let lhs = plus * plus + minus * minus - 2.0 * e0 * e0;
+    let rhs = 2.0 * delta * delta * b2;
+    println!(
+        "node {node}: E = {e0:.6e}, E+ = {plus:.6e}, E- = {minus:.6e}; E+^2 + E-^2 - 2E^2 = {lhs:.10e}, 2 delta^2 |b|^2 = {rhs:.10e}"
+    );
+    assert!((lhs - rhs).abs() <= 1e-8 * rhs, "{lhs} vs {rhs}");
+}
+
+/// Grade `dir` and return the error's message, checking that no report appeared.
+fn refused(req: GradeRequest) -> String {
+    match grade(&req) {
+        Ok(_) => panic!("graded {}", req.solutions.display()),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn bad_solution_folders_are_refused_with_the_file_and_the_field() {
+    let case = common::case("contact-mms", 0, Method::Mortar, &[]);
+    let (sol, _) = solve_case(&case, SolverKind::Newton, 4).unwrap();
+    let last = sol.states.last().unwrap();
+    let good = outside(&case, last, &last.u);
+    let scene = || Source::Scene("contact-mms".into());
+    // Two solutions of one level.
+    let dir = tempfile::tempdir().unwrap();
+    write_vtu(&dir.path().join("level_0.vtu"), &good);
+    write_series(dir.path(), 0, &case, &sol);
+    let msg = refused(request(scene(), dir.path(), false));
+    assert!(msg.contains("level_0") && msg.contains("has 2 solutions"), "{msg}");
+    // A level asked for that is missing.
+    let dir = tempfile::tempdir().unwrap();
+    write_vtu(&dir.path().join("level_0.vtu"), &good);
+    let mut req = request(scene(), dir.path(), false);
+    req.levels = Some(vec![0, 1]);
+    let msg = refused(req);
+    assert!(msg.contains("level_1") && msg.contains("--levels"), "{msg}");
+    // Two levels with the same h.
+    write_vtu(&dir.path().join("level_1.vtu"), &good);
+    let msg = refused(request(scene(), dir.path(), false));
+    assert!(msg.contains("same h"), "{msg}");
+    // A mesh that leaves a triangle of body 1 out.
+    let dir = tempfile::tempdir().unwrap();
+    let mut holed = good.clone();
+    let t = holed.body.iter().position(|&b| b == 1).unwrap();
+    holed.triangles.remove(t);
+    holed.body.remove(t);
+    holed.stress.remove(t);
+    let file = dir.path().join("level_0.vtu");
+    write_vtu(&file, &holed);
+    let msg = refused(request(scene(), dir.path(), false));
+    assert!(msg.contains(&file.display().to_string()) && msg.contains("does not cover"), "{msg}");
+    // Times that are not the problem's steps.
+    let dir = tempfile::tempdir().unwrap();
+    write_series(dir.path(), 0, &case, &sol);
+    let pvd = dir.path().join("level_0.pvd");
+    let text = std::fs::read_to_string(&pvd).unwrap().replace("timestep=\"5e-1\"", "timestep=\"0.6\"");
+    std::fs::write(&pvd, text).unwrap();
+    let msg = refused(request(scene(), dir.path(), false));
+    assert!(msg.contains("level_0.pvd") && msg.contains("time"), "{msg}");
+    // A cone's name as the label, and a scene without an exact solution.
+    let dir = tempfile::tempdir().unwrap();
+    write_vtu(&dir.path().join("level_0.vtu"), &good);
+    let mut req = request(scene(), dir.path(), false);
+    req.name = "nts".into();
+    assert!(refused(req).contains("--name"));
+    let msg = refused(request(Source::Scene("rates".into()), dir.path(), false));
+    assert!(msg.contains("no exact solution") && msg.contains("contact-mms"), "{msg}");
+}
+
+#[test]
+fn the_threshold_is_met_and_missed() {
+    let case0 = common::case("contact-mms", 0, Method::Mortar, &[]);
+    let dir = tempfile::tempdir().unwrap();
+    for level in 0..=2 {
+        let case = if level == 0 {
+            case0.clone()
+        } else {
+            common::case("contact-mms", level, Method::Mortar, &[])
+        };
+        let (sol, _) = solve_case(&case, SolverKind::Newton, 4).unwrap();
+        write_series(dir.path(), level, &case, &sol);
+    }
+    let mut req = request(Source::Scene("contact-mms".into()), dir.path(), false);
+    req.threshold = Some(0.7);
+    let g = grade(&req).unwrap();
+    assert!(g.failures.is_empty(), "{:?}", g.failures);
+    req.threshold = Some(1.5);
+    let g = grade(&req).unwrap();
+    assert_eq!(g.failures.len(), 1, "{:?}", g.failures);
+    assert!(g.failures[0].contains("below the threshold 1.5"), "{:?}", g.failures);
+}
