@@ -244,7 +244,7 @@ fn a_pvd_lists_its_steps_in_file_order_resolved_against_its_folder() {
     }
     // A collection written by hand: other attributes, no declaration, a comment.
     let text = "<VTKFile type=\"Collection\" version=\"0.1\">\n<!-- two steps -->\n<Collection>\n  <DataSet part=\"0\" timestep=\"2e-1\" file=\"a.vtu\"></DataSet>\n  <DataSet timestep=\" 4 \" file=\"/abs/b.vtu\"/>\n</Collection>\n</VTKFile>\n";
-    let read = parse_pvd(text, Path::new("run/s.pvd")).unwrap();
+    let read = parse_pvd(text.as_bytes(), Path::new("run/s.pvd")).unwrap();
     assert_eq!(
         read,
         vec![
@@ -877,7 +877,7 @@ fn malformed_xml_is_refused_with_its_line() {
 
 fn refused_pvd(text: &str, field: &str, needles: &[&str]) {
     let file = path("s.pvd");
-    assert_refused(parse_pvd(text, &file), &file, field, needles);
+    assert_refused(parse_pvd(text.as_bytes(), &file), &file, field, needles);
 }
 
 #[test]
