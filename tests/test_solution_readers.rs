@@ -428,6 +428,15 @@ fn a_grid_of_another_type_is_refused() {
 }
 
 #[test]
+fn a_parallel_grid_is_refused_with_the_piece_route() {
+    refused_vtu(
+        &vtu_text_with("type=\"UnstructuredGrid\"", "type=\"PUnstructuredGrid\""),
+        "VTKFile",
+        &["parallel grid (.pvtu)", "run on one process"],
+    );
+}
+
+#[test]
 fn two_pieces_are_refused() {
     let text = String::from_utf8(vtu_with(Encoding::Ascii, |_| {})).unwrap();
     let (a, b) = (
@@ -529,6 +538,15 @@ fn quadratic_triangles_are_refused_with_the_p1_route() {
             "P2 is not graded yet",
             "interpolate to P1",
         ],
+    );
+}
+
+#[test]
+fn lagrange_triangles_are_refused_with_the_p1_route() {
+    refused_vtu(
+        &with_cell(69.0, 6),
+        "Cells",
+        &["Lagrange triangle (VTK type 69", "P2 is not graded yet"],
     );
 }
 

@@ -14,7 +14,9 @@
 //! Every refusal is an [`Error::input`] naming the file, the field (`PointData/displacement`,
 //! `CellData/body`, `Cells`, `$NodeData "displacement" (line 40)`, ...) and the fix.
 //! Counts in a file are checked against the bytes present before anything is allocated
-//! from them, so a corrupt header cannot ask for absurd memory.
+//! from them, so a corrupt header cannot ask for absurd memory. What must vanish (z, a third
+//! displacement component, the z row of a stress) or agree (s12 and s21) is judged to
+//! [`ROUNDING`] epsilons of the precision stored, relative to its array's size.
 //!
 //! Written by hand on quick-xml (the XML), base64 and flate2 (zlib) because no maintained
 //! Rust crate reads these files whole. Checked: vtkio's last release is 0.6.3 (2021); its
@@ -472,7 +474,7 @@ fn ordered<const N: usize>(b: &[u8], order: ByteOrder) -> [u8; N] {
     a
 }
 
-/// Decode packed binary numbers of type `t`; `field` names the array for an error.
+/// Decode packed binary numbers of type `t` in byte order `order`.
 fn from_bytes(bytes: &[u8], t: Scalar, order: ByteOrder) -> std::result::Result<Numbers, String> {
     let n = t.size();
     let chunks = bytes.chunks_exact(n);
@@ -841,6 +843,13 @@ fn read_root(a: &HashMap<String, String>, doc: &mut VtuDocument, path: &Path) ->
     let field = "VTKFile";
     match a.get("type").map(String::as_str) {
         Some("UnstructuredGrid") => {}
+        Some("PUnstructuredGrid") => {
+            return Err(Error::input(
+                path,
+                field,
+                "type=\"PUnstructuredGrid\": a parallel grid (.pvtu) only lists its pieces; read the .vtu of a run on one process, or merge the pieces into one .vtu (ParaView's Merge Blocks, then Save Data)",
+            ));
+        }
         other => {
             return Err(Error::input(
                 path,
@@ -1403,6 +1412,8 @@ pub fn parse_vtu(bytes: &[u8], path: &Path, names: &FieldNames) -> Result<Soluti
                 let (what, kind) = match other {
                     9 => ("quadrilateral", ElementKind::Quadrilateral),
                     22 => ("quadratic triangle", ElementKind::QuadraticTriangle),
+                    // What FEniCSx writes for a triangle of degree 2 or more.
+                    69 => ("Lagrange triangle", ElementKind::QuadraticTriangle),
                     _ => ("cell", ElementKind::Other),
                 };
                 return Err(Error::input(
@@ -1993,7 +2004,7 @@ fn binary_msh(path: &Path) -> Error {
     )
 }
 
-/// Whether the text starting a file announces a binary MSH (`$MeshFormat` version 1 ...).
+/// Whether the text starting a file announces a binary MSH (`$MeshFormat`, a version, 1).
 fn announces_binary(prefix: &str) -> bool {
     prefix.find("$MeshFormat").is_some_and(|i| {
         let mut t = prefix[i + "$MeshFormat".len()..].split_whitespace();
