@@ -1,16 +1,20 @@
 //! The long run of the readers' fuzzing (the quick tier is tests/test_fuzz_readers.rs):
 //!
 //! ```sh
-//! cargo run --release --example fuzz_readers -- [INPUTS_PER_READER] [SEED]
+//! cargo run --release --example fuzz_readers -- [INPUTS_PER_READER] [SEED] [READER...]
 //! ```
 //!
 //! tries INPUTS_PER_READER inputs (default 100,000; half random text, half a few edits of a
-//! valid file) on each reader: gmsh's MSH 4.1 output, study files, scene files. A scene that
-//! reads is also checked against its level-0 mesh and its problem set up (everything
-//! `solve` does before the time loop); gmsh runs once per distinct .geo and parameters, into
-//! a temporary mesh cache. Prints per reader the inputs tried, accepted, rejected, the
-//! panics and the errors that do not name the file and a field; saves those inputs under
-//! target/fuzz-readers/; exits 1 if there is any. Deterministic for a seed, on 2 threads.
+//! valid file) on each reader, or on the READERs named: gmsh's MSH 4.1 output (msh), study
+//! files (study), scene files (scene), and the readers of other codes' solutions: .vtu with
+//! ascii, inline base64, appended raw and appended base64 arrays (vtu-ascii, vtu-binary,
+//! vtu-appended-raw, vtu-appended-base64), .pvd (pvd) and .msh with views (msh-solution).
+//! A scene that reads is also checked against its level-0 mesh and its problem set up
+//! (everything `solve` does before the time loop); gmsh runs once per distinct .geo and
+//! parameters, into a temporary mesh cache. Prints per reader the inputs tried, accepted,
+//! rejected, the panics and the errors that do not name the file and a field; saves those
+//! inputs under target/fuzz-readers/; exits 1 if there is any. Deterministic for a seed, on
+//! 2 threads.
 
 #[path = "../tests/common/fuzz.rs"]
 mod fuzz;
@@ -25,15 +29,17 @@ const DEFAULT_INPUTS: u64 = 100_000;
 const DEFAULT_SEED: u64 = 20261122;
 /// Bad inputs saved and printed per reader.
 const SHOWN: usize = 5;
+/// How to run the example.
+const USAGE: &str =
+    "cargo run --release --example fuzz_readers -- [INPUTS_PER_READER] [SEED] [READER...]";
 
 fn argument(args: &[String], i: usize, name: &str, default: u64) -> Result<u64, String> {
     match args.get(i) {
         None => Ok(default),
-        Some(a) => a.replace('_', "").parse().map_err(|_| {
-            format!(
-                "{name}: '{a}' is not a non-negative integer; usage: cargo run --release --example fuzz_readers -- [INPUTS_PER_READER] [SEED]"
-            )
-        }),
+        Some(a) => a
+            .replace('_', "")
+            .parse()
+            .map_err(|_| format!("{name}: '{a}' is not a non-negative integer; usage: {USAGE}")),
     }
 }
 
@@ -62,6 +68,23 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    let mut readers = Vec::new();
+    for name in args.iter().skip(2) {
+        match Reader::named(name) {
+            Some(r) => readers.push(r),
+            None => {
+                let known: Vec<&str> = Reader::ALL.iter().map(|r| r.name()).collect();
+                eprintln!(
+                    "error: READER: '{name}' is not a reader; the readers are {}; usage: {USAGE}",
+                    known.join(", ")
+                );
+                return ExitCode::from(2);
+            }
+        }
+    }
+    if readers.is_empty() {
+        readers = Reader::ALL.to_vec();
+    }
     // A cache of its own: the odd parameters of mutated scenes stay out of the project's.
     let cache = tempfile::tempdir().expect("a temporary folder");
     // SAFETY: no other thread exists yet (rayon's pool is built below).
@@ -78,7 +101,7 @@ fn main() -> ExitCode {
         thousands(count)
     );
     let mut failed = false;
-    for reader in Reader::ALL {
+    for reader in readers {
         let bases = fuzz::bases(reader, &[]);
         let meshes = Meshes::default();
         // The panics are counted and reported below, not printed as they happen.
@@ -129,10 +152,10 @@ fn main() -> ExitCode {
             let mut first: Vec<u64> = panics.iter().map(|p| p.0).take(SHOWN).collect();
             first.extend(unnamed.iter().map(|u| u.0).take(SHOWN));
             for index in first {
-                let (path, text) = fuzz::input(reader, &bases, seed, index);
+                let (path, bytes) = fuzz::input(reader, &bases, seed, index);
                 let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("txt");
                 let f = saved_dir.join(format!("{}-{index}.{ext}", reader.name()));
-                std::fs::write(&f, text).expect("write a saved input");
+                std::fs::write(&f, bytes).expect("write a saved input");
                 println!("  input {index} saved as {}", f.display());
             }
             failed = true;

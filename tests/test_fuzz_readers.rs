@@ -1,13 +1,17 @@
-//! Reference: SPEC section 8 (bad input), issue 6 item 4, issue 47 part 6.
-//! Goal: the readers of user files (gmsh's MSH 4.1 output, study files, scene files) turn
-//! any input, random or a mutated valid file, into a value or an error naming the file and
+//! Reference: SPEC section 8 (bad input), issue 6 item 4, issue 47 part 6, the `grade`
+//! issue (readers of other codes' solutions).
+//! Goal: the readers of user files (gmsh's MSH 4.1 output, study files, scene files; the
+//! solutions of other codes in .vtu of each encoding, .pvd and .msh with views) turn any
+//! input, random or a mutated valid file, into a value or an error naming the file and
 //! the field, never a panic; what they accept is usable (node indices in range, finite
-//! coordinates, validated study and scene data); a scene is read up to its level-0 mesh
-//! and its problem's set-up, and an error found against the mesh names the scene file and
-//! its field, not the cached mesh.
-//! Data: meshes gmsh writes for meshes/two_blocks.geo, the committed studies and scenes;
-//! the quick tier of examples/fuzz_readers.rs (same inputs, same seed): 300 random and 300
-//! mutated inputs per reader.
+//! coordinates, validated study and scene data; a two-body P1 solution with one finite
+//! value per point or triangle); a scene is read up to its level-0 mesh and its problem's
+//! set-up, and an error found against the mesh names the scene file and its field, not the
+//! cached mesh.
+//! Data: meshes gmsh writes for meshes/two_blocks.geo, the committed studies and scenes,
+//! the solution files of tests/common/solution_files.rs; the quick tier of
+//! examples/fuzz_readers.rs (same inputs, same seed): 300 random and 300 mutated inputs per
+//! reader.
 
 #[path = "common/fuzz.rs"]
 mod fuzz;
@@ -25,7 +29,9 @@ const INPUTS: u64 = 600;
 /// mutations do not reach past the first section).
 fn quick(reader: Reader, names: &[&str]) -> fuzz::Tally {
     let bases = fuzz::bases(reader, names);
-    assert_eq!(bases.len(), names.len());
+    // The solution readers take all their bases.
+    assert!(names.is_empty() || bases.len() == names.len());
+    assert!(!bases.is_empty());
     let t = fuzz::run(reader, &bases, &Meshes::default(), SEED, INPUTS);
     println!(
         "{}: {} inputs, {} accepted ({} of {} mutated), rejected {:?}",
@@ -55,6 +61,76 @@ fn msh_reader_never_panics_on_random_or_mutated_files() {
 #[test]
 fn study_reader_never_panics_on_random_or_mutated_files() {
     quick(Reader::Study, &["patch", "rates", "rates-quick"]);
+}
+
+#[test]
+fn vtu_ascii_reader_never_panics_on_random_or_mutated_files() {
+    quick(Reader::VtuAscii, &[]);
+}
+
+#[test]
+fn vtu_binary_reader_never_panics_on_random_or_mutated_files() {
+    quick(Reader::VtuBinary, &[]);
+}
+
+#[test]
+fn vtu_appended_raw_reader_never_panics_on_random_or_mutated_files() {
+    quick(Reader::VtuAppendedRaw, &[]);
+}
+
+#[test]
+fn vtu_appended_base64_reader_never_panics_on_random_or_mutated_files() {
+    quick(Reader::VtuAppendedBase64, &[]);
+}
+
+#[test]
+fn pvd_reader_never_panics_on_random_or_mutated_files() {
+    quick(Reader::Pvd, &[]);
+}
+
+#[test]
+fn msh_solution_reader_never_panics_on_random_or_mutated_files() {
+    quick(Reader::MshSolution, &[]);
+}
+
+/// Every base of the solution readers reads, and a huge count written over each binary
+/// header word of the appended raw bases is refused with the array named, without
+/// allocating what the count claims.
+#[test]
+fn solution_bases_read_and_huge_header_counts_are_refused() {
+    for reader in Reader::ALL.into_iter().filter(|r| r.reads_solutions()) {
+        for base in fuzz::bases(reader, &[]) {
+            let outcome = match reader {
+                Reader::Pvd => fuzz::check_pvd(&base.bytes, &base.path),
+                Reader::MshSolution => fuzz::check_msh_solution(&base.bytes, &base.path),
+                _ => fuzz::check_vtu(&base.bytes, &base.path),
+            };
+            assert_eq!(outcome, Outcome::Accepted, "{}", base.path.display());
+        }
+    }
+    let mut refused = 0;
+    for base in fuzz::bases(Reader::VtuAppendedRaw, &[]) {
+        for word in 0..4 {
+            for width in [4usize, 8] {
+                // kind 6: a huge word; byte 1 (odd: 8 wide) or 0 (4 wide) picks u64::MAX.
+                let byte = if width == 8 { 3 } else { 0 };
+                let edit = (6u8, 0.0, word, byte, String::new());
+                let bytes = fuzz::mutate_bytes(&base.bytes, &[edit]);
+                if bytes == base.bytes {
+                    continue;
+                }
+                match fuzz::check_vtu(&bytes, &base.path) {
+                    Outcome::Rejected { named, error, .. } => {
+                        assert!(named, "{error}");
+                        refused += 1;
+                    }
+                    Outcome::Accepted => {}
+                }
+            }
+        }
+    }
+    println!("{refused} huge header words refused");
+    assert!(refused >= 20);
 }
 
 #[test]
@@ -145,7 +221,7 @@ fn scene_errors_found_against_the_mesh_name_the_scene_file_and_field() {
         ),
     ];
     for (edits, field, needle) in cases {
-        let mut text = base.text.clone();
+        let mut text = base.text().to_string();
         for (from, to) in edits {
             assert!(text.contains(from), "the rates scene has {from}");
             text = text.replacen(from, to, 1);
@@ -207,7 +283,7 @@ fn toml_errors_name_the_key_with_its_table_and_index() {
             "key contact.friction",
         ),
     ] {
-        let text = base.text.replacen(from, to, 1);
+        let text = base.text().replacen(from, to, 1);
         let Outcome::Rejected { error, named, .. } =
             fuzz::check_scene(&text, &base.path, &meshes, Method::Mortar)
         else {
@@ -233,9 +309,9 @@ fn a_constant_division_by_zero_in_an_exact_field_is_an_error_not_a_panic() {
     use contact_rates::scene::Expr;
     let base = &fuzz::bases(Reader::Scene, &["contact-mms-vp-time"])[0];
     let from = "(45/0.91)*(-(2*y-1)*(0.91/150)";
-    assert!(base.text.contains(from));
+    assert!(base.text().contains(from));
     let text = base
-        .text
+        .text()
         .replacen(from, "(45/0.91)*(-(2*y-1)*(0.91/1/0)", 1);
     let outcome = fuzz::check_scene(&text, &base.path, &Meshes::default(), Method::Mortar);
     println!("{outcome:?}");

@@ -244,7 +244,7 @@ fn a_pvd_lists_its_steps_in_file_order_resolved_against_its_folder() {
     }
     // A collection written by hand: other attributes, no declaration, a comment.
     let text = "<VTKFile type=\"Collection\" version=\"0.1\">\n<!-- two steps -->\n<Collection>\n  <DataSet part=\"0\" timestep=\"2e-1\" file=\"a.vtu\"></DataSet>\n  <DataSet timestep=\" 4 \" file=\"/abs/b.vtu\"/>\n</Collection>\n</VTKFile>\n";
-    let read = parse_pvd(text, Path::new("run/s.pvd")).unwrap();
+    let read = parse_pvd(text.as_bytes(), Path::new("run/s.pvd")).unwrap();
     assert_eq!(
         read,
         vec![
@@ -428,6 +428,15 @@ fn a_grid_of_another_type_is_refused() {
 }
 
 #[test]
+fn a_parallel_grid_is_refused_with_the_piece_route() {
+    refused_vtu(
+        &vtu_text_with("type=\"UnstructuredGrid\"", "type=\"PUnstructuredGrid\""),
+        "VTKFile",
+        &["parallel grid (.pvtu)", "run on one process"],
+    );
+}
+
+#[test]
 fn two_pieces_are_refused() {
     let text = String::from_utf8(vtu_with(Encoding::Ascii, |_| {})).unwrap();
     let (a, b) = (
@@ -529,6 +538,15 @@ fn quadratic_triangles_are_refused_with_the_p1_route() {
             "P2 is not graded yet",
             "interpolate to P1",
         ],
+    );
+}
+
+#[test]
+fn lagrange_triangles_are_refused_with_the_p1_route() {
+    refused_vtu(
+        &with_cell(69.0, 6),
+        "Cells",
+        &["Lagrange triangle (VTK type 69", "P2 is not graded yet"],
     );
 }
 
@@ -877,7 +895,7 @@ fn malformed_xml_is_refused_with_its_line() {
 
 fn refused_pvd(text: &str, field: &str, needles: &[&str]) {
     let file = path("s.pvd");
-    assert_refused(parse_pvd(text, &file), &file, field, needles);
+    assert_refused(parse_pvd(text.as_bytes(), &file), &file, field, needles);
 }
 
 #[test]

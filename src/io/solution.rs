@@ -14,7 +14,9 @@
 //! Every refusal is an [`Error::input`] naming the file, the field (`PointData/displacement`,
 //! `CellData/body`, `Cells`, `$NodeData "displacement" (line 40)`, ...) and the fix.
 //! Counts in a file are checked against the bytes present before anything is allocated
-//! from them, so a corrupt header cannot ask for absurd memory.
+//! from them, so a corrupt header cannot ask for absurd memory. What must vanish (z, a third
+//! displacement component, the z row of a stress) or agree (s12 and s21) is judged to
+//! [`ROUNDING`] epsilons of the precision stored, relative to its array's size.
 //!
 //! Written by hand on quick-xml (the XML), base64 and flate2 (zlib) because no maintained
 //! Rust crate reads these files whole. Checked: vtkio's last release is 0.6.3 (2021); its
@@ -472,7 +474,7 @@ fn ordered<const N: usize>(b: &[u8], order: ByteOrder) -> [u8; N] {
     a
 }
 
-/// Decode packed binary numbers of type `t`; `field` names the array for an error.
+/// Decode packed binary numbers of type `t` in byte order `order`.
 fn from_bytes(bytes: &[u8], t: Scalar, order: ByteOrder) -> std::result::Result<Numbers, String> {
     let n = t.size();
     let chunks = bytes.chunks_exact(n);
@@ -841,6 +843,13 @@ fn read_root(a: &HashMap<String, String>, doc: &mut VtuDocument, path: &Path) ->
     let field = "VTKFile";
     match a.get("type").map(String::as_str) {
         Some("UnstructuredGrid") => {}
+        Some("PUnstructuredGrid") => {
+            return Err(Error::input(
+                path,
+                field,
+                "type=\"PUnstructuredGrid\": a parallel grid (.pvtu) only lists its pieces; read the .vtu of a run on one process, or merge the pieces into one .vtu (ParaView's Merge Blocks, then Save Data)",
+            ));
+        }
         other => {
             return Err(Error::input(
                 path,
@@ -996,20 +1005,20 @@ impl Source<'_> {
                 } else {
                     (0, base64_chars(end), header)
                 };
-                let chars = chars.ok_or("a payload past any file")?;
-                let text = t.get(from..from + chars).ok_or_else(|| {
+                let to = chars
+                    .and_then(|c| c.checked_add(from))
+                    .ok_or("a payload past any file")?;
+                let text = t.get(from..to).ok_or_else(|| {
                     format!(
-                        "the base64 text holds {} characters, the header announces {} bytes ({} characters)",
-                        t.len(),
-                        n,
-                        from + chars
+                        "the base64 text holds {} characters, the header announces {n} bytes ({to} characters)",
+                        t.len()
                     )
                 })?;
                 let bytes = BASE64
                     .decode(text)
                     .map_err(|e| format!("the data is not valid base64 ({e})"))?;
                 bytes
-                    .get(skip..skip + n)
+                    .get(skip..skip.saturating_add(n))
                     .map(<[u8]>::to_vec)
                     .ok_or_else(|| "the data is shorter than announced".into())
             }
@@ -1235,7 +1244,8 @@ impl VtuDocument {
                         "{m}{counts}; the binary data does not match the array (a truncated or edited file, or a wrong header_type): write the file again"
                     ))
                 })?;
-                if bytes.len() % (t.size() * a.components) != 0 {
+                let tuple_bytes = t.size().saturating_mul(a.components);
+                if !bytes.len().is_multiple_of(tuple_bytes) {
                     return Err(wrong_count(bytes.len() / t.size()));
                 }
                 from_bytes(&bytes, t, self.order)
@@ -1402,6 +1412,8 @@ pub fn parse_vtu(bytes: &[u8], path: &Path, names: &FieldNames) -> Result<Soluti
                 let (what, kind) = match other {
                     9 => ("quadrilateral", ElementKind::Quadrilateral),
                     22 => ("quadratic triangle", ElementKind::QuadraticTriangle),
+                    // What FEniCSx writes for a triangle of degree 2 or more.
+                    69 => ("Lagrange triangle", ElementKind::QuadraticTriangle),
                     _ => ("cell", ElementKind::Other),
                 };
                 return Err(Error::input(
@@ -1618,7 +1630,12 @@ pub fn parse_vtu(bytes: &[u8], path: &Path, names: &FieldNames) -> Result<Soluti
 /// files resolved against the .pvd's folder.
 pub fn read_pvd(path: &Path) -> Result<Vec<(f64, PathBuf)>> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    let text = std::str::from_utf8(&bytes).map_err(|e| {
+    parse_pvd(&bytes, path)
+}
+
+/// Read the bytes of a .pvd; `path` names the file in errors and resolves the datasets.
+pub fn parse_pvd(bytes: &[u8], path: &Path) -> Result<Vec<(f64, PathBuf)>> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
         Error::input(
             path,
             "XML",
@@ -1628,16 +1645,13 @@ pub fn read_pvd(path: &Path) -> Result<Vec<(f64, PathBuf)>> {
             ),
         )
     })?;
-    parse_pvd(text, path)
-}
-
-/// Read the text of a .pvd; `path` names the file in errors and resolves the datasets.
-pub fn parse_pvd(text: &str, path: &Path) -> Result<Vec<(f64, PathBuf)>> {
     use quick_xml::events::Event;
     let folder = path.parent().unwrap_or(Path::new(""));
     let mut reader = quick_xml::Reader::from_str(text);
     let mut stack: Vec<String> = Vec::new();
     let mut out: Vec<(f64, PathBuf)> = Vec::new();
+    // The dataset of each time read (0 and -0 alike).
+    let mut of_time: HashMap<u64, usize> = HashMap::new();
     let mut root_seen = false;
     loop {
         let at = reader.buffer_position();
@@ -1714,7 +1728,7 @@ pub fn parse_pvd(text: &str, path: &Path) -> Result<Vec<(f64, PathBuf)>> {
                         ));
                     }
                 };
-                if let Some(j) = out.iter().position(|(t, _)| *t == time) {
+                if let Some(&j) = of_time.get(&(time + 0.0).to_bits()) {
                     return Err(Error::input(
                         path,
                         field("timestep"),
@@ -1723,6 +1737,7 @@ pub fn parse_pvd(text: &str, path: &Path) -> Result<Vec<(f64, PathBuf)>> {
                         ),
                     ));
                 }
+                of_time.insert((time + 0.0).to_bits(), i);
                 out.push((time, file));
             }
             _ => {}
@@ -1989,7 +2004,7 @@ fn binary_msh(path: &Path) -> Error {
     )
 }
 
-/// Whether the text starting a file announces a binary MSH (`$MeshFormat` version 1 ...).
+/// Whether the text starting a file announces a binary MSH (`$MeshFormat`, a version, 1).
 fn announces_binary(prefix: &str) -> bool {
     prefix.find("$MeshFormat").is_some_and(|i| {
         let mut t = prefix[i + "$MeshFormat".len()..].split_whitespace();
@@ -2017,7 +2032,8 @@ fn parse_msh_file(text: &str, path: &Path, names: &FieldNames) -> Result<MshFile
     let mut node_index: HashMap<u64, usize> = HashMap::new();
     let (mut format_seen, mut nodes_seen, mut elements_seen) = (false, false, false);
     while let Some(tok) = c.token() {
-        c.section = tok.to_string();
+        // A section's errors name it; a stray token names the file and its line.
+        c.section = if tok.starts_with('$') { tok } else { "file" }.to_string();
         if !format_seen && tok != "$MeshFormat" {
             return Err(c.err(format!(
                 "the file starts with '{tok}', not $MeshFormat: give gmsh's MSH file (ASCII 4.1 or 2.2)"
