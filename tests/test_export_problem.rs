@@ -46,7 +46,11 @@ fn the_export_reads_back_as_the_solvers_problem() {
             .arg(&converted)
             .output()
             .expect("gmsh runs");
-        assert!(status.status.success(), "{}", String::from_utf8_lossy(&status.stderr));
+        assert!(
+            status.status.success(),
+            "{}",
+            String::from_utf8_lossy(&status.stderr)
+        );
         // The 4.1 file keeps the model's numbering (loads_L.csv refers to it).
         let own = read_msh(&dir.join(format!("mesh_{level}.msh"))).unwrap();
         for (g, p) in own.nodes.iter().enumerate() {
@@ -62,10 +66,26 @@ fn the_export_reads_back_as_the_solvers_problem() {
                 v
             };
             let model_nodes: Vec<[f64; 2]> = (0..m.n_nodes).map(|g| m.position(g)).collect();
-            assert_eq!(sorted(raw.nodes.clone()), sorted(model_nodes), "{}", file.display());
+            assert_eq!(
+                sorted(raw.nodes.clone()),
+                sorted(model_nodes),
+                "{}",
+                file.display()
+            );
             let curves = raw.names_of_dim(1);
-            for name in ["bottom", "top", "contact_upper", "contact_lower", "left_upper", "right_lower"] {
-                assert!(curves.iter().any(|c| c == name), "{}: {curves:?}", file.display());
+            for name in [
+                "bottom",
+                "top",
+                "contact_upper",
+                "contact_lower",
+                "left_upper",
+                "right_lower",
+            ] {
+                assert!(
+                    curves.iter().any(|c| c == name),
+                    "{}: {curves:?}",
+                    file.display()
+                );
             }
             let surfaces = raw.names_of_dim(2);
             assert_eq!(surfaces, vec!["lower".to_string(), "upper".to_string()]);
@@ -90,11 +110,19 @@ fn the_export_reads_back_as_the_solvers_problem() {
     let text = std::fs::read_to_string(dir.join("problem.toml")).unwrap();
     let problem: toml::Value = toml::from_str(&text).unwrap();
     let body = &problem["bodies"][0];
-    let (e, nu) = (body["young"].as_float().unwrap(), body["poisson"].as_float().unwrap());
-    assert_eq!(body["lambda_star"].as_float().unwrap(), e * nu / (1.0 - nu * nu));
+    let (e, nu) = (
+        body["young"].as_float().unwrap(),
+        body["poisson"].as_float().unwrap(),
+    );
+    assert_eq!(
+        body["lambda_star"].as_float().unwrap(),
+        e * nu / (1.0 - nu * nu)
+    );
     assert!((body["mu"].as_float().unwrap() - e / (2.0 * (1.0 + nu))).abs() <= 1e-14 * e);
     assert_eq!(problem["time"]["steps"].as_integer(), Some(4));
-    let normal = problem["contact"]["pieces"][0]["slave_normal"].as_array().unwrap();
+    let normal = problem["contact"]["pieces"][0]["slave_normal"]
+        .as_array()
+        .unwrap();
     assert_eq!(normal[1].as_float(), Some(-1.0));
     check_problem_py(&dir);
 }
@@ -111,7 +139,9 @@ fn check_problem_py(dir: &Path) {
             std::env::var_os("CONTACT_RATES_REQUIRE_SYMPY").is_none(),
             "python3 with sympy is required (pip install sympy)"
         );
-        eprintln!("note: python3 with sympy not found: problem.py's check not run (pip install sympy)");
+        eprintln!(
+            "note: python3 with sympy not found: problem.py's check not run (pip install sympy)"
+        );
         return;
     }
     let run = Command::new("python3")
@@ -120,7 +150,11 @@ fn check_problem_py(dir: &Path) {
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&run.stdout);
-    assert!(run.status.success(), "{stdout}{}", String::from_utf8_lossy(&run.stderr));
+    assert!(
+        run.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
     println!("{stdout}");
     let count: usize = stdout
         .split_whitespace()
@@ -136,7 +170,12 @@ fn check_problem_py(dir: &Path) {
 fn a_scene_without_an_exact_solution_is_refused_and_nothing_written() {
     let out = tempfile::tempdir().unwrap();
     let dir = out.path().join("exported");
-    let e = export(&Source::Scene("rates".into()), &[0], &dir).unwrap_err().to_string();
-    assert!(e.contains("no exact solution") && e.contains("contact-mms"), "{e}");
+    let e = export(&Source::Scene("rates".into()), &[0], &dir)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("no exact solution") && e.contains("contact-mms"),
+        "{e}"
+    );
     assert!(!dir.exists());
 }

@@ -62,11 +62,16 @@ fn write_vtu(path: &Path, s: &Solution) {
 
 /// A solve's steps t_1..t_N as `dir/level_L.pvd` with one .vtu per step.
 fn write_series(dir: &Path, level: usize, case: &Case, sol: &Solved) {
-    let mut pvd = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n");
+    let mut pvd = String::from(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n",
+    );
     for (n, s) in sol.states.iter().enumerate().skip(1) {
         let name = format!("level_{level}_step_{n}.vtu");
         write_vtu(&dir.join(&name), &outside(case, s, &s.u));
-        pvd.push_str(&format!("<DataSet timestep=\"{:e}\" file=\"{name}\"/>\n", s.time));
+        pvd.push_str(&format!(
+            "<DataSet timestep=\"{:e}\" file=\"{name}\"/>\n",
+            s.time
+        ));
     }
     pvd.push_str("</Collection>\n</VTKFile>\n");
     std::fs::write(dir.join(format!("level_{level}.pvd")), pvd).unwrap();
@@ -85,7 +90,10 @@ fn request(source: Source, dir: &Path, compare: bool) -> GradeRequest {
 }
 
 fn errors_of<'a>(g: &'a Graded, method: &str) -> Vec<&'a ErrorRecord> {
-    g.errors.iter().filter(|r| r.method.name() == method).collect()
+    g.errors
+        .iter()
+        .filter(|r| r.method.name() == method)
+        .collect()
 }
 
 #[test]
@@ -99,11 +107,19 @@ fn round_trip_of_this_projects_solves_gives_the_study_errors() {
         let (sol, _) = solve_case(&case, SolverKind::Newton, study.file.steps).unwrap();
         write_series(dir.path(), level, &case, &sol);
     }
-    let g = grade(&request(Source::Study("rates-exact".into()), dir.path(), true)).unwrap();
+    let g = grade(&request(
+        Source::Study("rates-exact".into()),
+        dir.path(),
+        true,
+    ))
+    .unwrap();
     // Against the committed study (reports/rates-exact, levels 0-5).
-    let committed: Vec<ErrorRecord> =
-        read(Path::new(env!("CARGO_MANIFEST_DIR")).join("reports/rates-exact/errors.csv").as_path())
-            .unwrap();
+    let committed: Vec<ErrorRecord> = read(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("reports/rates-exact/errors.csv")
+            .as_path(),
+    )
+    .unwrap();
     let mine = errors_of(&g, "outside");
     assert_eq!(mine.len(), 3 * study.file.quantities.len());
     let mut worst = 0.0f64;
@@ -113,13 +129,22 @@ fn round_trip_of_this_projects_solves_gives_the_study_errors() {
             .find(|c| c.method.name() == "mortar" && c.level == r.level && c.quantity == r.quantity)
             .expect("the study has the row");
         worst = worst.max((r.error - s.error).abs() / s.error.abs());
-        assert!((r.h - s.h).abs() <= 1e-15 * s.h && r.dofs == s.dofs, "{r:?} vs {s:?}");
+        assert!(
+            (r.h - s.h).abs() <= 1e-15 * s.h && r.dofs == s.dofs,
+            "{r:?} vs {s:?}"
+        );
     }
-    println!("round trip: {} errors, largest relative difference to the study {worst:.2e}", mine.len());
+    println!(
+        "round trip: {} errors, largest relative difference to the study {worst:.2e}",
+        mine.len()
+    );
     assert!(worst <= 1e-10, "{worst}");
     // Rates and verdicts against grade's own mortar on the same levels.
     let rate = |m: &str, q: Quantity| -> &RateRecord {
-        g.rates.iter().find(|r| r.method.name() == m && r.quantity == q).unwrap()
+        g.rates
+            .iter()
+            .find(|r| r.method.name() == m && r.quantity == q)
+            .unwrap()
     };
     for &q in &study.file.quantities {
         let (a, b) = (rate("outside", q), rate("mortar", q));
@@ -171,7 +196,11 @@ fn a_known_perturbation_obeys_the_parallelogram_law() {
     let delta = 1e-3 * last.u.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     let norm_exact = {
         let cmp = ExactComparison::new(exact, contact_rates::verify::exact_error::DEFAULT_POINTS);
-        let d = cmp.difference(m, &case.problem.interface, &P1Field::of_state(&case.problem, last));
+        let d = cmp.difference(
+            m,
+            &case.problem.interface,
+            &P1Field::of_state(&case.problem, last),
+        );
         (d.exact.l2_u + d.exact.semi_u).sqrt()
     };
     let graded = |shift: f64| -> f64 {
@@ -179,7 +208,12 @@ fn a_known_perturbation_obeys_the_parallelogram_law() {
         let mut u = last.u.clone();
         u[2 * node] += shift;
         write_vtu(&dir.path().join("level_1.vtu"), &outside(&case, last, &u));
-        let g = grade(&request(Source::Scene("contact-mms".into()), dir.path(), false)).unwrap();
+        let g = grade(&request(
+            Source::Scene("contact-mms".into()),
+            dir.path(),
+            false,
+        ))
+        .unwrap();
         let e = errors_of(&g, "outside")
             .into_iter()
             .find(|r| r.quantity == Quantity::H1U)
@@ -216,7 +250,10 @@ fn bad_solution_folders_are_refused_with_the_file_and_the_field() {
     write_vtu(&dir.path().join("level_0.vtu"), &good);
     write_series(dir.path(), 0, &case, &sol);
     let msg = refused(request(scene(), dir.path(), false));
-    assert!(msg.contains("level_0") && msg.contains("has 2 solutions"), "{msg}");
+    assert!(
+        msg.contains("level_0") && msg.contains("has 2 solutions"),
+        "{msg}"
+    );
     // A level asked for that is missing.
     let dir = tempfile::tempdir().unwrap();
     write_vtu(&dir.path().join("level_0.vtu"), &good);
@@ -238,12 +275,17 @@ fn bad_solution_folders_are_refused_with_the_file_and_the_field() {
     let file = dir.path().join("level_0.vtu");
     write_vtu(&file, &holed);
     let msg = refused(request(scene(), dir.path(), false));
-    assert!(msg.contains(&file.display().to_string()) && msg.contains("does not cover"), "{msg}");
+    assert!(
+        msg.contains(&file.display().to_string()) && msg.contains("does not cover"),
+        "{msg}"
+    );
     // Times that are not the problem's steps.
     let dir = tempfile::tempdir().unwrap();
     write_series(dir.path(), 0, &case, &sol);
     let pvd = dir.path().join("level_0.pvd");
-    let text = std::fs::read_to_string(&pvd).unwrap().replace("timestep=\"5e-1\"", "timestep=\"0.6\"");
+    let text = std::fs::read_to_string(&pvd)
+        .unwrap()
+        .replace("timestep=\"5e-1\"", "timestep=\"0.6\"");
     std::fs::write(&pvd, text).unwrap();
     let msg = refused(request(scene(), dir.path(), false));
     assert!(msg.contains("level_0.pvd") && msg.contains("time"), "{msg}");
@@ -254,7 +296,10 @@ fn bad_solution_folders_are_refused_with_the_file_and_the_field() {
     req.name = "nts".into();
     assert!(refused(req).contains("--name"));
     let msg = refused(request(Source::Scene("rates".into()), dir.path(), false));
-    assert!(msg.contains("no exact solution") && msg.contains("contact-mms"), "{msg}");
+    assert!(
+        msg.contains("no exact solution") && msg.contains("contact-mms"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -277,5 +322,9 @@ fn the_threshold_is_met_and_missed() {
     req.threshold = Some(1.5);
     let g = grade(&req).unwrap();
     assert_eq!(g.failures.len(), 1, "{:?}", g.failures);
-    assert!(g.failures[0].contains("below the threshold 1.5"), "{:?}", g.failures);
+    assert!(
+        g.failures[0].contains("below the threshold 1.5"),
+        "{:?}",
+        g.failures
+    );
 }

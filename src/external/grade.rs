@@ -49,8 +49,11 @@ pub enum Storage {
 }
 
 impl Storage {
-    const ALL: [(Storage, &'static str); 3] =
-        [(Storage::Vtu, "vtu"), (Storage::Pvd, "pvd"), (Storage::Msh, "msh")];
+    const ALL: [(Storage, &'static str); 3] = [
+        (Storage::Vtu, "vtu"),
+        (Storage::Pvd, "pvd"),
+        (Storage::Msh, "msh"),
+    ];
 }
 
 /// One level's measured solution.
@@ -87,42 +90,62 @@ pub struct Graded {
     pub notes: Vec<String>,
     /// Why the threshold failed (empty: passed or none given).
     pub failures: Vec<String>,
+    /// The command that reproduces the grade (the report folder aside).
+    pub command: String,
 }
 
 /// The solution files of `dir`, per level: exactly one each.
-fn level_files(dir: &Path, wanted: Option<&[usize]>) -> Result<BTreeMap<usize, (Storage, PathBuf)>> {
+fn level_files(
+    dir: &Path,
+    wanted: Option<&[usize]>,
+) -> Result<BTreeMap<usize, (Storage, PathBuf)>> {
     let entries = std::fs::read_dir(dir).map_err(|e| {
         Error::input(dir, "--solutions", format!("cannot read the folder ({e}); pass the folder that holds level_L.vtu, level_L.pvd or level_L.msh"))
     })?;
     let mut found: BTreeMap<usize, Vec<(Storage, PathBuf)>> = BTreeMap::new();
     for entry in entries.flatten() {
         let name = entry.file_name().to_string_lossy().to_string();
-        let Some(rest) = name.strip_prefix("level_") else { continue };
-        let Some((level, ext)) = rest.split_once('.') else { continue };
+        let Some(rest) = name.strip_prefix("level_") else {
+            continue;
+        };
+        let Some((level, ext)) = rest.split_once('.') else {
+            continue;
+        };
         let (Ok(level), Some(storage)) = (
             level.parse::<usize>(),
             Storage::ALL.iter().find(|(_, e)| *e == ext).map(|s| s.0),
         ) else {
             continue;
         };
-        found.entry(level).or_default().push((storage, entry.path()));
+        found
+            .entry(level)
+            .or_default()
+            .push((storage, entry.path()));
     }
     if let Some((level, files)) = found.iter().find(|(_, f)| f.len() > 1) {
         let names: Vec<String> = files.iter().map(|f| f.1.display().to_string()).collect();
         return Err(Error::input(
             dir,
             format!("level_{level}"),
-            format!("level {level} has {} solutions ({}); keep one of them", files.len(), names.join(", ")),
+            format!(
+                "level {level} has {} solutions ({}); keep one of them",
+                files.len(),
+                names.join(", ")
+            ),
         ));
     }
-    let mut out: BTreeMap<usize, (Storage, PathBuf)> =
-        found.into_iter().map(|(l, mut f)| (l, f.remove(0))).collect();
+    let mut out: BTreeMap<usize, (Storage, PathBuf)> = found
+        .into_iter()
+        .map(|(l, mut f)| (l, f.remove(0)))
+        .collect();
     if let Some(wanted) = wanted {
         if let Some(missing) = wanted.iter().find(|l| !out.contains_key(l)) {
             return Err(Error::input(
                 dir,
                 format!("level_{missing}"),
-                format!("--levels asks for level {missing}, but the folder has no level_{missing}.vtu, .pvd or .msh; write it, or leave the level out of --levels"),
+                format!(
+                    "--levels asks for level {missing}, but the folder has no level_{missing}.vtu, .pvd or .msh; write it, or leave the level out of --levels"
+                ),
             ));
         }
         out.retain(|l, _| wanted.contains(l));
@@ -155,7 +178,10 @@ fn read_level(
         Storage::Msh => read_msh_solution(
             path,
             names,
-            [&family.scene.bodies[0].surface, &family.scene.bodies[1].surface],
+            [
+                &family.scene.bodies[0].surface,
+                &family.scene.bodies[1].surface,
+            ],
         )?,
     };
     // t_0 = 0 is the unloaded state, not graded.
@@ -196,7 +222,11 @@ fn read_level(
 /// The quantities measured: the study's, or for a scene every one its exact solution
 /// gives; the pressure ones only where the solutions give a pressure.
 fn quantities(family: &Family, study: Option<&LoadedStudy>, pressure: bool) -> Vec<Quantity> {
-    let exact = family.scene.exact.as_deref().expect("a graded family has an exact solution");
+    let exact = family
+        .scene
+        .exact
+        .as_deref()
+        .expect("a graded family has an exact solution");
     let all: Vec<Quantity> = match study {
         Some(s) => s.file.quantities.clone(),
         None => Quantity::ALL
@@ -267,16 +297,24 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
         Source::Study(name) => Some(LoadedStudy::load(name)?),
         Source::Scene(_) => None,
     };
-    let exact = family.scene.exact.as_deref().expect("resolve refuses a scene without one");
+    let exact = family
+        .scene
+        .exact
+        .as_deref()
+        .expect("resolve refuses a scene without one");
     let points = study
         .as_ref()
-        .map_or(crate::verify::exact_error::DEFAULT_POINTS, |s| s.file.reference.quadrature);
+        .map_or(crate::verify::exact_error::DEFAULT_POINTS, |s| {
+            s.file.reference.quadrature
+        });
     let truth = Truth::Exact(exact, points);
     let files = level_files(&req.solutions, req.levels.as_deref())?;
     // The levels are independent: measured in parallel, in level order.
     let graded: Vec<(GradedLevel, BTreeMap<Quantity, f64>, bool)> = files
         .par_iter()
-        .map(|(&level, (storage, path))| grade_level(level, *storage, path, &req.names, &family, &truth))
+        .map(|(&level, (storage, path))| {
+            grade_level(level, *storage, path, &req.names, &family, &truth)
+        })
         .collect::<Result<Vec<_>>>()?;
     let resultant_fixed = graded.first().is_some_and(|g| g.2);
     let (levels, measured): (Vec<GradedLevel>, Vec<BTreeMap<Quantity, f64>>) =
@@ -287,7 +325,17 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
     let mut errors = Vec::new();
     for (l, e) in levels.iter().zip(&measured) {
         let steps = l.times.len();
-        errors.extend(rows(&label, l.level, l.h, l.dofs, steps, None, &quantities, e, &l.file)?);
+        errors.extend(rows(
+            &label,
+            l.level,
+            l.h,
+            l.dofs,
+            steps,
+            None,
+            &quantities,
+            e,
+            &l.file,
+        )?);
     }
     let compared = req.compare;
     if compared {
@@ -306,8 +354,16 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
         errors.extend(cones.into_iter().flatten());
     }
     let key = key_quantity(exact);
-    let (rates, failures) = judge_all(&errors, &label, key, req.threshold, resultant_fixed, &req.solutions)?;
+    let (rates, failures) = judge_all(
+        &errors,
+        &label,
+        key,
+        req.threshold,
+        resultant_fixed,
+        &req.solutions,
+    )?;
     let notes = notes(&levels, &family, pressure);
+    let command = command_line(req, &files);
     Ok(Graded {
         scene: family.scene.name.clone(),
         study: family.study.clone(),
@@ -320,7 +376,46 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
         compared,
         notes,
         failures,
+        command,
     })
+}
+
+/// `contact-rates grade ...` with the request's options.
+fn command_line(req: &GradeRequest, files: &BTreeMap<usize, (Storage, PathBuf)>) -> String {
+    let source = match &req.source {
+        Source::Study(s) => format!("--study {s}"),
+        Source::Scene(s) => format!("--scene {s}"),
+    };
+    let (first, last) = (
+        files.keys().next().copied().unwrap_or(0),
+        files.keys().last().copied().unwrap_or(0),
+    );
+    let mut out = format!(
+        "contact-rates grade {source} --solutions {} --levels {first}-{last} --name {}",
+        req.solutions.display(),
+        req.name
+    );
+    if let Some(t) = req.threshold {
+        out.push_str(&format!(" --threshold {t}"));
+    }
+    if !req.compare {
+        out.push_str(" --no-compare");
+    }
+    let defaults = FieldNames::default();
+    for (flag, name, default) in [
+        (
+            "--displacement",
+            &req.names.displacement,
+            &defaults.displacement,
+        ),
+        ("--stress", &req.names.stress, &defaults.stress),
+        ("--pressure", &req.names.pressure, &defaults.pressure),
+    ] {
+        if name != default {
+            out.push_str(&format!(" {flag} {name}"));
+        }
+    }
+    out
 }
 
 /// One level's file read, put on a model of the scene and measured against `truth`; with
@@ -373,14 +468,18 @@ fn check_label(name: &str) -> Result<MethodLabel> {
         return Err(Error::input(
             "--name",
             "name",
-            format!("'{name}' is not a label; use letters, digits and - _ . + (e.g. getfem-nitsche)"),
+            format!(
+                "'{name}' is not a label; use letters, digits and - _ . + (e.g. getfem-nitsche)"
+            ),
         ));
     }
     match MethodLabel::parse(name) {
         MethodLabel::Cone(m) => Err(Error::input(
             "--name",
             "name",
-            format!("'{m}' names this project's own cone, which grade puts beside yours; choose another label"),
+            format!(
+                "'{m}' names this project's own cone, which grade puts beside yours; choose another label"
+            ),
         )),
         label => Ok(label),
     }
@@ -389,7 +488,10 @@ fn check_label(name: &str) -> Result<MethodLabel> {
 /// Two levels with the same h cannot give a rate: refused.
 fn check_distinct_h(levels: &[GradedLevel], dir: &Path) -> Result<()> {
     for (i, a) in levels.iter().enumerate() {
-        if let Some(b) = levels[i + 1..].iter().find(|b| (a.h - b.h).abs() <= 1e-12 * a.h) {
+        if let Some(b) = levels[i + 1..]
+            .iter()
+            .find(|b| (a.h - b.h).abs() <= 1e-12 * a.h)
+        {
             return Err(Error::input(
                 dir,
                 format!("level_{}", b.level),
@@ -493,7 +595,8 @@ fn judge_all(
             let a = rates::judge(&levels, 0.0, quantity, resultant_fixed)
                 .map_err(|e| Error::input(dir, "levels", format!("{method} {quantity}: {e}")))?;
             let required = threshold.filter(|_| method == label && quantity == key);
-            let pass = required.map(|r| a.used.len() >= MIN_FIT_LEVELS && a.fit.is_some_and(|f| f.rate >= r));
+            let pass = required
+                .map(|r| a.used.len() >= MIN_FIT_LEVELS && a.fit.is_some_and(|f| f.rate >= r));
             if pass == Some(false) {
                 failures.push(match a.fit {
                     Some(f) if a.used.len() >= MIN_FIT_LEVELS => format!(
@@ -508,7 +611,13 @@ fn judge_all(
                     ),
                 });
             }
-            out.push(RateRecord::new(method.clone(), quantity, &a, required, pass));
+            out.push(RateRecord::new(
+                method.clone(),
+                quantity,
+                &a,
+                required,
+                pass,
+            ));
         }
     }
     Ok((out, failures))

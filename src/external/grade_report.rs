@@ -9,6 +9,7 @@ use crate::report::folder::{write, write_folder};
 use crate::report::markdown::{Doc, Table};
 use crate::report::plot::{self, Series};
 use crate::verify::quantity::Quantity;
+use crate::verify::rates::Verdict;
 use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord};
 use std::path::Path;
 
@@ -65,11 +66,7 @@ impl Graded {
             });
             if let Some(line) = self.rate(m, self.key).and_then(|r| fit_line(r, &rows)) {
                 series.push(Series {
-                    label: format!(
-                        "{m} fit: slope {:.2} ± {:.2}",
-                        line.0,
-                        line.1
-                    ),
+                    label: format!("{m} fit: slope {:.2} ± {:.2}", line.0, line.1),
                     points: line.2,
                     markers: false,
                     line: true,
@@ -98,9 +95,22 @@ impl Graded {
         doc.heading(1, format!("Grade of `{}` on {what}", self.label));
         doc.paragraph(self.lead());
         if !self.failures.is_empty() {
-            doc.paragraph(format!("**Threshold missed**: {}.", self.failures.join("; ")));
+            doc.paragraph(format!(
+                "**Threshold missed**: {}.",
+                self.failures.join("; ")
+            ));
+        }
+        if self.compared {
+            if let Some(table) = self.contact_table() {
+                doc.paragraph(format!(
+                    "On Gamma_C, where mortar and nts differ, at the finest level ({}):",
+                    self.levels.last().map_or(0, |l| l.level)
+                ));
+                doc.table(&table);
+            }
         }
         doc.list(&self.notes);
+        doc.paragraph(format!("Graded with `{}`.", self.command));
         doc.image("error against h", "error_vs_h.png");
         doc.heading(2, format!("{} per level", self.key));
         doc.table(&self.key_table());
@@ -115,10 +125,15 @@ impl Graded {
     /// The first paragraph: the graded code's key rate and verdict beside the cones'.
     fn lead(&self) -> String {
         let rate = |m: &MethodLabel| {
-            self.rate(m, self.key).map_or("no rate".into(), |r| match r.rate {
-                Some(v) => format!("{v:.3} ± {:.3} ({})", r.stderr.unwrap_or(0.0), r.verdict.name()),
-                None => format!("no rate ({})", r.verdict.name()),
-            })
+            self.rate(m, self.key)
+                .map_or("no rate".into(), |r| match r.rate {
+                    Some(v) => format!(
+                        "{v:.3} ± {:.3} ({})",
+                        r.stderr.unwrap_or(0.0),
+                        r.verdict.name()
+                    ),
+                    None => format!("no rate ({})", r.verdict.name()),
+                })
         };
         let label = MethodLabel::External(self.label.clone());
         let norm = match self.key {
@@ -164,6 +179,50 @@ impl Graded {
             })
             .collect();
         (!parts.is_empty()).then(|| parts.join(" and "))
+    }
+
+    /// The contact quantities at the finest level: each method's error and the graded
+    /// code's error over each cone's (None without such quantities).
+    fn contact_table(&self) -> Option<Table> {
+        let level = self.levels.last()?.level;
+        let label = MethodLabel::External(self.label.clone());
+        let cones: Vec<MethodLabel> = self
+            .methods()
+            .into_iter()
+            .filter(|m| m.cone().is_some())
+            .collect();
+        let mut header = vec!["quantity".to_string(), self.label.clone()];
+        header.extend(cones.iter().map(|m| format!("{m}")));
+        header.extend(cones.iter().map(|m| format!("{} / {m}", self.label)));
+        let mut table = Table::new(header);
+        for q in Quantity::CONTACT {
+            let Some(mine) = self.error(&label, level, q).map(|r| r.error) else {
+                continue;
+            };
+            // Its error measures the load quadrature (round-off), not the discretization.
+            if self
+                .rate(&label, q)
+                .is_some_and(|r| r.verdict == Verdict::FixedByEquilibrium)
+            {
+                continue;
+            }
+            let theirs: Vec<Option<f64>> = cones
+                .iter()
+                .map(|m| self.error(m, level, q).map(|r| r.error))
+                .collect();
+            let mut row = vec![format!("`{q}`"), format!("{mine:.3e}")];
+            row.extend(
+                theirs
+                    .iter()
+                    .map(|e| e.map_or("-".into(), |e| format!("{e:.3e}"))),
+            );
+            row.extend(theirs.iter().map(|e| match e {
+                Some(e) if *e > 0.0 => format!("{:.3}", mine / e),
+                _ => "-".into(),
+            }));
+            table.row(row);
+        }
+        (!table.is_empty()).then_some(table)
     }
 
     fn key_table(&self) -> Table {
@@ -214,7 +273,11 @@ impl Graded {
                     format!("{v:.3} ± {:.3}", r.stderr.unwrap_or(0.0))
                 }),
                 r.verdict.name().to_string(),
-                if r.levels_used.is_empty() { "-".into() } else { r.levels_used.clone() },
+                if r.levels_used.is_empty() {
+                    "-".into()
+                } else {
+                    r.levels_used.clone()
+                },
                 r.successive.clone(),
                 match (r.threshold, r.pass) {
                     (Some(t), Some(true)) => format!(">= {t}: pass"),
@@ -228,14 +291,23 @@ impl Graded {
 
     fn level_table(&self) -> Table {
         let mut table = Table::new([
-            "level", "file", "h", "dofs", "triangles", "steps graded", "stress", "pressure",
+            "level",
+            "file",
+            "h",
+            "dofs",
+            "triangles",
+            "steps graded",
+            "stress",
+            "pressure",
         ]);
         for l in &self.levels {
             table.row([
                 l.level.to_string(),
                 format!(
                     "`{}`",
-                    l.file.file_name().map_or(String::new(), |f| f.to_string_lossy().to_string())
+                    l.file
+                        .file_name()
+                        .map_or(String::new(), |f| f.to_string_lossy().to_string())
                 ),
                 format!("{:.5}", l.h),
                 l.dofs.to_string(),
@@ -244,8 +316,16 @@ impl Graded {
                     Storage::Vtu => "T only".into(),
                     _ => format!("{} of {}", l.times.len(), self.steps),
                 },
-                if l.stress_given { "given".into() } else { "E eps(u_h)".into() },
-                if l.pressure_given { "given".into() } else { "-".into() },
+                if l.stress_given {
+                    "given".into()
+                } else {
+                    "E eps(u_h)".into()
+                },
+                if l.pressure_given {
+                    "given".into()
+                } else {
+                    "-".into()
+                },
             ]);
         }
         table
@@ -282,10 +362,14 @@ fn fit_line(r: &RateRecord, rows: &[&ErrorRecord]) -> Option<(f64, f64, Vec<(f64
         return None;
     }
     let n = points.len() as f64;
-    let intercept = points.iter().map(|p| p.1.ln() - rate * p.0.ln()).sum::<f64>() / n;
-    let (lo, hi) = points
+    let intercept = points
         .iter()
-        .fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.0), b.max(p.0)));
+        .map(|p| p.1.ln() - rate * p.0.ln())
+        .sum::<f64>()
+        / n;
+    let (lo, hi) = points.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| {
+        (a.min(p.0), b.max(p.0))
+    });
     let at = |h: f64| (h, (intercept + rate * h.ln()).exp());
     Some((rate, r.stderr.unwrap_or(0.0), vec![at(lo), at(hi)]))
 }

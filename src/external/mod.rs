@@ -4,9 +4,9 @@
 //! integrals and rate verdicts as the studies, beside this project's two cones.
 
 pub mod export;
+pub mod grade;
+pub mod grade_report;
+pub mod mesh_in;
 pub mod msh_write;
 pub mod problem;
 mod readme;
-pub mod grade;
-pub mod mesh_in;
-pub mod grade_report;
