@@ -115,7 +115,7 @@ One file per level L in the solutions folder, any of:
 - `level_L.pvd`: a ParaView collection of `.vtu` files, one per step, whose `timestep`s are the
   t_n of `problem.toml` (to 1e-9 T);
 - `level_L.msh`: gmsh MSH (ASCII 4.1 or 2.2) with the bodies as physical surfaces named as in
-  `mesh_L.msh`, and `$NodeData`/`$ElementData` views named as the fields below, one per step
+  `mesh_L.msh` (or, without `$PhysicalNames`, with physical tags 1 and 2), and `$NodeData`/`$ElementData` views named as the fields below, one per step
   (the view's time is its real tag).
 
 Fields (other names with `--displacement`, `--stress`, `--pressure`), in the scene's units:

@@ -2364,7 +2364,8 @@ fn read_view(c: &mut Cursor, per_element: bool, names: &FieldNames) -> Result<Op
 }
 
 /// Read a solution in gmsh's ASCII MSH format (4.1 or 2.2): the triangles of the physical
-/// surfaces named `bodies[0]` (body 1) and `bodies[1]` (body 2), the nodes they use, and
+/// surfaces named `bodies[0]` (body 1) and `bodies[1]` (body 2) (in a file without
+/// `$PhysicalNames`, physical tags 1 and 2, as in the exported mesh), the nodes they use, and
 /// per time step the views named by `names`: `$NodeData` displacement (2 or 3
 /// components), optional `$ElementData` stress (3, 4 or 9 components, as for a .vtu),
 /// optional `$NodeData` pressure (1 component). A step's time is its views' first real
@@ -2421,6 +2422,8 @@ pub fn parse_msh_solution(
             .collect();
         body_tags[k] = match tags[..] {
             [t] => t,
+            // Without names, the physical tags of the exported mesh: 1 and 2.
+            [] if surfaces.is_empty() => k as i64 + 1,
             [] => {
                 return Err(Error::input(
                     path,
