@@ -95,7 +95,8 @@ struct GradeArgs {
     #[arg(long, default_value = "graded")]
     name: String,
     /// Exit non-zero when the graded code's theorem-norm rate (l2_stress where the exact
-    /// solution gives no displacement) is below R, or when no rate can be fitted.
+    /// solution gives no displacement) is below R, or when its errors support no rate
+    /// (only a fitted or drifting rate counts).
     #[arg(long, value_name = "R")]
     threshold: Option<f64>,
     /// Report folder (default: reports/grade-NAME).

@@ -62,12 +62,22 @@ fn write_vtu(path: &Path, s: &Solution) {
 
 /// A solve's steps t_1..t_N as `dir/level_L.pvd` with one .vtu per step.
 fn write_series(dir: &Path, level: usize, case: &Case, sol: &Solved) {
+    write_series_scaled(dir, level, case, sol, 1.0)
+}
+
+/// [`write_series`] with every stress scaled by `factor`.
+fn write_series_scaled(dir: &Path, level: usize, case: &Case, sol: &Solved, factor: f64) {
     let mut pvd = String::from(
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n",
     );
     for (n, s) in sol.states.iter().enumerate().skip(1) {
         let name = format!("level_{level}_step_{n}.vtu");
-        write_vtu(&dir.join(&name), &outside(case, s, &s.u));
+        let mut written = outside(case, s, &s.u);
+        written
+            .stress
+            .iter_mut()
+            .for_each(|v| v.iter_mut().for_each(|c| *c *= factor));
+        write_vtu(&dir.join(&name), &written);
         pvd.push_str(&format!(
             "<DataSet timestep=\"{:e}\" file=\"{name}\"/>\n",
             s.time
@@ -279,6 +289,48 @@ fn bad_solution_folders_are_refused_with_the_file_and_the_field() {
         msg.contains(&file.display().to_string()) && msg.contains("does not cover"),
         "{msg}"
     );
+    // The bodies glued at the ends of Gamma_C: body 2's corner points replaced by body 1's.
+    let dir = tempfile::tempdir().unwrap();
+    let mut glued = good.clone();
+    for t in 0..glued.triangles.len() {
+        if glued.body[t] == 2 {
+            for k in 0..3 {
+                let p = glued.triangles[t][k];
+                if let Some(q) = (0..glued.points.len()).find(|&q| {
+                    q != p
+                        && glued.points[q] == glued.points[p]
+                        && glued
+                            .triangles
+                            .iter()
+                            .zip(&glued.body)
+                            .any(|(tri, b)| *b == 1 && tri.contains(&q))
+                }) {
+                    glued.triangles[t][k] = q;
+                }
+            }
+        }
+    }
+    assert_ne!(glued.triangles, good.triangles);
+    write_vtu(&dir.path().join("level_0.vtu"), &glued);
+    let msg = refused(request(scene(), dir.path(), false));
+    assert!(msg.contains("belongs to triangles of both bodies"), "{msg}");
+    // A triangle without area.
+    let dir = tempfile::tempdir().unwrap();
+    let mut flat = good.clone();
+    let [a, b, c] = flat.triangles[3];
+    let (pa, pb) = (flat.points[a], flat.points[b]);
+    flat.points[c] = [(pa[0] + pb[0]) / 2.0, (pa[1] + pb[1]) / 2.0];
+    write_vtu(&dir.path().join("level_0.vtu"), &flat);
+    let msg = refused(request(scene(), dir.path(), false));
+    assert!(msg.contains("has no area"), "{msg}");
+    // The state at T for one level, a series for another.
+    let dir = tempfile::tempdir().unwrap();
+    write_vtu(&dir.path().join("level_0.vtu"), &good);
+    let case1 = common::case("contact-mms", 1, Method::Mortar, &[]);
+    let (sol1, _) = solve_case(&case1, SolverKind::Newton, 4).unwrap();
+    write_series(dir.path(), 1, &case1, &sol1);
+    let msg = refused(request(scene(), dir.path(), false));
+    assert!(msg.contains("the same way"), "{msg}");
     // Times that are not the problem's steps.
     let dir = tempfile::tempdir().unwrap();
     write_series(dir.path(), 0, &case, &sol);
@@ -304,16 +356,15 @@ fn bad_solution_folders_are_refused_with_the_file_and_the_field() {
 
 #[test]
 fn the_threshold_is_met_and_missed() {
-    let case0 = common::case("contact-mms", 0, Method::Mortar, &[]);
-    let dir = tempfile::tempdir().unwrap();
+    let (dir, skewed) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
     for level in 0..=2 {
-        let case = if level == 0 {
-            case0.clone()
-        } else {
-            common::case("contact-mms", level, Method::Mortar, &[])
-        };
+        let case = common::case("contact-mms", level, Method::Mortar, &[]);
         let (sol, _) = solve_case(&case, SolverKind::Newton, 4).unwrap();
         write_series(dir.path(), level, &case, &sol);
+        // The finest level's stress 6% off: successive rates 0.93 and 0.57, no window of
+        // agreeing rates (pre-asymptotic), so no rate to meet a threshold with.
+        let factor = if level == 2 { 1.06 } else { 1.0 };
+        write_series_scaled(skewed.path(), level, &case, &sol, factor);
     }
     let mut req = request(Source::Scene("contact-mms".into()), dir.path(), false);
     req.threshold = Some(0.7);
@@ -324,6 +375,26 @@ fn the_threshold_is_met_and_missed() {
     assert_eq!(g.failures.len(), 1, "{:?}", g.failures);
     assert!(
         g.failures[0].contains("below the threshold 1.5"),
+        "{:?}",
+        g.failures
+    );
+    let mut req = request(Source::Scene("contact-mms".into()), skewed.path(), false);
+    req.threshold = Some(0.7);
+    let g = grade(&req).unwrap();
+    let theorem = g
+        .rates
+        .iter()
+        .find(|r| r.method.name() == "outside" && r.quantity == Quantity::Theorem)
+        .unwrap();
+    println!(
+        "skewed: rate {:?}, {}, successive {}",
+        theorem.rate,
+        theorem.verdict.name(),
+        theorem.successive
+    );
+    assert_eq!(g.failures.len(), 1, "{:?}", g.failures);
+    assert!(
+        g.failures[0].contains("support no rate"),
         "{:?}",
         g.failures
     );

@@ -11,7 +11,7 @@ use crate::solve::SolverKind;
 use crate::verify::field::P1History;
 use crate::verify::jobs::{self, Job};
 use crate::verify::quantity::Quantity;
-use crate::verify::rates::{self, LevelError, MIN_FIT_LEVELS};
+use crate::verify::rates::{self, LevelError, MIN_FIT_LEVELS, Verdict};
 use crate::verify::study_file::{LoadedStudy, needs};
 use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord};
 use crate::verify::truth::Truth;
@@ -149,6 +149,20 @@ fn level_files(
             ));
         }
         out.retain(|l, _| wanted.contains(l));
+    }
+    let at_t: Vec<usize> = out
+        .iter()
+        .filter(|(_, f)| f.0 == Storage::Vtu)
+        .map(|(l, _)| *l)
+        .collect();
+    if !at_t.is_empty() && at_t.len() < out.len() {
+        return Err(Error::input(
+            dir,
+            format!("level_{}", at_t[0]),
+            format!(
+                "levels {at_t:?} give the state at T alone (.vtu), the others a series: their errors would be different norms (at T, or the maximum over the steps); give every level the same way"
+            ),
+        ));
     }
     if out.is_empty() {
         return Err(Error::input(
@@ -595,11 +609,15 @@ fn judge_all(
             let a = rates::judge(&levels, 0.0, quantity, resultant_fixed)
                 .map_err(|e| Error::input(dir, "levels", format!("{method} {quantity}: {e}")))?;
             let required = threshold.filter(|_| method == label && quantity == key);
-            let pass = required
-                .map(|r| a.used.len() >= MIN_FIT_LEVELS && a.fit.is_some_and(|f| f.rate >= r));
+            // Only a rate the rules support (fitted, or drifting) can meet a threshold: a
+            // pre-asymptotic fit is flagged, not a rate.
+            let supported = matches!(a.verdict, Verdict::Fitted | Verdict::Drifting);
+            let pass = required.map(|r| {
+                supported && a.used.len() >= MIN_FIT_LEVELS && a.fit.is_some_and(|f| f.rate >= r)
+            });
             if pass == Some(false) {
                 failures.push(match a.fit {
-                    Some(f) if a.used.len() >= MIN_FIT_LEVELS => format!(
+                    Some(f) if supported && a.used.len() >= MIN_FIT_LEVELS => format!(
                         "{method}'s {quantity} rate {:.3} is below the threshold {}",
                         f.rate,
                         required.unwrap_or(0.0)

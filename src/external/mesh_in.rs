@@ -102,6 +102,8 @@ impl OutsideModel {
         file: &Path,
     ) -> Result<Self> {
         let size = diameter(&mesh.points);
+        check_bodies_apart(mesh, file)?;
+        check_triangles(mesh, file)?;
         check_areas(scene, mesh, reference, file)?;
         // Straight boundaries match to round-off; a coarse tolerance would let an edge of a
         // wrong boundary through.
@@ -224,6 +226,54 @@ impl OutsideModel {
         P1Field::from_nodal(model, &self.interface, time, u, stress, pressure)
             .map_err(|e| Error::input(file, "stress", e.to_string()))
     }
+}
+
+/// The two bodies share no point: a point of both (a writer that merged coincident points)
+/// glues them there and changes every error.
+fn check_bodies_apart(mesh: &SolutionMesh, file: &Path) -> Result<()> {
+    let mut body_of = vec![0u8; mesh.points.len()];
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for &p in tri {
+            let b = mesh.body[t];
+            if body_of[p] != 0 && body_of[p] != b {
+                let x = mesh.points[p];
+                return Err(Error::input(
+                    file,
+                    "Cells",
+                    format!(
+                        "point {p} at ({}, {}) belongs to triangles of both bodies, which glues them there; write each body with points of its own (do not merge coincident points where the bodies touch)",
+                        x[0], x[1]
+                    ),
+                ));
+            }
+            body_of[p] = b;
+        }
+    }
+    Ok(())
+}
+
+/// No triangle is degenerate (area at round-off of its longest edge squared), the
+/// criterion of the scene's own meshes.
+fn check_triangles(mesh: &SolutionMesh, file: &Path) -> Result<()> {
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        let [p, q, r] = tri.map(|i| mesh.points[i]);
+        let edge2 = [(p, q), (q, r), (r, p)]
+            .iter()
+            .map(|(a, b)| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2))
+            .fold(0.0f64, f64::max);
+        let area = crate::mesh::signed_area(p, q, r).abs();
+        if area <= mesh.precision.tolerance(1.0).max(1e-14) * edge2.max(f64::MIN_POSITIVE) {
+            return Err(Error::input(
+                file,
+                "Cells",
+                format!(
+                    "triangle {t} with corners ({}, {}), ({}, {}), ({}, {}) has no area: remove it, or fix its points",
+                    p[0], p[1], q[0], q[1], r[0], r[1]
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// An error about the scene's mesh, restated as one about the solution file's.
