@@ -248,8 +248,9 @@ fn quantities(family: &Family, study: Option<&LoadedStudy>, pressure: bool) -> V
             .filter(|q| needs(*q).iter().all(|f| exact.gives(*f)))
             .collect(),
     };
+    // A distance between the cones is not a property of one solution.
     all.into_iter()
-        .filter(|q| pressure || !is_pressure(*q))
+        .filter(|q| !q.is_distance() && (pressure || !is_pressure(*q)))
         .collect()
 }
 
@@ -353,10 +354,13 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
     }
     let compared = req.compare;
     if compared {
-        let cone_quantities = match &study {
+        let cone_quantities: Vec<Quantity> = match &study {
             Some(s) => s.file.quantities.clone(),
             None => self::quantities(&family, None, true),
-        };
+        }
+        .into_iter()
+        .filter(|q| !q.is_distance())
+        .collect();
         let jobs: Vec<(Method, usize)> = [Method::Mortar, Method::Nts]
             .into_iter()
             .flat_map(|m| levels.iter().map(move |l| (m, l.level)))

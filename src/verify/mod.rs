@@ -6,6 +6,7 @@
 //! study kind is ([`kind`]). Nothing here knows any particular kind.
 
 pub mod contact_error;
+pub mod distance;
 pub mod exact_error;
 pub mod field;
 pub mod intersect;

@@ -52,11 +52,37 @@ pub enum Quantity {
     /// max_n ||[u.nu]^+||_L2(Gamma_C), relative to |Gamma_C|^(1/2) max |u_ref|.
     #[serde(rename = "l2_penetration")]
     L2Penetration,
+    /// Proposition 3.1's consistency term max_n |int_Gamma_C sigma_nu [u_h.nu]|^(1/2), with
+    /// the exact sigma_nu, relative to the truth's theorem norm: the part of the error the
+    /// discrete contact condition adds (it vanishes for a cone inside the continuous one).
+    #[serde(rename = "consistency")]
+    Consistency,
+    /// The distance between the two cones' solutions on the same meshes, D = max_n
+    /// (||u^I - u^pi||_H1 + ||sigma^I - sigma^pi||_L2), relative to the truth's theorem norm:
+    /// D - e_mortar <= e_nts <= D + e_mortar, so D falling like h^(1/2) while e_mortar
+    /// falls like h shows an h^(1/2) part in nts's error. Listed under nts.
+    #[serde(rename = "cone_distance")]
+    ConeDistance,
+    /// D in ||.||_H1 of the displacement, relative as h1_u.
+    #[serde(rename = "cone_distance_h1_u")]
+    ConeDistanceH1U,
+    /// D in ||.||_L2 of the stress, relative as l2_stress.
+    #[serde(rename = "cone_distance_l2_stress")]
+    ConeDistanceL2Stress,
+    /// D in the stress over the triangles touching Gamma_C, relative as band_stress.
+    #[serde(rename = "cone_distance_band_stress")]
+    ConeDistanceBandStress,
+    /// D in the pressure, L2(Gamma_C), relative as l2_pressure.
+    #[serde(rename = "cone_distance_l2_pressure")]
+    ConeDistanceL2Pressure,
+    /// D in the normal jump [u.nu], L2(Gamma_C), relative as l2_penetration.
+    #[serde(rename = "cone_distance_normal_jump")]
+    ConeDistanceNormalJump,
 }
 
 impl Quantity {
     /// Every quantity, in the order reports list them.
-    pub const ALL: [Quantity; 12] = [
+    pub const ALL: [Quantity; 19] = [
         Quantity::Theorem,
         Quantity::H1U,
         Quantity::L2U,
@@ -69,7 +95,30 @@ impl Quantity {
         Quantity::PressureWeighted,
         Quantity::PressureOscillation,
         Quantity::L2Penetration,
+        Quantity::Consistency,
+        Quantity::ConeDistance,
+        Quantity::ConeDistanceH1U,
+        Quantity::ConeDistanceL2Stress,
+        Quantity::ConeDistanceBandStress,
+        Quantity::ConeDistanceL2Pressure,
+        Quantity::ConeDistanceNormalJump,
     ];
+
+    /// The distances between the two cones (measured between two solutions, not against
+    /// the truth).
+    pub const DISTANCES: [Quantity; 6] = [
+        Quantity::ConeDistance,
+        Quantity::ConeDistanceH1U,
+        Quantity::ConeDistanceL2Stress,
+        Quantity::ConeDistanceBandStress,
+        Quantity::ConeDistanceL2Pressure,
+        Quantity::ConeDistanceNormalJump,
+    ];
+
+    /// Whether it is a distance between the two cones.
+    pub fn is_distance(self) -> bool {
+        Self::DISTANCES.contains(&self)
+    }
 
     /// The quantities measured on Gamma_C and next to it, where the cones differ.
     pub const CONTACT: [Quantity; 8] = [
@@ -103,6 +152,13 @@ impl Quantity {
             Quantity::PressureWeighted => "pressure_weighted",
             Quantity::PressureOscillation => "pressure_oscillation",
             Quantity::L2Penetration => "l2_penetration",
+            Quantity::Consistency => "consistency",
+            Quantity::ConeDistance => "cone_distance",
+            Quantity::ConeDistanceH1U => "cone_distance_h1_u",
+            Quantity::ConeDistanceL2Stress => "cone_distance_l2_stress",
+            Quantity::ConeDistanceBandStress => "cone_distance_band_stress",
+            Quantity::ConeDistanceL2Pressure => "cone_distance_l2_pressure",
+            Quantity::ConeDistanceNormalJump => "cone_distance_normal_jump",
         }
     }
 }
@@ -124,6 +180,22 @@ impl std::fmt::Display for Quantity {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.pad(self.name())
     }
+}
+
+/// The truth's sizes that relative errors divide by, each the max over the steps t_1..t_N:
+/// what a distance between two solutions is made relative to, as their errors are.
+#[derive(Debug, Clone, Copy)]
+pub struct Scale {
+    /// ||u||_H1 + ||sigma||_L2.
+    pub theorem: f64,
+    /// ||u||_H1.
+    pub h1: f64,
+    /// ||sigma||_L2.
+    pub stress: f64,
+    /// ||p||_L2(Gamma_C), where the solution gives a pressure.
+    pub pressure: Option<f64>,
+    /// |Gamma_C|^(1/2) max |u| (the normal jump's scale).
+    pub jump: f64,
 }
 
 /// The differences of one solution to the reference, per time step t_1..t_N.
@@ -148,6 +220,21 @@ pub struct Differences<'a> {
 }
 
 impl Differences<'_> {
+    /// The truth's sizes the relative errors divide by.
+    pub fn scale(&self) -> Scale {
+        let max_over =
+            |f: &dyn Fn(&SquaredNorms) -> f64| self.reference.iter().map(f).fold(0.0f64, f64::max);
+        Scale {
+            theorem: max_over(&|n| n.theorem()),
+            h1: max_over(&|n| n.h1()),
+            stress: max_over(&|n| n.stress.sqrt()),
+            pressure: self
+                .pressure
+                .map(|p| p.iter().map(|p| p.1.sqrt()).fold(0.0f64, f64::max)),
+            jump: self.contact_length.sqrt() * self.reference_displacement,
+        }
+    }
+
     /// Every quantity's relative error (max over the steps, relative to the reference's
     /// max over the steps); the pressure quantities only when the solution gives a pressure.
     pub fn relative(&self) -> BTreeMap<Quantity, f64> {

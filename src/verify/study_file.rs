@@ -283,6 +283,25 @@ impl StudyFile {
                 "steps must be at least 1 (the time step k must be positive)".into(),
             );
         }
+        let both = [Method::Mortar, Method::Nts]
+            .iter()
+            .all(|m| self.methods.contains(m));
+        if let Some(q) = self.quantities.iter().find(|q| q.is_distance() && !both) {
+            return bad(
+                path,
+                "quantities",
+                format!(
+                    "'{q}' is the distance between the two cones' solutions: list both methods (methods = [\"mortar\", \"nts\"]) or leave it out"
+                ),
+            );
+        }
+        if self.quantities.contains(&Quantity::Consistency) && !self.reference.exact {
+            return bad(
+                path,
+                "quantities",
+                "'consistency' takes the exact sigma_nu: measure against the exact solution (reference.exact = true) or leave it out".into(),
+            );
+        }
         Ok(())
     }
 }
@@ -613,6 +632,12 @@ pub fn needs(q: Quantity) -> &'static [Field] {
         | Quantity::PressureWeighted
         | Quantity::PressureOscillation => &[Field::Pressure],
         Quantity::BandStress => &[Field::Stress],
+        // Relative to the truth's theorem norm.
+        Quantity::Consistency | Quantity::ConeDistance => &[Field::Displacement, Field::Stress],
+        Quantity::ConeDistanceH1U => &[Field::Displacement],
+        Quantity::ConeDistanceL2Stress | Quantity::ConeDistanceBandStress => &[Field::Stress],
+        Quantity::ConeDistanceL2Pressure => &[Field::Pressure],
+        Quantity::ConeDistanceNormalJump => &[],
     }
 }
 

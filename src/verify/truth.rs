@@ -4,6 +4,7 @@
 
 use crate::analytical::Exact;
 use crate::case::Case;
+use crate::contact::Interface;
 use crate::solve::{Solution, inf_norm};
 use crate::verify::contact_error::{
     self, ContactStep, TruthPressure, contact_step, reference_profile,
@@ -12,7 +13,7 @@ use crate::verify::exact_error::{ExactComparison, ExactDifference};
 use crate::verify::field::{P1Field, P1History};
 use crate::verify::jobs::{JobId, Solved};
 use crate::verify::norms::{self, Comparison, SquaredNorms};
-use crate::verify::quantity::{Differences, Quantity};
+use crate::verify::quantity::{Differences, Quantity, Scale};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 
@@ -95,12 +96,14 @@ pub fn reference(ids: [JobId; 3], solved: &mut Solved, level: usize) -> Referenc
     let d1 = relative_errors(
         &P1History::of_solution(&coarser1.0, &coarser1.1),
         &reference,
-    );
+    )
+    .0;
     let d2 = relative_errors(
         &P1History::of_solution(&coarser2.0, &coarser2.1),
         &reference,
-    );
-    for q in Quantity::ALL {
+    )
+    .0;
+    for q in d1.keys().copied().collect::<Vec<_>>() {
         let (error, rate) = estimated_reference_error(d1[&q], d2[&q]);
         if q == Quantity::Theorem {
             (reference.facts.error, reference.facts.error_rate) = (error, rate);
@@ -129,10 +132,20 @@ impl Truth<'_> {
     /// Every quantity's relative error of a discrete solution, whoever computed it (the
     /// pressure quantities only when it gives a pressure).
     pub fn errors(&self, history: &P1History) -> BTreeMap<Quantity, f64> {
+        self.measure(history).0
+    }
+
+    /// [`Truth::errors`] with the truth's sizes they are relative to.
+    pub fn measure(&self, history: &P1History) -> (BTreeMap<Quantity, f64>, Scale) {
         match self {
             Truth::Solved(reference) => relative_errors(history, reference),
             Truth::Exact(exact, points) => exact_errors(history, exact, *points),
         }
+    }
+
+    /// [`Truth::measure`] of one solved level.
+    pub fn measure_solved(&self, case: &Case, sol: &Solution) -> (BTreeMap<Quantity, f64>, Scale) {
+        self.measure(&P1History::of_solution(case, sol))
     }
 
     /// The estimated error of the truth in the theorem norm (0 for the exact solution).
@@ -150,7 +163,11 @@ impl Truth<'_> {
 }
 
 /// Every quantity's relative error of a discrete solution against the exact solution.
-pub fn exact_errors(history: &P1History, exact: &Exact, points: usize) -> BTreeMap<Quantity, f64> {
+pub fn exact_errors(
+    history: &P1History,
+    exact: &Exact,
+    points: usize,
+) -> (BTreeMap<Quantity, f64>, Scale) {
     let (model, interface) = (history.model, history.interface);
     let cmp = ExactComparison::new(exact, points);
     // Steps are independent: measured in parallel, in step order (the same bits).
@@ -168,7 +185,7 @@ pub fn exact_errors(history: &P1History, exact: &Exact, points: usize) -> BTreeM
         .par_iter()
         .map(|s| contact_step(interface, s, &TruthPressure::Exact(exact, s.time)))
         .collect();
-    Differences {
+    let differences = Differences {
         fields: &fields,
         reference: &reference,
         pressure: pressure.as_deref(),
@@ -184,8 +201,22 @@ pub fn exact_errors(history: &P1History, exact: &Exact, points: usize) -> BTreeM
         contact: &contact,
         band_stress: &band_stress,
         contact_length: interface.length(),
+    };
+    let (mut errors, scale) = (differences.relative(), differences.scale());
+    if exact.stress.is_some() {
+        let term = history
+            .steps
+            .par_iter()
+            .map(|s| consistency_term(interface, s, exact))
+            .collect::<Vec<f64>>()
+            .into_iter()
+            .fold(0.0f64, f64::max);
+        errors.insert(
+            Quantity::Consistency,
+            term / scale.theorem.max(f64::MIN_POSITIVE),
+        );
     }
-    .relative()
+    (errors, scale)
 }
 
 /// The largest interpenetration over a solution's history (length).
@@ -198,11 +229,12 @@ pub fn history_penetration(history: &P1History) -> f64 {
         .fold(0.0f64, f64::max)
 }
 
-/// Every quantity's relative error of a discrete solution against the reference.
+/// Every quantity's relative error of a discrete solution against the reference, with the
+/// reference's sizes.
 pub fn relative_errors(
     history: &P1History,
     reference: &ReferenceSolution,
-) -> BTreeMap<Quantity, f64> {
+) -> (BTreeMap<Quantity, f64>, Scale) {
     let (model, interface) = (history.model, history.interface);
     let rproblem = &reference.case.problem;
     let (rmodel, rinterface) = (&rproblem.model, &rproblem.interface);
@@ -229,7 +261,7 @@ pub fn relative_errors(
             contact_step(interface, s, &truth)
         })
         .collect();
-    Differences {
+    let differences = Differences {
         fields: &fields,
         reference: &reference.norms,
         pressure: pressure.as_deref(),
@@ -238,8 +270,54 @@ pub fn relative_errors(
         contact: &contact,
         band_stress: &band_stress,
         contact_length: interface.length(),
+    };
+    (differences.relative(), differences.scale())
+}
+
+/// |int_Gamma_C sigma_nu [u_h.nu]|^(1/2) at one step, sigma_nu = nu^1 . sigma nu^1 of the
+/// exact slave stress (zero where the bodies separate) and [u_h.nu] linear between the merged
+/// trace nodes of both bodies: 8 Gauss points per stretch between breakpoints (the traces'
+/// nodes and the exact fields' kinks).
+pub fn consistency_term(interface: &Interface, s: &P1Field, exact: &Exact) -> f64 {
+    let gauss = crate::quadrature::gauss_legendre(8);
+    let jumps = crate::contact::normal_jumps(interface, &s.u);
+    let kinks = crate::expr::kink_functions(&exact.contact_kinks(), s.time);
+    let mut total = 0.0;
+    for (pi, piece) in interface.pieces.iter().enumerate() {
+        let mut f: Vec<(f64, f64)> = jumps
+            .iter()
+            .filter(|j| j.0 == pi)
+            .map(|j| (j.1, j.2))
+            .collect();
+        f.sort_by(|a, b| a.0.total_cmp(&b.0));
+        f.dedup_by(|a, b| (a.0 - b.0).abs() <= 1e-14 * piece.length);
+        let mut breaks: Vec<f64> = f.iter().map(|p| p.0).collect();
+        let (a, b) = (piece.point(0.0), piece.point(piece.length));
+        breaks.extend(
+            crate::quadrature::segment_breaks(a, b, &kinks)
+                .into_iter()
+                .map(|r| r * piece.length),
+        );
+        breaks.sort_by(f64::total_cmp);
+        breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-14 * piece.length);
+        let n = piece.normal;
+        for w in breaks.windows(2) {
+            let len = w[1] - w[0];
+            if len <= 0.0 {
+                continue;
+            }
+            for &(q, wq) in &gauss {
+                let sq = w[0] + q * len;
+                let x = piece.point(sq);
+                let Some(st) = exact.stress_at(0, x[0], x[1], s.time) else {
+                    continue;
+                };
+                let snn = n[0] * n[0] * st[0] + 2.0 * n[0] * n[1] * st[2] + n[1] * n[1] * st[1];
+                total += wq * len * snn * super::norms::eval_pl(&f, sq);
+            }
+        }
     }
-    .relative()
+    total.abs().sqrt()
 }
 
 /// A reference solve's pressure (this project's solver always gives one).

@@ -47,7 +47,10 @@ use crate::verify::exact_error::{
 };
 use crate::verify::jobs::{self, Job, JobId, Mode, Solved};
 use crate::verify::field::{P1Field, pressure_profile};
+use crate::verify::distance::cone_distance;
+use crate::verify::field::P1History;
 use crate::verify::norms;
+use crate::verify::quantity::Scale;
 use crate::verify::quantity::Quantity;
 use crate::verify::rates::{self, Assessment, LevelError};
 use crate::verify::study_file::{LoadedStudy, StudyFile, Threshold, provenance};
@@ -490,10 +493,11 @@ fn measure_levels(
             (method, level, case, sol)
         })
         .collect();
-    let all_errors: Vec<BTreeMap<Quantity, f64>> = runs
+    let measured: Vec<(BTreeMap<Quantity, f64>, Scale)> = runs
         .par_iter()
-        .map(|(_, _, case, sol)| truth.relative_errors(case, sol))
+        .map(|(_, _, case, sol)| truth.measure_solved(case, sol))
         .collect();
+    let all_errors: Vec<&BTreeMap<Quantity, f64>> = measured.iter().map(|m| &m.0).collect();
     let mut out = Measured::default();
     if let Some((_, _, case, _)) = runs.first() {
         out.mesh = Some(case.mesh.clone());
@@ -526,10 +530,13 @@ fn measure_levels(
             0.1 / umax.max(f64::MIN_POSITIVE)
         }
     };
-    for ((method, level, case, sol), errors) in runs.iter().zip(&all_errors) {
+    for ((method, level, case, sol), errors) in runs.iter().zip(all_errors) {
         let (method, level) = (*method, *level);
         out.errors
             .extend(error_rows(sf, method, case, sol, errors)?);
+        if method == Method::Nts {
+            out.errors.extend(distance_rows(sf, &runs, level, &measured)?);
+        }
         let flagged = errors[&Quantity::Theorem] < 5.0 * truth.error();
         out.levels.push(level_info(case, sol, method, flagged));
         if level == profile_level {
@@ -539,6 +546,55 @@ fn measure_levels(
         }
     }
     Ok(out)
+}
+
+/// The rows of errors.csv of the cone distance on `level` (listed under nts), where the
+/// study measures it: both cones' solutions on that level's mesh, relative to the truth's
+/// sizes there.
+fn distance_rows(
+    sf: &StudyFile,
+    runs: &[(Method, usize, Case, Solution)],
+    level: usize,
+    measured: &[(BTreeMap<Quantity, f64>, Scale)],
+) -> Result<Vec<ErrorRecord>> {
+    let wanted: Vec<Quantity> = sf.quantities.iter().copied().filter(|q| q.is_distance()).collect();
+    let find = |m: Method| runs.iter().position(|r| r.0 == m && r.1 == level);
+    let (Some(a), Some(b)) = (find(Method::Mortar), find(Method::Nts)) else {
+        return Ok(Vec::new());
+    };
+    if wanted.is_empty() {
+        return Ok(Vec::new());
+    }
+    let (ca, sa) = (&runs[a].2, &runs[a].3);
+    let (cb, sb) = (&runs[b].2, &runs[b].3);
+    let d = cone_distance(
+        &P1History::of_solution(ca, sa),
+        &P1History::of_solution(cb, sb),
+        &measured[b].1,
+    );
+    wanted
+        .into_iter()
+        .filter(|q| d.contains_key(q))
+        .map(|quantity| {
+            let error = d[&quantity];
+            if !error.is_finite() {
+                return Err(Error::NotConverged(format!(
+                    "level {level}: the {quantity} is not finite"
+                )));
+            }
+            Ok(ErrorRecord {
+                method: Method::Nts.into(),
+                level,
+                h: cb.h,
+                dofs: cb.problem.model.n_free,
+                steps: sf.steps,
+                quantity,
+                error,
+                wall_s: None,
+                parameter: None,
+            })
+        })
+        .collect()
 }
 
 /// The rows of errors.csv of one solved level: the study's quantities, each finite.
@@ -551,6 +607,7 @@ fn error_rows(
 ) -> Result<Vec<ErrorRecord>> {
     sf.quantities
         .iter()
+        .filter(|q| !q.is_distance())
         .map(|&quantity| {
             let error = errors[&quantity];
             if !error.is_finite() {
@@ -730,6 +787,10 @@ fn fit_rates(
                 .iter()
                 .filter(|r| r.method == method && r.quantity == quantity)
                 .collect();
+            // A distance between the cones is listed under nts only.
+            if rows.is_empty() && quantity.is_distance() {
+                continue;
+            }
             let levels: Vec<LevelError> = rows
                 .iter()
                 .map(|r| LevelError {
