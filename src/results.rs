@@ -181,10 +181,36 @@ impl Report {
     }
 
     /// The rows whose errors stop decreasing.
+    /// The errors that stop decreasing (a distance between the cones is no error: it is
+    /// reported with the distance).
     fn stalled(&self) -> impl Iterator<Item = &RateRecord> {
         self.rates
             .iter()
-            .filter(|r| r.verdict == Verdict::NotConverging)
+            .filter(|r| r.verdict == Verdict::NotConverging && !r.quantity.is_distance())
+    }
+
+    /// The distance between the cones and the consistency terms, as a sentence; None where
+    /// the study does not measure it.
+    fn distance_text(&self) -> Option<String> {
+        let d = self.rate(Method::Nts, Quantity::ConeDistance)?;
+        let mut out = format!(
+            "the distance D between the cones' solutions (Theorem 3.1's norm) falls at {}",
+            rate_text(d)
+        );
+        let consistency: Vec<String> = CONES
+            .iter()
+            .filter_map(|&m| {
+                self.rate(m, Quantity::Consistency)
+                    .map(|r| format!("{m} {}", rate_text(r)))
+            })
+            .collect();
+        if !consistency.is_empty() {
+            out.push_str(&format!(
+                "; Proposition 3.1's consistency term: {}",
+                consistency.join("; ")
+            ));
+        }
+        Some(out)
     }
 }
 
@@ -306,6 +332,9 @@ fn study_section(doc: &mut Doc, dir: &Path, name: &str, what: &str) -> Result<()
         listed(&near_half(&report), "; ", "no quantity")
     ));
     separation_bullets(doc, &report);
+    if let Some(text) = report.distance_text() {
+        doc.bullet(format!("Between the cones: {text}."));
+    }
     doc.bullet(format!(
         "Does not converge: {}.",
         listed(&stalled_texts(&report), "; ", "nothing")
@@ -465,6 +494,24 @@ pub fn headline(reports: &Path) -> Result<String> {
         "**Theorem 3.1's norm**, fitted rates in h: {}.",
         theorem.join("; ")
     ));
+    let distances: Vec<String> = studies
+        .iter()
+        .filter_map(|(name, _, report)| {
+            let d = report.rate(Method::Nts, Quantity::ConeDistance)?;
+            // Only a rate the rules support is printed here.
+            let text = match d.verdict {
+                Verdict::Fitted | Verdict::Drifting => rate_text(d),
+                v => format!("no rate yet ({})", v.name()),
+            };
+            Some(format!("{text} in `{name}`"))
+        })
+        .collect();
+    if !distances.is_empty() {
+        doc.bullet(format!(
+            "**nts's h^(1/2), measured:** the distance D between the two cones' solutions on the same meshes bounds nts's error from both sides (D - e_mortar <= e_nts <= D + e_mortar); it falls at {}, while mortar's error falls at about 1: nts's error holds a part that decays like h^(1/2), still too small to show in its own rate (each report predicts the level where it overtakes; [docs/results.md](docs/results.md)).",
+            distances.join(", ")
+        ));
+    }
     doc.bullet(format!(
         "**Does not converge:** {}.",
         listed(&stalled_anywhere(&studies), "; ", "nothing")

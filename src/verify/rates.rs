@@ -568,6 +568,32 @@ pub fn fit_power_sum(points: &[(f64, f64, f64)]) -> Option<PowerSumFit> {
     (fit.a.iter().chain(&fit.c).all(|v| v.is_finite())).then_some(fit)
 }
 
+impl Assessment {
+    /// The judged rate with its standard error, or the verdict that replaces it, as reports
+    /// write it.
+    pub fn describe(&self) -> String {
+        match (self.verdict, self.fit) {
+            (Verdict::Fitted, Some(f)) => format!("{:.3} ± {:.3}", f.rate, f.stderr),
+            (Verdict::Drifting, Some(f)) => format!(
+                "{:.3} ± {:.3} (drifting: {} over every level)",
+                f.rate,
+                f.stderr,
+                crate::io::fmt3(self.fit_all.map_or(f64::NAN, |f| f.rate))
+            ),
+            (Verdict::PreAsymptotic, Some(f)) => {
+                format!("{:.3} ± {:.3} (pre-asymptotic)", f.rate, f.stderr)
+            }
+            (Verdict::RoundOff, _) => format!("exact (round-off, <= {ROUNDOFF:.0e})"),
+            (Verdict::NotConverging, _) => "**does not converge**".into(),
+            (Verdict::TooFewLevels, _) => format!("no fit (< {MIN_FIT_LEVELS} levels)"),
+            (Verdict::FixedByEquilibrium, _) => {
+                "fixed by equilibrium: measures the load quadrature".into()
+            }
+            _ => "n/a".into(),
+        }
+    }
+}
+
 /// [`assess`] of one quantity; where equilibrium fixes the contact resultant
 /// (`resultant_fixed`) and the quantity is its error, that error measures the load
 /// quadrature, not the discretization: it is named so and never fitted.

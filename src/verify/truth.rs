@@ -153,9 +153,12 @@ impl Truth<'_> {
         self.quantity_error(Quantity::Theorem)
     }
 
-    /// The estimated error of the truth in quantity `q` (0 for the exact solution).
+    /// The estimated error of the truth in quantity `q` (0 for the exact solution, and for a
+    /// distance between the cones: two discrete solutions, which the truth's error does not
+    /// limit).
     pub fn quantity_error(&self, q: Quantity) -> f64 {
         match self {
+            Truth::Solved(_) if q.is_distance() => 0.0,
             Truth::Solved(r) => r.quantity_errors[&q],
             Truth::Exact(..) => 0.0,
         }

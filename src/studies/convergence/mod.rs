@@ -12,6 +12,7 @@
 //! 5. the rate in time on a fixed mesh;
 //! 6. the provenance.
 
+mod distance_report;
 pub mod report;
 
 use crate::verify::kind::{Found, Kind, Outcome};

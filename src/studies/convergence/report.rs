@@ -64,25 +64,7 @@ fn fmt_rate(r: &RateRow) -> String {
 
 /// A judged rate with its standard error, or the verdict that replaces it.
 fn fmt_assessment(a: &rates::Assessment) -> String {
-    match (a.verdict, a.fit) {
-        (Verdict::Fitted, Some(f)) => format!("{:.3} ± {:.3}", f.rate, f.stderr),
-        (Verdict::Drifting, Some(f)) => format!(
-            "{:.3} ± {:.3} (drifting: {} over every level)",
-            f.rate,
-            f.stderr,
-            fmt3(a.fit_all.map_or(f64::NAN, |f| f.rate))
-        ),
-        (Verdict::PreAsymptotic, Some(f)) => {
-            format!("{:.3} ± {:.3} (pre-asymptotic)", f.rate, f.stderr)
-        }
-        (Verdict::RoundOff, _) => format!("exact (round-off, <= {:.0e})", rates::ROUNDOFF),
-        (Verdict::NotConverging, _) => "**does not converge**".into(),
-        (Verdict::TooFewLevels, _) => format!("no fit (< {} levels)", rates::MIN_FIT_LEVELS),
-        (Verdict::FixedByEquilibrium, _) => {
-            "fixed by equilibrium: measures the load quadrature".into()
-        }
-        _ => "n/a".into(),
-    }
+    a.describe()
 }
 
 /// Celik's observed order of the last three levels, "(oscillatory)" where it oscillates.
@@ -133,6 +115,7 @@ pub fn write_study(res: &StudyResult, dir: &Path) -> Result<()> {
 
 fn plots(res: &StudyResult, d: &Path) -> Result<()> {
     error_vs_h(res, d)?;
+    super::distance_report::plot(res, d)?;
     contact_vs_h(res, d)?;
     error_vs_time(res, d)?;
     if let Some(ts) = &res.time_study {
@@ -396,6 +379,7 @@ fn readme(res: &StudyResult) -> String {
     let mut doc = Doc::new();
     title(&mut doc, res);
     cones_compared(&mut doc, res);
+    super::distance_report::section(&mut doc, res);
     doc.image("error against h", "error_vs_h.png");
     rates_table(&mut doc, res);
     errors_table(&mut doc, res);
@@ -503,7 +487,14 @@ fn quantities_compared(res: &StudyResult) -> (Vec<Quantity>, Vec<String>) {
             .iter()
             .all(|&m| rate_row(res, m, q).is_some_and(|r| r.assessment.verdict.compares_cones()))
     };
-    let quantities = &res.file.quantities;
+    // The distances between the cones have a section of their own.
+    let quantities: Vec<Quantity> = res
+        .file
+        .quantities
+        .iter()
+        .copied()
+        .filter(|q| !q.is_distance())
+        .collect();
     let ordered = quantities
         .iter()
         .filter(|q| q.is_contact())
