@@ -47,7 +47,7 @@ enum Command {
         merge: bool,
     },
     /// Print the Results page docs/results.md, read from the committed reports' CSVs
-    /// (reports/rates, rates-exact, rates-exact-vp, patch, two-size-exact, two-size-rates,
+    /// (reports/rates, rates-exact, rates-exact-vp, patch, crossover, two-size-exact, two-size-rates,
     /// speed, stability).
     Results {
         /// Print instead README.md's headline table (between its `headline` markers).
