@@ -51,7 +51,12 @@ fn an_elastic_solution_given_as_nodal_values_measures_as_the_solver_state() {
                 .collect(),
         };
         let given = truth.errors(&outside(true));
-        assert_eq!(given.len(), Quantity::ALL.len());
+        // Every quantity of one solution against the exact solution (a distance between the
+        // cones is not one).
+        assert_eq!(
+            given.len(),
+            Quantity::ALL.iter().filter(|q| !q.is_distance()).count()
+        );
         for (q, e) in &own {
             // The same integrals of the same P1 field; the stress C eps(u_h) recomputed from
             // u_h differs from the solver's by round-off.
@@ -63,7 +68,7 @@ fn an_elastic_solution_given_as_nodal_values_measures_as_the_solver_state() {
             );
         }
         let without = truth.errors(&outside(false));
-        for q in Quantity::ALL {
+        for q in Quantity::ALL.into_iter().filter(|q| !q.is_distance()) {
             let pressure_quantity = matches!(
                 q,
                 Quantity::L2Pressure

@@ -37,6 +37,9 @@ pub struct ExactDifference {
     pub max_displacement: f64,
     /// ||sigma - sigma_ex||^2 on the band of triangles touching Gamma_C.
     pub band_stress: f64,
+    /// int sigma : eps(u) of the exact solution over both bodies (its energy, stress x
+    /// area); 0 where the exact solution gives no displacement and stress.
+    pub energy: f64,
 }
 
 fn tensor_norm2(s: [f64; 3]) -> f64 {
@@ -85,7 +88,9 @@ impl<'a> ExactComparison<'a> {
                 let lam = [1.0 - l1 - l2, l1, l2];
                 let x = [0, 1].map(|c| (0..3).map(|a| lam[a] * pos[a][c]).sum::<f64>());
                 let w = w * el.area;
+                let mut grad_e = None;
                 if let (Some(u), Some(g)) = (&ex.displacement, &ex.gradient) {
+                    let mut ge_all = [[0.0; 2]; 2];
                     for c in 0..2 {
                         let ue = u[b][c].eval(x[0], x[1], t);
                         let uhc: f64 = (0..3).map(|a| lam[a] * uh[a][c]).sum();
@@ -95,10 +100,17 @@ impl<'a> ExactComparison<'a> {
                             let ge = g[b][c][d].eval(x[0], x[1], t);
                             out.difference.semi_u += w * (grad_h[c][d] - ge).powi(2);
                             out.exact.semi_u += w * ge * ge;
+                            ge_all[c][d] = ge;
                         }
                     }
+                    grad_e = Some(ge_all);
                 }
                 if let Some(se) = ex.stress_at(b, x[0], x[1], t) {
+                    if let Some(g) = grad_e {
+                        // sigma : eps(u) = s11 e11 + s22 e22 + 2 s12 e12.
+                        out.energy +=
+                            w * (se[0] * g[0][0] + se[1] * g[1][1] + se[2] * (g[0][1] + g[1][0]));
+                    }
                     let (d, n) = (
                         tensor_norm2([0, 1, 2].map(|k| sh[k] - se[k])),
                         tensor_norm2(se),

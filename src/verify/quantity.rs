@@ -53,7 +53,8 @@ pub enum Quantity {
     #[serde(rename = "l2_penetration")]
     L2Penetration,
     /// Proposition 3.1's consistency term max_n |int_Gamma_C sigma_nu [u_h.nu]|^(1/2), with
-    /// the exact sigma_nu, relative to the truth's theorem norm: the part of the error the
+    /// the exact sigma_nu, relative to the exact solution's energy norm (int sigma : eps(u))^(1/2)
+    /// (both are square roots of energies): the part of the error the
     /// discrete contact condition adds (it vanishes for a cone inside the continuous one).
     #[serde(rename = "consistency")]
     Consistency,

@@ -22,12 +22,11 @@ fn error(res: &StudyResult, m: Method, level: usize, q: Quantity) -> Option<f64>
         .map(|e| e.error)
 }
 
-/// The fit of a rate the rules support (fitted or drifting).
+/// The fit of a fitted rate (the rules' window of agreeing successive rates).
 fn supported_fit(row: Option<&RateRow>) -> Option<Fit> {
     let a = &row?.assessment;
-    matches!(a.verdict, Verdict::Fitted | Verdict::Drifting)
-        .then_some(a.fit)
-        .flatten()
+    // A drifting rate is still changing: no line to extrapolate.
+    (a.verdict == Verdict::Fitted).then_some(a.fit).flatten()
 }
 
 /// The section, where the study measures the cone distance in the theorem norm.
