@@ -32,29 +32,7 @@ fn crossover_scenes_are_the_scaled_closed_form() {
     for (name, epsilon) in [("crossover", 0.2), ("crossover-quick", 0.01)] {
         let closed = StackedBlocks::new(100.0, 0.3, 3.0, 10.0 * epsilon);
         let scene = Scene::load(name).unwrap();
-        let ex = scene.exact.as_deref().unwrap();
-        let mut worst = 0.0f64;
-        for b in 0..2 {
-            for i in 0..=10 {
-                for j in 0..=10 {
-                    let (x, y) = (i as f64 / 10.0, 1.0 - b as f64 + j as f64 / 10.0);
-                    let (u, s) = (
-                        closed.displacement(b, x, y, 1.0),
-                        closed.stress(b, x, y, 1.0),
-                    );
-                    let (ue, se) = (
-                        ex.displacement_at(b, x, y, 1.0).unwrap(),
-                        ex.stress_at(b, x, y, 1.0).unwrap(),
-                    );
-                    for c in 0..2 {
-                        worst = worst.max((u[c] - ue[c]).abs() / 0.05);
-                    }
-                    for k in 0..3 {
-                        worst = worst.max((s[k] - se[k]).abs() / 10.0);
-                    }
-                }
-            }
-        }
+        let worst = common::closed_form_difference(&closed, &scene);
         println!("{name}: largest difference scene / closed form {worst:.2e}");
         assert!(worst < 1e-12, "{name}: {worst}");
     }

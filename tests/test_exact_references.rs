@@ -102,28 +102,7 @@ fn stacked_exact_scene_is_the_closed_form() {
     let closed = StackedBlocks::scene();
     let scene = Scene::load("stacked-exact").unwrap();
     let ex = scene.exact.as_deref().unwrap();
-    let mut worst = 0.0f64;
-    for b in 0..2 {
-        for i in 0..=10 {
-            for j in 0..=10 {
-                let (x, y) = (i as f64 / 10.0, b as f64 * -1.0 + 1.0 + j as f64 / 10.0);
-                let (u, s) = (
-                    closed.displacement(b, x, y, 1.0),
-                    closed.stress(b, x, y, 1.0),
-                );
-                let (ue, se) = (
-                    ex.displacement_at(b, x, y, 1.0).unwrap(),
-                    ex.stress_at(b, x, y, 1.0).unwrap(),
-                );
-                for c in 0..2 {
-                    worst = worst.max((u[c] - ue[c]).abs() / 0.05);
-                }
-                for k in 0..3 {
-                    worst = worst.max((s[k] - se[k]).abs() / 10.0);
-                }
-            }
-        }
-    }
+    let worst = common::closed_form_difference(&closed, &scene);
     println!("largest difference scene / closed form: {worst:.2e} of the field's size");
     assert!(worst < 1e-12, "{worst}");
     // Its equilibrium: the body force of the closed form's stress vanishes.

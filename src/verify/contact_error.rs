@@ -304,16 +304,23 @@ pub fn penetration_l2(interface: &Interface, u: &[f64]) -> f64 {
     )
 }
 
+/// The normal jumps (piece, abscissa, jump) on piece `pi` as (abscissa, jump), sorted
+/// along the piece: the jump is linear between them.
+pub fn piece_jumps(jumps: &[(usize, f64, f64)], pi: usize) -> Vec<(f64, f64)> {
+    let mut f: Vec<(f64, f64)> = jumps
+        .iter()
+        .filter(|j| j.0 == pi)
+        .map(|j| (j.1, j.2))
+        .collect();
+    f.sort_by(|a, b| a.0.total_cmp(&b.0));
+    f
+}
+
 /// ||[u.nu]^+||^2 from the normal jumps (piece, abscissa, jump) of `pieces` pieces.
 fn positive_jump_l2(pieces: usize, jumps: &[(usize, f64, f64)]) -> f64 {
     let mut total = 0.0;
     for pi in 0..pieces {
-        let mut f: Vec<(f64, f64)> = jumps
-            .iter()
-            .filter(|j| j.0 == pi)
-            .map(|j| (j.1, j.2))
-            .collect();
-        f.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let f = piece_jumps(jumps, pi);
         for w in f.windows(2) {
             let ((s0, f0), (s1, f1)) = (w[0], w[1]);
             let len = s1 - s0;

@@ -5,7 +5,7 @@
 //! like h^(1/2) while e_mortar falls like h shows that nts's error has an h^(1/2) part,
 //! the rate Theorem 3.1 allows K_h^I.
 
-use super::contact_error::band;
+use super::contact_error::{band, piece_jumps};
 use super::field::P1History;
 use super::norms::{norms_of_difference, pressure_difference};
 use super::quantity::{Quantity, Scale};
@@ -16,12 +16,7 @@ use std::collections::BTreeMap;
 fn jump_l2(pieces: usize, jumps: &[(usize, f64, f64)]) -> f64 {
     let mut total = 0.0;
     for pi in 0..pieces {
-        let mut f: Vec<(f64, f64)> = jumps
-            .iter()
-            .filter(|j| j.0 == pi)
-            .map(|j| (j.1, j.2))
-            .collect();
-        f.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let f = piece_jumps(jumps, pi);
         for w in f.windows(2) {
             let ((s0, f0), (s1, f1)) = (w[0], w[1]);
             total += (s1 - s0).max(0.0) * (f0 * f0 + f0 * f1 + f1 * f1) / 3.0;

@@ -7,7 +7,7 @@ use crate::case::Case;
 use crate::contact::Interface;
 use crate::solve::{Solution, inf_norm};
 use crate::verify::contact_error::{
-    self, ContactStep, TruthPressure, contact_step, reference_profile,
+    self, ContactStep, TruthPressure, contact_step, piece_jumps, reference_profile,
 };
 use crate::verify::exact_error::{ExactComparison, ExactDifference};
 use crate::verify::field::{P1Field, P1History};
@@ -292,12 +292,7 @@ pub fn consistency_term(interface: &Interface, s: &P1Field, exact: &Exact) -> f6
     let kinks = crate::expr::kink_functions(&exact.contact_kinks(), s.time);
     let mut total = 0.0;
     for (pi, piece) in interface.pieces.iter().enumerate() {
-        let mut f: Vec<(f64, f64)> = jumps
-            .iter()
-            .filter(|j| j.0 == pi)
-            .map(|j| (j.1, j.2))
-            .collect();
-        f.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut f = piece_jumps(&jumps, pi);
         f.dedup_by(|a, b| (a.0 - b.0).abs() <= 1e-14 * piece.length);
         let mut breaks: Vec<f64> = f.iter().map(|p| p.0).collect();
         let (a, b) = (piece.point(0.0), piece.point(piece.length));

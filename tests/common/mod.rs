@@ -59,3 +59,39 @@ pub fn assert_rate_passes(r: &contact_rates::studies::convergence::RateRow, leve
         r.threshold
     );
 }
+
+/// Largest difference between a scene's exact displacement and stress and the stacked
+/// blocks' closed form `closed`, on an 11 x 11 grid of each block at t = 1, relative to the
+/// fields' sizes (0.05 for u, 10 for sigma).
+pub fn closed_form_difference(
+    closed: &contact_rates::analytical::stacked::StackedBlocks,
+    scene: &Scene,
+) -> f64 {
+    let ex = scene
+        .exact
+        .as_deref()
+        .expect("the scene has an exact solution");
+    let mut worst = 0.0f64;
+    for b in 0..2 {
+        for i in 0..=10 {
+            for j in 0..=10 {
+                let (x, y) = (i as f64 / 10.0, 1.0 - b as f64 + j as f64 / 10.0);
+                let (u, s) = (
+                    closed.displacement(b, x, y, 1.0),
+                    closed.stress(b, x, y, 1.0),
+                );
+                let (ue, se) = (
+                    ex.displacement_at(b, x, y, 1.0).unwrap(),
+                    ex.stress_at(b, x, y, 1.0).unwrap(),
+                );
+                for c in 0..2 {
+                    worst = worst.max((u[c] - ue[c]).abs() / 0.05);
+                }
+                for k in 0..3 {
+                    worst = worst.max((s[k] - se[k]).abs() / 10.0);
+                }
+            }
+        }
+    }
+    worst
+}
