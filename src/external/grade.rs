@@ -2,7 +2,7 @@
 //! measured against the scene's exact solution with the studies' error integrals, judged by
 //! the studies' rate verdicts, beside this project's mortar and nts on the family's meshes.
 
-use super::export::{Family, Source};
+use super::family::{Family, Source};
 use super::mesh_in::OutsideModel;
 use crate::contact::Method;
 use crate::error::{Error, Result};

@@ -1,6 +1,6 @@
 //! The README.md of an exported problem: what to solve, what to write back, how to convert.
 
-use super::export::Family;
+use super::family::Family;
 use std::fmt::Write as _;
 
 /// The README of an export of `family` at `levels` (level, h, nodes, triangles).
