@@ -19,23 +19,31 @@ use contact_rates::verify::field::P1History;
 use contact_rates::verify::quantity::Quantity;
 use contact_rates::verify::solve_case;
 use contact_rates::verify::truth::Truth;
+use std::collections::BTreeMap;
+
+/// Both cones on `scene` at `level` (its own sizes, 4 steps) against its exact solution:
+/// mortar's and nts's errors and the distance between them.
+fn both_cones(scene: &str, level: usize) -> [BTreeMap<Quantity, f64>; 3] {
+    let loaded = Scene::load(scene).unwrap();
+    let truth = Truth::Exact(loaded.exact.as_deref().unwrap(), 4);
+    let cases = [Method::Mortar, Method::Nts].map(|m| common::case(scene, level, m, &[]));
+    let sols = cases
+        .each_ref()
+        .map(|c| solve_case(c, SolverKind::Newton, 4).unwrap().0);
+    let (mortar, _) = truth.measure_solved(&cases[0], &sols[0]);
+    let (nts, scale) = truth.measure_solved(&cases[1], &sols[1]);
+    let d = cone_distance(
+        &P1History::of_solution(&cases[0], &sols[0]),
+        &P1History::of_solution(&cases[1], &sols[1]),
+        &scale,
+    );
+    [mortar, nts, d]
+}
 
 #[test]
 fn patch_distance_equals_nts_error_where_mortar_is_exact() {
-    let scene = Scene::load("patch").unwrap();
-    let truth = Truth::Exact(scene.exact.as_deref().unwrap(), 4);
     for level in 0..=2 {
-        let cases = [Method::Mortar, Method::Nts].map(|m| common::case("patch", level, m, &[]));
-        let sols = cases
-            .each_ref()
-            .map(|c| solve_case(c, SolverKind::Newton, 4).unwrap().0);
-        let (mortar, _) = truth.measure_solved(&cases[0], &sols[0]);
-        let (nts, scale) = truth.measure_solved(&cases[1], &sols[1]);
-        let d = cone_distance(
-            &P1History::of_solution(&cases[0], &sols[0]),
-            &P1History::of_solution(&cases[1], &sols[1]),
-            &scale,
-        );
+        let [mortar, nts, d] = both_cones("patch", level);
         for (distance, error) in [
             (Quantity::ConeDistanceL2Stress, Quantity::L2Stress),
             (Quantity::ConeDistanceBandStress, Quantity::BandStress),
@@ -58,21 +66,9 @@ fn patch_distance_equals_nts_error_where_mortar_is_exact() {
 
 #[test]
 fn the_distance_bounds_nts_error_from_both_sides() {
-    let scene = Scene::load("contact-mms").unwrap();
-    let truth = Truth::Exact(scene.exact.as_deref().unwrap(), 4);
     for level in 0..=2 {
-        let cases =
-            [Method::Mortar, Method::Nts].map(|m| common::case("contact-mms", level, m, &[]));
-        let sols = cases
-            .each_ref()
-            .map(|c| solve_case(c, SolverKind::Newton, 4).unwrap().0);
-        let (mortar, _) = truth.measure_solved(&cases[0], &sols[0]);
-        let (nts, scale) = truth.measure_solved(&cases[1], &sols[1]);
-        let d = cone_distance(
-            &P1History::of_solution(&cases[0], &sols[0]),
-            &P1History::of_solution(&cases[1], &sols[1]),
-            &scale,
-        )[&Quantity::ConeDistance];
+        let [mortar, nts, d] = both_cones("contact-mms", level);
+        let d = d[&Quantity::ConeDistance];
         let (em, en) = (mortar[&Quantity::Theorem], nts[&Quantity::Theorem]);
         println!("level {level}: D {d:.4e}, e_mortar {em:.4e}, e_nts {en:.4e}");
         // Max over the steps of a norm: the bounds hold step by step, hence for the maxima

@@ -172,26 +172,16 @@ fn displacement_2d(
 ) -> Result<Vec<[f64; 2]>> {
     match components {
         2 => Ok(values.chunks_exact(2).map(|t| [t[0], t[1]]).collect()),
-        3 => {
-            let scale = largest(values, 3, &[0, 1]);
-            let tolerance = precision.tolerance(scale);
-            if let Some((i, t)) = values
-                .chunks_exact(3)
-                .enumerate()
-                .find(|(_, t)| t[2].abs() > tolerance)
-            {
-                return Err(Error::input(
-                    file,
-                    field,
-                    format!(
-                        "the third component at {} is {:e}, not zero (largest in-plane |u| {scale:e}); the grading is 2D in the x-y plane: write the x and y components only, or a zero z component",
-                        label(i),
-                        t[2]
-                    ),
-                ));
-            }
-            Ok(values.chunks_exact(3).map(|t| [t[0], t[1]]).collect())
-        }
+        3 => in_plane(values, precision).map_err(|(i, z, scale)| {
+            Error::input(
+                file,
+                field,
+                format!(
+                    "the third component at {} is {z:e}, not zero (largest in-plane |u| {scale:e}); the grading is 2D in the x-y plane: write the x and y components only, or a zero z component",
+                    label(i)
+                ),
+            )
+        }),
         n => Err(Error::input(
             file,
             field,
@@ -269,23 +259,30 @@ fn planar_points(
     file: &Path,
     field: &str,
 ) -> Result<Vec<[f64; 2]>> {
-    let size = largest(xyz, 3, &[0, 1]);
-    let tolerance = precision.tolerance(size);
-    if let Some((i, p)) = xyz
-        .chunks_exact(3)
-        .enumerate()
-        .find(|(_, p)| p[2].abs() > tolerance)
-    {
-        return Err(Error::input(
+    in_plane(xyz, precision).map_err(|(i, z, size)| {
+        Error::input(
             file,
             field,
             format!(
-                "point {i} has z = {:e}, not zero (largest |x|, |y| {size:e}); the grading is 2D: write the mesh in the z = 0 plane",
-                p[2]
+                "point {i} has z = {z:e}, not zero (largest |x|, |y| {size:e}); the grading is 2D: write the mesh in the z = 0 plane"
             ),
-        ));
+        )
+    })
+}
+
+/// The (x, y) of 3-component tuples whose third component vanishes to the precision,
+/// relative to the largest |x|, |y|; else the first offending tuple, its third component and
+/// that scale.
+fn in_plane(
+    xyz: &[f64],
+    precision: Precision,
+) -> std::result::Result<Vec<[f64; 2]>, (usize, f64, f64)> {
+    let scale = largest(xyz, 3, &[0, 1]);
+    let tolerance = precision.tolerance(scale);
+    match xyz.chunks_exact(3).position(|t| t[2].abs() > tolerance) {
+        Some(i) => Err((i, xyz[3 * i + 2], scale)),
+        None => Ok(xyz.chunks_exact(3).map(|t| [t[0], t[1]]).collect()),
     }
-    Ok(xyz.chunks_exact(3).map(|p| [p[0], p[1]]).collect())
 }
 
 /// Refuse a mesh without a triangle of each body.
