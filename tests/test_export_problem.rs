@@ -10,20 +10,11 @@ mod common;
 
 use contact_rates::case::Case;
 use contact_rates::contact::Method;
-use contact_rates::external::export::{Source, export};
+use contact_rates::external::export::{LoadRow, Source, export};
 use contact_rates::mesh::msh::read_msh;
 use contact_rates::verify::study_file::LoadedStudy;
 use std::path::Path;
 use std::process::Command;
-
-#[derive(serde::Deserialize)]
-struct LoadRow {
-    step: usize,
-    t: f64,
-    node: usize,
-    fx: f64,
-    fy: f64,
-}
 
 #[test]
 fn the_export_reads_back_as_the_solvers_problem() {

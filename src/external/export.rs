@@ -12,17 +12,21 @@ use crate::io::csv_bytes;
 use crate::report::folder::write;
 use crate::report::{Output, Staging};
 use crate::scene::Scene;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// One row of loads_L.csv: the P1-consistent nodal load (force) at one node and step.
-#[derive(Serialize)]
-struct LoadRow {
-    step: usize,
-    t: f64,
-    node: usize,
-    fx: f64,
-    fy: f64,
+#[derive(Debug, Serialize, Deserialize)]
+pub struct LoadRow {
+    /// Step n (1..N).
+    pub step: usize,
+    /// t_n.
+    pub t: f64,
+    /// Node tag of mesh_L.msh (the model's node number + 1).
+    pub node: usize,
+    /// The load's components (force).
+    pub fx: f64,
+    pub fy: f64,
 }
 
 /// One row of source_L.csv: the constitutive source's mean over one triangle at t_n

@@ -250,20 +250,8 @@ fn quantities(family: &Family, study: Option<&LoadedStudy>, pressure: bool) -> V
     };
     // A distance between the cones is not a property of one solution.
     all.into_iter()
-        .filter(|q| !q.is_distance() && (pressure || !is_pressure(*q)))
+        .filter(|q| !q.is_distance() && (pressure || !q.needs_pressure()))
         .collect()
-}
-
-/// The quantities that need the discrete pressure.
-pub fn is_pressure(q: Quantity) -> bool {
-    matches!(
-        q,
-        Quantity::L2Pressure
-            | Quantity::PressureWeighted
-            | Quantity::PressureResultant
-            | Quantity::PressureOscillation
-            | Quantity::ContactEdge
-    )
 }
 
 /// The rows of errors.csv of one level's errors.
@@ -503,28 +491,33 @@ fn check_label(name: &str) -> Result<MethodLabel> {
     }
 }
 
-/// Two levels with the same h cannot give a rate: refused.
+/// Two levels with the same h cannot give a rate ([`rates::check_distinct_h`]): refused,
+/// naming both files, before anything is solved beside them.
 fn check_distinct_h(levels: &[GradedLevel], dir: &Path) -> Result<()> {
-    for (i, a) in levels.iter().enumerate() {
-        if let Some(b) = levels[i + 1..]
-            .iter()
-            .find(|b| (a.h - b.h).abs() <= 1e-12 * a.h)
-        {
-            return Err(Error::input(
-                dir,
-                format!("level_{}", b.level),
-                format!(
-                    "levels {} and {} have the same h = {} ({} and {}): each level must be a finer mesh than the one before; write level L on the family's level-L mesh",
-                    a.level,
-                    b.level,
-                    a.h,
-                    a.file.display(),
-                    b.file.display()
-                ),
-            ));
-        }
-    }
-    Ok(())
+    let as_levels: Vec<LevelError> = levels
+        .iter()
+        .map(|l| LevelError {
+            level: l.level,
+            h: l.h,
+            dofs: l.dofs as f64,
+            error: 0.0,
+        })
+        .collect();
+    rates::check_distinct_h(&as_levels).map_err(|e| {
+        let of = |level: usize| levels.iter().find(|l| l.level == level);
+        let file = |level: usize| of(level).map_or(String::new(), |l| l.file.display().to_string());
+        let (a, b) = e.levels;
+        Error::input(
+            dir,
+            format!("level_{b}"),
+            format!(
+                "levels {a} and {b} have the same h = {} ({} and {}): each level must be a finer mesh than the one before; write level L on the family's level-L mesh",
+                of(a).map_or(f64::NAN, |l| l.h),
+                file(a),
+                file(b)
+            ),
+        )
+    })
 }
 
 /// The quantity a threshold applies to: the theorem norm, or l2_stress where the exact
@@ -658,7 +651,11 @@ fn notes(levels: &[GradedLevel], family: &Family, pressure: bool) -> Vec<String>
         out.push("Where a file gives no stress, the stress graded is E eps(u_h) per triangle (elastic bodies).".into());
     }
     if !pressure {
-        out.push("Not every level gives a pressure: the pressure quantities (l2_pressure, pressure_weighted, pressure_resultant, pressure_oscillation, contact_edge) are not measured.".into());
+        let names: Vec<&str> = Quantity::PRESSURE.iter().map(|q| q.name()).collect();
+        out.push(format!(
+            "Not every level gives a pressure: the pressure quantities ({}) are not measured.",
+            names.join(", ")
+        ));
     }
     out
 }

@@ -64,15 +64,8 @@ impl Graded {
                 color: i,
                 thin: false,
             });
-            if let Some(line) = self.rate(m, self.key).and_then(|r| fit_line(r, &rows)) {
-                series.push(Series {
-                    label: format!("{m} fit: slope {:.2} ± {:.2}", line.0, line.1),
-                    points: line.2,
-                    markers: false,
-                    line: true,
-                    color: i,
-                    thin: false,
-                });
+            if let Some(line) = self.rate(m, self.key).and_then(|r| fit_line(r, &rows, i)) {
+                series.push(line);
             }
         }
         plot::loglog(
@@ -344,9 +337,10 @@ impl Graded {
     }
 }
 
-/// The least-squares line of a rate over its fitted levels (slope, its standard error,
-/// the line's ends): the intercept is the mean of log e - rate log h over those levels.
-fn fit_line(r: &RateRecord, rows: &[&ErrorRecord]) -> Option<(f64, f64, Vec<(f64, f64)>)> {
+/// The least-squares line of a rate over its fitted levels, drawn in `color`: the
+/// intercept is the mean of log e - rate log h over those levels (rates.csv keeps no
+/// intercept).
+fn fit_line(r: &RateRecord, rows: &[&ErrorRecord], color: usize) -> Option<Series> {
     let rate = r.rate?;
     let used: Vec<usize> = r
         .levels_used
@@ -358,18 +352,18 @@ fn fit_line(r: &RateRecord, rows: &[&ErrorRecord]) -> Option<(f64, f64, Vec<(f64
         .filter(|e| used.contains(&e.level))
         .map(|e| (e.h, e.error))
         .collect();
-    if points.len() < 2 {
-        return None;
-    }
-    let n = points.len() as f64;
+    let n = points.len().max(1) as f64;
     let intercept = points
         .iter()
         .map(|p| p.1.ln() - rate * p.0.ln())
         .sum::<f64>()
         / n;
-    let (lo, hi) = points.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| {
-        (a.min(p.0), b.max(p.0))
-    });
-    let at = |h: f64| (h, (intercept + rate * h.ln()).exp());
-    Some((rate, r.stderr.unwrap_or(0.0), vec![at(lo), at(hi)]))
+    let hs: Vec<f64> = points.iter().map(|p| p.0).collect();
+    let label = format!(
+        "{} fit: slope {:.2} ± {:.2}",
+        r.method,
+        rate,
+        r.stderr.unwrap_or(0.0)
+    );
+    plot::fit_line(label, rate, intercept, &hs, color)
 }

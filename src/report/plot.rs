@@ -875,6 +875,35 @@ pub struct Series {
     pub thin: bool,
 }
 
+/// The fitted line exp(intercept) x^rate drawn across the span of `xs` (the fitted levels'
+/// h or k), labelled `label`; None with fewer than two.
+pub fn fit_line(
+    label: String,
+    rate: f64,
+    intercept: f64,
+    xs: &[f64],
+    color: usize,
+) -> Option<Series> {
+    if xs.len() < 2 {
+        return None;
+    }
+    let ends = [
+        xs.iter().copied().fold(f64::INFINITY, f64::min),
+        xs.iter().copied().fold(0.0, f64::max),
+    ];
+    Some(Series {
+        label,
+        points: ends
+            .iter()
+            .map(|&x| (x, (intercept + rate * x.ln()).exp()))
+            .collect(),
+        markers: false,
+        line: true,
+        color,
+        thin: false,
+    })
+}
+
 fn range(points: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for v in points.filter(|v| v.is_finite() && (!log || *v > 0.0)) {

@@ -219,9 +219,4 @@ impl<'a> P1History<'a> {
                 .collect(),
         }
     }
-
-    /// Whether every step gives a pressure.
-    pub fn has_pressure(&self) -> bool {
-        self.steps.iter().all(|s| s.pressure.is_some())
-    }
 }

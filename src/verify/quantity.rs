@@ -116,6 +116,21 @@ impl Quantity {
         Quantity::ConeDistanceNormalJump,
     ];
 
+    /// The quantities of one solution that need its discrete pressure (measured only where
+    /// the solution gives one).
+    pub const PRESSURE: [Quantity; 5] = [
+        Quantity::L2Pressure,
+        Quantity::PressureWeighted,
+        Quantity::PressureResultant,
+        Quantity::PressureOscillation,
+        Quantity::ContactEdge,
+    ];
+
+    /// Whether it needs the solution's discrete pressure.
+    pub fn needs_pressure(self) -> bool {
+        Self::PRESSURE.contains(&self)
+    }
+
     /// Whether it is a distance between the two cones.
     pub fn is_distance(self) -> bool {
         Self::DISTANCES.contains(&self)

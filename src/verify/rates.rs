@@ -338,7 +338,8 @@ pub fn assess(levels: &[LevelError], truth_error: f64) -> Result<Assessment, Equ
 }
 
 /// Errs on two levels with the same h (to 1e-12 relative).
-fn check_distinct_h(levels: &[LevelError]) -> Result<(), EqualH> {
+/// Refuse two levels with the same h (relative 1e-12): no rate between them.
+pub fn check_distinct_h(levels: &[LevelError]) -> Result<(), EqualH> {
     for (i, a) in levels.iter().enumerate() {
         for b in &levels[i + 1..] {
             if (a.h - b.h).abs() <= 1e-12 * a.h.abs().max(b.h.abs()) {

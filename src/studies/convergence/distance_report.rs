@@ -11,17 +11,6 @@ use crate::verify::quantity::Quantity;
 use crate::verify::rates::{Fit, Verdict};
 use std::path::Path;
 
-fn rate_row(res: &StudyResult, m: Method, q: Quantity) -> Option<&RateRow> {
-    res.rates.iter().find(|r| r.method == m && r.quantity == q)
-}
-
-fn error(res: &StudyResult, m: Method, level: usize, q: Quantity) -> Option<f64> {
-    res.errors
-        .iter()
-        .find(|e| e.method == m && e.level == level && e.quantity == q)
-        .map(|e| e.error)
-}
-
 /// The fit of a fitted rate (the rules' window of agreeing successive rates).
 fn supported_fit(row: Option<&RateRow>) -> Option<Fit> {
     let a = &row?.assessment;
@@ -32,7 +21,7 @@ fn supported_fit(row: Option<&RateRow>) -> Option<Fit> {
 /// The section, where the study measures the cone distance in the theorem norm.
 pub fn section(doc: &mut Doc, res: &StudyResult) {
     let key = Quantity::ConeDistance;
-    let Some(d_row) = rate_row(res, Method::Nts, key) else {
+    let Some(d_row) = res.rate(Method::Nts, key) else {
         return;
     };
     let theorem = Quantity::Theorem;
@@ -53,9 +42,9 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
     let mut table = Table::new(header);
     for level in &res.file.mesh.levels {
         let (Some(em), Some(en), Some(d)) = (
-            error(res, Method::Mortar, *level, theorem),
-            error(res, Method::Nts, *level, theorem),
-            error(res, Method::Nts, *level, key),
+            res.error(Method::Mortar, *level, theorem),
+            res.error(Method::Nts, *level, theorem),
+            res.error(Method::Nts, *level, key),
         ) else {
             continue;
         };
@@ -76,7 +65,7 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
         if consistency {
             for m in [Method::Mortar, Method::Nts] {
                 row.push(
-                    error(res, m, *level, Quantity::Consistency)
+                    res.error(m, *level, Quantity::Consistency)
                         .map_or("-".into(), |v| format!("{v:.4e}")),
                 );
             }
@@ -86,13 +75,13 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
     doc.table(&table);
     let mut rates = Table::new(["quantity", "rate of the distance in h (nts's rows of rates.csv)"]);
     for q in Quantity::DISTANCES {
-        if let Some(r) = rate_row(res, Method::Nts, q) {
+        if let Some(r) = res.rate(Method::Nts, q) {
             rates.row([format!("`{q}`"), r.assessment.describe()]);
         }
     }
     if consistency {
         for m in [Method::Mortar, Method::Nts] {
-            if let Some(r) = rate_row(res, m, Quantity::Consistency) {
+            if let Some(r) = res.rate(m, Quantity::Consistency) {
                 rates.row([format!("`consistency`, {m}"), r.assessment.describe()]);
             }
         }
@@ -104,7 +93,7 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
 /// Where D's fitted line reaches mortar's, and the local rate of the upper bound
 /// D + e_mortar of nts's error there and two levels later.
 fn crossover(res: &StudyResult, d_row: &RateRow) -> String {
-    let mortar = supported_fit(rate_row(res, Method::Mortar, Quantity::Theorem));
+    let mortar = supported_fit(res.rate(Method::Mortar, Quantity::Theorem));
     let (Some(fm), Some(fd)) = (mortar, supported_fit(Some(d_row))) else {
         return "No crossover is predicted: D's or mortar's theorem-norm errors support no rate (see the rates above).".into();
     };
@@ -146,7 +135,7 @@ fn crossover(res: &StudyResult, d_row: &RateRow) -> String {
 /// cone_distance.png: e_mortar, e_nts and D in the theorem norm against h, with D's and
 /// mortar's fitted lines.
 pub fn plot(res: &StudyResult, d: &Path) -> Result<()> {
-    let Some(d_row) = rate_row(res, Method::Nts, Quantity::ConeDistance) else {
+    let Some(d_row) = res.rate(Method::Nts, Quantity::ConeDistance) else {
         return Ok(());
     };
     let points = |m: Method, q: Quantity| -> Vec<(f64, f64)> {
@@ -158,43 +147,28 @@ pub fn plot(res: &StudyResult, d: &Path) -> Result<()> {
     };
     let mut series = Vec::new();
     let curves = [
-        ("e_mortar", Method::Mortar, Quantity::Theorem, rate_row(res, Method::Mortar, Quantity::Theorem), 0),
+        ("e_mortar", Method::Mortar, Quantity::Theorem, res.rate(Method::Mortar, Quantity::Theorem), 0),
         ("e_nts", Method::Nts, Quantity::Theorem, None, 1),
         ("D (nts - mortar)", Method::Nts, Quantity::ConeDistance, Some(d_row), 2),
     ];
     for (label, m, q, row, color) in curves {
-        let pts = points(m, q);
         series.push(Series {
             label: label.to_string(),
-            points: pts.clone(),
+            points: points(m, q),
             markers: true,
             line: row.is_none(),
             color,
             thin: row.is_none(),
         });
-        if let Some(fit) = supported_fit(row) {
+        if let (Some(fit), Some(row)) = (supported_fit(row), row) {
             let used: Vec<f64> = res
                 .errors
                 .iter()
-                .filter(|e| e.method == m && e.quantity == q && row.is_some_and(|r| r.assessment.used.contains(&e.level)))
+                .filter(|e| e.method == m && e.quantity == q && row.assessment.used.contains(&e.level))
                 .map(|e| e.h)
                 .collect();
-            let (lo, hi) = used
-                .iter()
-                .fold((f64::INFINITY, 0.0f64), |(a, b), &h| (a.min(h), b.max(h)));
-            if used.len() >= 2 {
-                series.push(Series {
-                    label: format!("{label} fit: slope {:.2} ± {:.2}", fit.rate, fit.stderr),
-                    points: [lo, hi]
-                        .iter()
-                        .map(|&h| (h, (fit.intercept + fit.rate * h.ln()).exp()))
-                        .collect(),
-                    markers: false,
-                    line: true,
-                    color,
-                    thin: false,
-                });
-            }
+            let line = format!("{label} fit: slope {:.2} ± {:.2}", fit.rate, fit.stderr);
+            series.extend(plot::fit_line(line, fit.rate, fit.intercept, &used, color));
         }
     }
     plot::loglog(

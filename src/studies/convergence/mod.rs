@@ -260,6 +260,19 @@ pub struct StudyResult {
 }
 
 impl StudyResult {
+    /// The rate row of a cone and quantity.
+    pub fn rate(&self, m: Method, q: Quantity) -> Option<&RateRow> {
+        self.rates.iter().find(|r| r.method == m && r.quantity == q)
+    }
+
+    /// The error of a cone and quantity at `level`.
+    pub fn error(&self, m: Method, level: usize, q: Quantity) -> Option<f64> {
+        self.errors
+            .iter()
+            .find(|e| e.method == m && e.quantity == q && e.level == level)
+            .map(|e| e.error)
+    }
+
     /// The thresholds the study missed, one sentence each (empty: it passed).
     pub fn failures(&self) -> Vec<String> {
         self.rates

@@ -162,22 +162,9 @@ fn error_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
             .filter(|r| rate.assessment.used.contains(&r.level))
             .map(|r| r.h)
             .collect();
-        if let Some(fit) = rate.assessment.fit.filter(|_| used.len() >= 2) {
-            let hs = [
-                used.iter().copied().fold(f64::INFINITY, f64::min),
-                used.iter().copied().fold(0.0, f64::max),
-            ];
-            series.push(Series {
-                label: format!("{m} fit: slope {:.2} ± {:.2}", fit.rate, fit.stderr),
-                points: hs
-                    .iter()
-                    .map(|&h| (h, (fit.intercept + fit.rate * h.ln()).exp()))
-                    .collect(),
-                markers: false,
-                line: true,
-                color: i,
-                thin: false,
-            });
+        if let Some(fit) = rate.assessment.fit {
+            let label = format!("{m} fit: slope {:.2} ± {:.2}", fit.rate, fit.stderr);
+            series.extend(plot::fit_line(label, fit.rate, fit.intercept, &used, i));
         }
     }
     for (i, &m) in res.file.methods.iter().enumerate() {
@@ -220,27 +207,14 @@ fn error_vs_k(res: &StudyResult, ts: &TimeStudy, d: &Path) -> Result<()> {
     }];
     let a = &ts.assessment;
     let used: Vec<f64> = a.used.iter().map(|&i| ts.runs[i].k).collect();
-    if let Some(fit) = a.fit.filter(|_| used.len() >= 2) {
-        let ks = [
-            used.iter().copied().fold(f64::INFINITY, f64::min),
-            used.iter().copied().fold(0.0, f64::max),
-        ];
-        series.push(Series {
-            label: format!(
-                "fit: slope {:.2} ± {:.2} ({})",
-                fit.rate,
-                fit.stderr,
-                a.verdict.name()
-            ),
-            points: ks
-                .iter()
-                .map(|&k| (k, (fit.intercept + fit.rate * k.ln()).exp()))
-                .collect(),
-            markers: false,
-            line: true,
-            color: 0,
-            thin: false,
-        });
+    if let Some(fit) = a.fit {
+        let label = format!(
+            "fit: slope {:.2} ± {:.2} ({})",
+            fit.rate,
+            fit.stderr,
+            a.verdict.name()
+        );
+        series.extend(plot::fit_line(label, fit.rate, fit.intercept, &used, 0));
     }
     plot::loglog(
         &d.join("error_vs_k.png"),
@@ -466,16 +440,12 @@ fn finest_level(res: &StudyResult) -> usize {
 
 /// The rate row of a cone and quantity.
 fn rate_row(res: &StudyResult, m: Method, q: Quantity) -> Option<&RateRow> {
-    res.rates.iter().find(|r| r.method == m && r.quantity == q)
+    res.rate(m, q)
 }
 
 /// The error of a cone and quantity at the finest level.
 fn finest_error(res: &StudyResult, m: Method, q: Quantity) -> Option<f64> {
-    let finest = finest_level(res);
-    res.errors
-        .iter()
-        .find(|e| e.method == m && e.quantity == q && e.level == finest)
-        .map(|e| e.error)
+    res.error(m, finest_level(res), q)
 }
 
 /// The quantities that compare the cones, contact quantities first, and the others, each
