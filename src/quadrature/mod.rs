@@ -5,6 +5,8 @@
 //! Written by hand: the rules are twenty lines, and the crates that offer them fix the
 //! order at compile time or pull in a linear-algebra stack for the Golub-Welsch solve.
 
+pub mod singular;
+
 use std::borrow::Cow;
 
 /// Gauss-Legendre points and weights on [0, 1] with `n` points (exact for polynomials of
