@@ -37,7 +37,8 @@ pub fn support_warnings(
     raw: &crate::mesh::RawMesh,
 ) -> Result<Vec<String>> {
     let sc = &model.scene;
-    let f = model.load(sc.final_time)?;
+    // The load only where a component is free (a clamped pair of bodies pays nothing).
+    let mut f: Option<Vec<f64>> = None;
     let mut out = Vec::new();
     for b in 0..2 {
         let mesh = &model.meshes[b];
@@ -52,6 +53,13 @@ pub fn support_warnings(
                 held[r.component] = true;
             }
         }
+        if held == [true, true] {
+            continue;
+        }
+        if f.is_none() {
+            f = Some(model.load(sc.final_time)?);
+        }
+        let f = f.as_deref().expect("computed above");
         let range = model.node_offset[b]..model.node_offset[b] + mesh.nodes.len();
         let load = [0, 1].map(|c| range.clone().map(|n| f[2 * n + c]).sum::<f64>());
         let scale = load[0].abs().max(load[1].abs()).max(f64::MIN_POSITIVE);

@@ -681,31 +681,51 @@ impl Model {
             // A manufactured scene derives the body force from its exact fields.
             let derived = exact.is_some_and(|e| e.body_force.is_some());
             let field = format!("bodies[{}].body_force", self.scene.bodies[body].file_index);
+            // A singular part's load r^(beta-2) (times P1, smooth along the rays) and the
+            // rest of the load, each with its own rule on the triangles at the point.
+            let singular = exact.and_then(|e| e.singular.as_ref());
+            let powers = singular.map_or([0.0; 2], |s| [0.0, s.exponent - 2.0]);
             for e in self.elements.iter().filter(|e| e.body == body) {
                 let p = e.nodes.map(|n| self.position(n));
-                for &(l1, l2, w) in quadrature::triangle_rule(p, &kinks, &triangle).iter() {
-                    let lam = [1.0 - l1 - l2, l1, l2];
-                    let x = lam[0] * p[0][0] + lam[1] * p[1][0] + lam[2] * p[2][0];
-                    let y = lam[0] * p[0][1] + lam[1] * p[1][1] + lam[2] * p[2][1];
-                    let v = if derived {
-                        let v = [bf.0[0].eval(x, y, t), bf.0[1].eval(x, y, t)];
-                        if v.iter().any(|c| !c.is_finite()) {
-                            return Err(Error::input(
-                                &self.scene.file,
-                                "exact",
-                                format!(
-                                    "the body force -div sigma of body '{}' derived from the exact fields is not finite at x = {x}, y = {y}, t = {t}; fix the displacement (or the stress)",
-                                    self.scene.bodies[body].surface
-                                ),
-                            ));
-                        }
-                        v
-                    } else {
-                        bf.eval(x, y, t, &self.scene.file, &field)?
-                    };
-                    for a in 0..3 {
-                        for c in 0..2 {
-                            f[2 * e.nodes[a] + c] += w * e.area * lam[a] * v[c];
+                let point = singular.map(|s| s.point);
+                for (part, rule) in quadrature::singular::rules(p, &kinks, &triangle, point, &powers) {
+                    for &(l1, l2, w) in rule.iter() {
+                        let lam = [1.0 - l1 - l2, l1, l2];
+                        let x = lam[0] * p[0][0] + lam[1] * p[1][0] + lam[2] * p[2][0];
+                        let y = lam[0] * p[0][1] + lam[1] * p[1][1] + lam[2] * p[2][1];
+                        let v = if derived {
+                            let whole = || [bf.0[0].eval(x, y, t), bf.0[1].eval(x, y, t)];
+                            let sing = || {
+                                let fs = &singular.expect("a part is singular").body_force[body];
+                                [fs[0].eval(x, y, t), fs[1].eval(x, y, t)]
+                            };
+                            let v = match part {
+                                None => whole(),
+                                // The rest: smooth at the point.
+                                Some(0) => {
+                                    let (a, b) = (whole(), sing());
+                                    [a[0] - b[0], a[1] - b[1]]
+                                }
+                                Some(_) => sing(),
+                            };
+                            if v.iter().any(|c| !c.is_finite()) {
+                                return Err(Error::input(
+                                    &self.scene.file,
+                                    "exact",
+                                    format!(
+                                        "the body force -div sigma of body '{}' derived from the exact fields is not finite at x = {x}, y = {y}, t = {t}; fix the displacement (or the stress)",
+                                        self.scene.bodies[body].surface
+                                    ),
+                                ));
+                            }
+                            v
+                        } else {
+                            bf.eval(x, y, t, &self.scene.file, &field)?
+                        };
+                        for a in 0..3 {
+                            for c in 0..2 {
+                                f[2 * e.nodes[a] + c] += w * e.area * lam[a] * v[c];
+                            }
                         }
                     }
                 }

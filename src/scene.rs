@@ -126,6 +126,24 @@ pub struct ExactSpec {
     /// the constitutive source s = d sigma/dt - E eps(du/dt) - G(sigma).
     #[serde(default)]
     pub manufactured: bool,
+    /// A part of the displacement singular at a point, added to `displacement`.
+    pub singular: Option<SingularSpec>,
+}
+
+/// `[exact.singular]`: the part of a manufactured elastic displacement singular at a point
+/// c, O(r^exponent) with r = |x - c| and a factor smooth along the rays from c (the
+/// `regularity` scenes). The displacement is `exact.displacement` plus this part; every
+/// integral on the triangles at c splits its integrand by power of r
+/// (`analytical::Singular`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SingularSpec {
+    /// The point c (length): a node of both meshes.
+    pub point: [f64; 2],
+    /// beta > 1/2 (the pressure ~ r^(beta-1) must lie in L2(Gamma_C)).
+    pub exponent: f64,
+    /// The singular part [u_x, u_y] of each body, in [[bodies]] order.
+    pub displacement: [[String; 2]; 2],
 }
 
 /// The TOML layout of a scene file.
@@ -604,7 +622,16 @@ fn exact_solution(
     file: &Path,
 ) -> Result<Exact> {
     let order = |b: usize| if swapped { 1 - b } else { b };
-    let displacement = exact_displacement(spec, order, file)?;
+    let mut displacement = exact_displacement(spec, order, file)?;
+    let singular = match &spec.singular {
+        Some(sp) => {
+            let part = singular_part(sp, spec, bodies, order, file)?;
+            let smooth = displacement.take().expect("checked by singular_part");
+            displacement = Some(crate::analytical::add_displacements(&smooth, &part));
+            Some((sp, part, smooth))
+        }
+        None => None,
+    };
     let (stress, asymmetry) = exact_stress(spec, order, file)?;
     let pressure = spec
         .pressure
@@ -622,6 +649,15 @@ fn exact_solution(
         [&bodies[0].material, &bodies[1].material],
     );
     exact.asymmetry = asymmetry;
+    exact.singular = singular.map(|(sp, part, smooth)| {
+        crate::analytical::Singular::new(
+            sp.point,
+            sp.exponent,
+            part,
+            smooth,
+            [&bodies[0].material, &bodies[1].material],
+        )
+    });
     if let Some(f) = &exact.body_force {
         for (b, body) in bodies.iter_mut().enumerate() {
             body.body_force = Some(VectorExpr(f[b].clone()));
@@ -638,6 +674,48 @@ fn exact_solution(
         ));
     }
     Ok(exact)
+}
+
+/// `[exact.singular]`'s displacement per body in slave-first order, after its checks: an
+/// elastic manufactured scene with a displacement, and beta > 1/2.
+fn singular_part(
+    sp: &SingularSpec,
+    spec: &ExactSpec,
+    bodies: &[SceneBody],
+    order: impl Fn(usize) -> usize,
+    file: &Path,
+) -> Result<[[Expr; 2]; 2]> {
+    let bad = |field: &str, msg: &str| Err(Error::input(file, field, msg.to_string()));
+    if !spec.manufactured || spec.displacement.is_none() || spec.stress.is_some() {
+        return bad(
+            "exact.singular",
+            "a singular part belongs to a manufactured displacement: set exact.manufactured = true and give exact.displacement (its smooth part), without exact.stress",
+        );
+    }
+    if bodies.iter().any(|b| b.material.viscoplastic.is_some()) {
+        return bad(
+            "exact.singular",
+            "a singular part is supported for elastic bodies only: remove lambda and yield_stress",
+        );
+    }
+    if !(sp.exponent > 0.5 && sp.exponent.is_finite()) {
+        return bad(
+            "exact.singular.exponent",
+            "the exponent beta must exceed 1/2 (the pressure ~ r^(beta-1) must lie in L2(Gamma_C)); give a number > 0.5",
+        );
+    }
+    if sp.point.iter().any(|v| !v.is_finite()) {
+        return bad("exact.singular.point", "give the point as [x, y], two finite numbers");
+    }
+    let d = &sp.displacement;
+    let parsed = [0, 1].map(|b| {
+        let i = order(b);
+        [0, 1].map(|c| {
+            Expr::parse(&d[i][c], file, &format!("exact.singular.displacement[{i}][{c}]"))
+        })
+    });
+    let [[a, b], [c, e]] = parsed;
+    Ok([[a?, b?], [c?, e?]])
 }
 
 /// `exact.displacement` per body in slave-first order (`order` maps it to file order).

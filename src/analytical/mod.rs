@@ -6,8 +6,10 @@
 //! s = d sigma/dt - E eps(du/dt) - G(sigma) (SPEC section 5, Roache's method of
 //! manufactured solutions with a source in every equation the fields do not satisfy).
 //!
-//! [`stacked`] derives the closed form of the `stacked-exact` scene.
+//! [`stacked`] derives the closed form of the `stacked-exact` scene; [`singular`] the
+//! `regularity` family, whose displacement has a part singular at a point ([`Singular`]).
 
+pub mod singular;
 pub mod stacked;
 
 use crate::expr::Expr;
@@ -42,6 +44,68 @@ pub struct Exact {
     /// s12 - s21 of a body whose stress was given as a full tensor with different
     /// off-diagonal texts: checked to vanish on the mesh before anything is solved.
     pub asymmetry: [Option<Expr>; 2],
+    /// The part of the fields singular at a point, already included in the fields above;
+    /// the integrals split each integrand by power of r there ([`Singular`]).
+    pub singular: Option<Singular>,
+}
+
+/// The part of an elastic manufactured solution singular at a point c: a displacement
+/// O(r^beta) (r = |x - c|), its gradient and stress O(r^(beta-1)) and body force
+/// O(r^(beta-2)), each r^power times a factor smooth along the rays from c. The exact
+/// fields include it; what remains of them is smooth at c. Integrals on the triangles at c
+/// integrate the remainder, the cross terms and the singular part's square each with
+/// its own Gauss-Jacobi weight (`quadrature::singular`).
+#[derive(Debug, Clone)]
+pub struct Singular {
+    /// The point c (length).
+    pub point: [f64; 2],
+    /// beta.
+    pub exponent: f64,
+    /// The singular part of each body's displacement.
+    pub displacement: [Displacement; 2],
+    /// The rest of it (smooth at c).
+    pub smooth: [Displacement; 2],
+    /// Its gradient `[b][c][d]`.
+    pub gradient: [[[Expr; 2]; 2]; 2],
+    /// Its stress (elastic).
+    pub stress: [StressField; 2],
+    /// Its body force -div sigma.
+    pub body_force: [[Expr; 2]; 2],
+}
+
+impl Singular {
+    /// The singular part `displacement` at `point` with exponent beta (`smooth` the rest of
+    /// the displacement), its other fields derived for the elastic `materials`.
+    pub fn new(
+        point: [f64; 2],
+        exponent: f64,
+        displacement: [Displacement; 2],
+        smooth: [Displacement; 2],
+        materials: [&Material; 2],
+    ) -> Self {
+        let gradient = [gradient(&displacement[0]), gradient(&displacement[1])];
+        let stress = [0, 1].map(|b| elastic_stress(materials[b], &gradient[b]));
+        let body_force = [body_force(&stress[0]), body_force(&stress[1])];
+        Singular {
+            point,
+            exponent,
+            displacement,
+            smooth,
+            gradient,
+            stress,
+            body_force,
+        }
+    }
+
+    /// Distance from c.
+    pub fn distance(&self, x: f64, y: f64) -> f64 {
+        (x - self.point[0]).hypot(y - self.point[1])
+    }
+}
+
+/// Two displacements added component by component.
+pub fn add_displacements(a: &[Displacement; 2], b: &[Displacement; 2]) -> [Displacement; 2] {
+    [0, 1].map(|l| [0, 1].map(|c| Expr::combine(&[(1.0, &a[l][c]), (1.0, &b[l][c])])))
 }
 
 /// What an exact solution gives, for messages.
@@ -137,6 +201,7 @@ impl Exact {
             body_force,
             source_rate,
             asymmetry: [None, None],
+            singular: None,
         }
     }
 
@@ -207,9 +272,14 @@ impl Exact {
         Some([s[0].eval(x, y, t), s[1].eval(x, y, t), s[2].eval(x, y, t)])
     }
 
-    /// Displacement of body `b` at (x, y, t).
+    /// Displacement of body `b` at (x, y, t). At a singular point the singular part's
+    /// expressions read 0 * inf; its limit there, 0, is taken.
     pub fn displacement_at(&self, b: usize, x: f64, y: f64, t: f64) -> Option<[f64; 2]> {
         let u = &self.displacement.as_ref()?[b];
+        if let Some(s) = self.singular.as_ref().filter(|s| s.distance(x, y) == 0.0) {
+            let u = &s.smooth[b];
+            return Some([u[0].eval(x, y, t), u[1].eval(x, y, t)]);
+        }
         Some([u[0].eval(x, y, t), u[1].eval(x, y, t)])
     }
 

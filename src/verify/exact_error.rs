@@ -42,8 +42,50 @@ pub struct ExactDifference {
     pub energy: f64,
 }
 
-fn tensor_norm2(s: [f64; 3]) -> f64 {
-    s[0] * s[0] + s[1] * s[1] + 2.0 * s[2] * s[2]
+/// The part of a product a b that one rule takes, each factor given as (whole, singular
+/// part) at a singular point: the smooth rest times the smooth rest (power 0), the cross
+/// terms (power gamma), the singular parts' product (power 2 gamma).
+#[derive(Debug, Clone, Copy)]
+enum Split {
+    /// The whole product (no singular point, or a triangle away from it).
+    Whole,
+    /// (a - a_s)(b - b_s).
+    Smooth,
+    /// (a - a_s) b_s + a_s (b - b_s).
+    Cross,
+    /// a_s b_s.
+    Singular,
+}
+
+/// What the rule of each power in `ExactComparison::difference` takes, for the
+/// displacement's integrands and for the gradient's and stress's: powers 0, beta - 1, beta,
+/// 2 beta - 2, 2 beta of r.
+const SPLIT_PARTS: [(Option<Split>, Option<Split>); 5] = [
+    (Some(Split::Smooth), Some(Split::Smooth)),
+    (None, Some(Split::Cross)),
+    (Some(Split::Cross), None),
+    (None, Some(Split::Singular)),
+    (Some(Split::Singular), None),
+];
+
+impl Split {
+    fn product(self, (a, a_s): (f64, f64), (b, b_s): (f64, f64)) -> f64 {
+        match self {
+            Split::Whole => a * b,
+            Split::Smooth => (a - a_s) * (b - b_s),
+            Split::Cross => (a - a_s) * b_s + a_s * (b - b_s),
+            Split::Singular => a_s * b_s,
+        }
+    }
+
+    fn square(self, a: f64, a_s: f64) -> f64 {
+        self.product((a, a_s), (a, a_s))
+    }
+}
+
+/// s11^2 + s22^2 + 2 s12^2, its part `p`, each component as (whole, singular part).
+fn tensor_square(p: Split, s: [(f64, f64); 3]) -> f64 {
+    p.product(s[0], s[0]) + p.product(s[1], s[1]) + 2.0 * p.product(s[2], s[2])
 }
 
 impl<'a> ExactComparison<'a> {
@@ -70,6 +112,10 @@ impl<'a> ExactComparison<'a> {
         };
         let band = super::contact_error::band(m, interface);
         let kinks = [0, 1].map(|b| kink_functions(&ex.kinks(b), t));
+        let singular = ex.singular.as_ref();
+        let beta = singular.map_or(1.0, |sg| sg.exponent);
+        // The powers of r of SPLIT_PARTS's rules.
+        let powers = [0.0, beta - 1.0, beta, 2.0 * beta - 2.0, 2.0 * beta];
         for (i, el) in m.elements.iter().enumerate() {
             let b = el.body;
             let pos = el.nodes.map(|n| m.position(n));
@@ -83,42 +129,67 @@ impl<'a> ExactComparison<'a> {
                 }
             }
             let sh = [s.stress[i][0], s.stress[i][1], s.stress[i][2]];
-            let rule = quadrature::triangle_rule(pos, &kinks[b], &self.triangle);
-            for &(l1, l2, w) in rule.iter() {
-                let lam = [1.0 - l1 - l2, l1, l2];
-                let x = [0, 1].map(|c| (0..3).map(|a| lam[a] * pos[a][c]).sum::<f64>());
-                let w = w * el.area;
-                let mut grad_e = None;
-                if let (Some(u), Some(g)) = (&ex.displacement, &ex.gradient) {
-                    let mut ge_all = [[0.0; 2]; 2];
-                    for c in 0..2 {
-                        let ue = u[b][c].eval(x[0], x[1], t);
-                        let uhc: f64 = (0..3).map(|a| lam[a] * uh[a][c]).sum();
-                        out.difference.l2_u += w * (uhc - ue).powi(2);
-                        out.exact.l2_u += w * ue * ue;
-                        for d in 0..2 {
-                            let ge = g[b][c][d].eval(x[0], x[1], t);
-                            out.difference.semi_u += w * (grad_h[c][d] - ge).powi(2);
-                            out.exact.semi_u += w * ge * ge;
-                            ge_all[c][d] = ge;
+            let point = singular.map(|sg| sg.point);
+            for (part, rule) in
+                quadrature::singular::rules(pos, &kinks[b], &self.triangle, point, &powers)
+            {
+                // Which part of each integrand this rule takes: the displacement's terms
+                // (powers 0, beta, 2 beta) and the gradient's and stress's (0, beta - 1,
+                // 2 beta - 2) split alike; None where the rule takes all of it.
+                let (u_part, g_part) = match part {
+                    None => (Some(Split::Whole), Some(Split::Whole)),
+                    Some(k) => SPLIT_PARTS[k],
+                };
+                for &(l1, l2, w) in rule.iter() {
+                    let lam = [1.0 - l1 - l2, l1, l2];
+                    let x = [0, 1].map(|c| (0..3).map(|a| lam[a] * pos[a][c]).sum::<f64>());
+                    let w = w * el.area;
+                    let sing = singular.filter(|_| part.is_some());
+                    let mut grad_e = None;
+                    if let (Some(u), Some(g)) = (&ex.displacement, &ex.gradient) {
+                        let mut ge_all = [[(0.0, 0.0); 2]; 2];
+                        for c in 0..2 {
+                            let ue = u[b][c].eval(x[0], x[1], t);
+                            let us = sing.map_or(0.0, |sg| sg.displacement[b][c].eval(x[0], x[1], t));
+                            let uhc: f64 = (0..3).map(|a| lam[a] * uh[a][c]).sum();
+                            if let Some(p) = u_part {
+                                out.difference.l2_u += w * p.square(uhc - ue, -us);
+                                out.exact.l2_u += w * p.square(ue, us);
+                            }
+                            for d in 0..2 {
+                                let ge = g[b][c][d].eval(x[0], x[1], t);
+                                let gs = sing.map_or(0.0, |sg| sg.gradient[b][c][d].eval(x[0], x[1], t));
+                                if let Some(p) = g_part {
+                                    out.difference.semi_u += w * p.square(grad_h[c][d] - ge, -gs);
+                                    out.exact.semi_u += w * p.square(ge, gs);
+                                }
+                                ge_all[c][d] = (ge, gs);
+                            }
                         }
+                        grad_e = Some(ge_all);
                     }
-                    grad_e = Some(ge_all);
-                }
-                if let Some(se) = ex.stress_at(b, x[0], x[1], t) {
-                    if let Some(g) = grad_e {
-                        // sigma : eps(u) = s11 e11 + s22 e22 + 2 s12 e12.
-                        out.energy +=
-                            w * (se[0] * g[0][0] + se[1] * g[1][1] + se[2] * (g[0][1] + g[1][0]));
-                    }
-                    let (d, n) = (
-                        tensor_norm2([0, 1, 2].map(|k| sh[k] - se[k])),
-                        tensor_norm2(se),
-                    );
-                    out.difference.stress += w * d;
-                    out.exact.stress += w * n;
-                    if band[i] {
-                        out.band_stress += w * d;
+                    let Some(p) = g_part else { continue };
+                    if let Some(se) = ex.stress_at(b, x[0], x[1], t) {
+                        let ss = sing.map_or([0.0; 3], |sg| {
+                            [0, 1, 2].map(|k| sg.stress[b][k].eval(x[0], x[1], t))
+                        });
+                        if let Some(g) = grad_e {
+                            // sigma : eps(u) = s11 e11 + s22 e22 + 2 s12 e12.
+                            let eps = [g[0][0], g[1][1], (g[0][1].0 + g[1][0].0, g[0][1].1 + g[1][0].1)];
+                            out.energy += w * (0..3)
+                                .map(|k| p.product((se[k], ss[k]), eps[k]))
+                                .sum::<f64>();
+                        }
+                        let dk = [0, 1, 2].map(|k| (sh[k] - se[k], -ss[k]));
+                        let (d, n) = (
+                            tensor_square(p, dk),
+                            tensor_square(p, [0, 1, 2].map(|k| (se[k], ss[k]))),
+                        );
+                        out.difference.stress += w * d;
+                        out.exact.stress += w * n;
+                        if band[i] {
+                            out.band_stress += w * d;
+                        }
                     }
                 }
             }
@@ -136,16 +207,51 @@ impl<'a> ExactComparison<'a> {
     ) -> (f64, f64) {
         let (mut diff, mut norm) = (0.0, 0.0);
         let kinks = kink_functions(&self.exact.contact_kinks(), t);
+        let singular = self.exact.singular.as_ref();
         for (piece, profile) in interface.pieces.iter().zip(pressure) {
             for w in profile.windows(2) {
                 let ((xa, pa), (xb, pb)) = (w[0], w[1]);
                 let len = (xb[0] - xa[0]).hypot(xb[1] - xa[1]);
+                let exact_at = |x: [f64; 2]| {
+                    self.exact
+                        .pressure_at(piece.normal, x[0], x[1], t)
+                        .unwrap_or(f64::NAN)
+                };
+                // A segment from the singular point: p = p_rest + p_s with p_s ~ r^(beta-1),
+                // the three parts of (p_h - p)^2 and p^2 each by its own Gauss-Jacobi rule.
+                let from_point = singular.and_then(|sg| {
+                    let at = |x: [f64; 2]| sg.distance(x[0], x[1]) <= 1e-12 * len;
+                    (at(xa) || at(xb)).then_some((sg, at(xb)))
+                });
+                if let Some((sg, reversed)) = from_point {
+                    let n = piece.normal;
+                    let singular_at = |x: [f64; 2]| {
+                        let st = sg.stress[0].each_ref().map(|e| e.eval(x[0], x[1], t));
+                        -(n[0] * n[0] * st[0] + n[1] * n[1] * st[1] + 2.0 * n[0] * n[1] * st[2])
+                    };
+                    let beta = sg.exponent;
+                    for (alpha, part) in [
+                        (0.0, Split::Smooth),
+                        (beta - 1.0, Split::Cross),
+                        (2.0 * beta - 2.0, Split::Singular),
+                    ] {
+                        for (r, wq) in quadrature::singular::segment_from(
+                            alpha,
+                            quadrature::singular::SINGULAR_POINTS,
+                        ) {
+                            let q = if reversed { 1.0 - r } else { r };
+                            let x = [xa[0] + q * (xb[0] - xa[0]), xa[1] + q * (xb[1] - xa[1])];
+                            let (exact, ps) = (exact_at(x), singular_at(x));
+                            let ph = pa + q * (pb - pa);
+                            diff += wq * len * part.square(ph - exact, -ps);
+                            norm += wq * len * part.square(exact, ps);
+                        }
+                    }
+                    continue;
+                }
                 for &(q, wq) in quadrature::segment_rule(xa, xb, &kinks, &self.segment).iter() {
                     let x = [xa[0] + q * (xb[0] - xa[0]), xa[1] + q * (xb[1] - xa[1])];
-                    let exact = self
-                        .exact
-                        .pressure_at(piece.normal, x[0], x[1], t)
-                        .unwrap_or(f64::NAN);
+                    let exact = exact_at(x);
                     let ph = pa + q * (pb - pa);
                     diff += wq * len * (ph - exact).powi(2);
                     norm += wq * len * exact * exact;

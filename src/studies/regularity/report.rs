@@ -1,0 +1,330 @@
+//! The report of `study regularity`: errors.csv and rates.csv (each with a `beta` column),
+//! one rate-against-beta plot per quantity with its best uniform-mesh rate, README.md
+//! leading with where the cones differ, and each beta's convergence report in `beta-BETA/`.
+
+use super::{Regularity, best_rate, theorem_applies};
+use crate::contact::Method;
+use crate::error::Result;
+use crate::io::csv_bytes;
+use crate::report::folder::{write, write_folder};
+use crate::report::markdown::{Doc, Table};
+use crate::report::plot::{self, Series};
+use crate::studies::convergence::{RateRow, StudyResult};
+use crate::verify::kind::Outcome;
+use crate::verify::quantity::Quantity;
+use crate::verify::rates::Verdict;
+use serde::Serialize;
+use std::path::Path;
+
+/// The quantities the report tabulates and plots, in order.
+const QUANTITIES: [Quantity; 5] = [
+    Quantity::Theorem,
+    Quantity::H1U,
+    Quantity::BandStress,
+    Quantity::L2Pressure,
+    Quantity::ConeDistance,
+];
+
+/// How far below its best rate a fitted rate may lie and still follow it: the tolerance of
+/// the studies' thresholds, or two standard errors where larger.
+const FOLLOW_TOLERANCE: f64 = 0.05;
+
+/// One row of errors.csv.
+#[derive(Debug, Serialize)]
+struct ErrorRow {
+    beta: f64,
+    method: String,
+    level: usize,
+    h: f64,
+    dofs: usize,
+    quantity: Quantity,
+    error: f64,
+    wall_s: Option<f64>,
+}
+
+/// One row of rates.csv.
+#[derive(Debug, Serialize)]
+struct RateCsv {
+    beta: f64,
+    method: Method,
+    quantity: Quantity,
+    /// The rate in h where the verdict supports one (fitted or drifting).
+    rate: Option<f64>,
+    stderr: Option<f64>,
+    verdict: Verdict,
+    levels_used: String,
+    /// The best rate a uniform P1 mesh can give for this quantity at this beta.
+    best_rate: Option<f64>,
+    /// Whether the rate reaches the best rate (within the tolerance), where both exist.
+    follows_best: Option<bool>,
+    /// Whether Theorem 3.1's hypotheses hold (beta > 1).
+    theorem_applies: bool,
+    /// The study's threshold on the theorem norm and whether it is met.
+    threshold: Option<f64>,
+    pass: Option<bool>,
+}
+
+/// The rate a row's verdict supports (fitted or drifting), with its standard error.
+fn supported(r: &RateRow) -> Option<(f64, f64)> {
+    matches!(r.assessment.verdict, Verdict::Fitted | Verdict::Drifting)
+        .then_some(r.assessment.fit)
+        .flatten()
+        .map(|f| (f.rate, f.stderr))
+}
+
+/// Whether a supported rate reaches `best` (within [`FOLLOW_TOLERANCE`] or 2 standard errors).
+fn follows(rate: (f64, f64), best: f64) -> bool {
+    rate.0 >= best - FOLLOW_TOLERANCE.max(2.0 * rate.1)
+}
+
+fn rate_rows(beta: f64, res: &StudyResult) -> Vec<RateCsv> {
+    res.rates
+        .iter()
+        .map(|r| {
+            let rate = supported(r);
+            let best = best_rate(r.quantity, beta);
+            RateCsv {
+                beta,
+                method: r.method,
+                quantity: r.quantity,
+                rate: rate.map(|x| x.0),
+                stderr: rate.map(|x| x.1),
+                verdict: r.assessment.verdict,
+                levels_used: crate::verify::table::join(&r.assessment.used),
+                best_rate: best,
+                follows_best: rate.zip(best).map(|(x, b)| follows(x, b)),
+                theorem_applies: theorem_applies(beta),
+                threshold: r.threshold.map(|t| t.value()),
+                pass: r.pass,
+            }
+        })
+        .collect()
+}
+
+/// A rate cell: the rate and its standard error where supported, else the verdict.
+fn cell(r: Option<&RateRow>) -> String {
+    match r {
+        Some(r) => match supported(r) {
+            Some((rate, se)) if r.assessment.verdict == Verdict::Drifting => {
+                format!("{rate:.3} ± {se:.3} (drifting)")
+            }
+            Some((rate, se)) => format!("{rate:.3} ± {se:.3}"),
+            None => r.assessment.verdict.name().to_string(),
+        },
+        None => "-".into(),
+    }
+}
+
+impl Regularity {
+    fn row(&self, beta: f64, m: Method, q: Quantity) -> Option<&RateRow> {
+        self.members
+            .iter()
+            .find(|(b, _)| *b == beta)
+            .and_then(|(_, res)| res.rate(m, q))
+    }
+
+    /// One sentence per beta on the theorem norm: each cone's rate beside the best, and
+    /// the gap between the cones.
+    fn differences(&self) -> Vec<String> {
+        self.members
+            .iter()
+            .map(|(beta, _)| {
+                let best = best_rate(Quantity::Theorem, *beta).expect("a best rate");
+                let [mortar, nts] = [Method::Mortar, Method::Nts]
+                    .map(|m| self.row(*beta, m, Quantity::Theorem).and_then(supported));
+                let say = |name: &str, r: Option<(f64, f64)>| match r {
+                    Some(x) if follows(x, best) => format!("{name} {:.2} (follows)", x.0),
+                    Some(x) => format!("{name} {:.2} (**{:.2} below**)", x.0, best - x.0),
+                    None => format!("{name} no rate"),
+                };
+                let dagger = if theorem_applies(*beta) { "" } else { " †" };
+                format!(
+                    "beta = {beta}{dagger}: best min(1, beta) = {best:.2}; {}, {}{}",
+                    say("mortar", mortar),
+                    say("nts", nts),
+                    match (mortar, nts) {
+                        (Some(a), Some(b)) => format!("; mortar - nts = {:+.2}", a.0 - b.0),
+                        _ => String::new(),
+                    }
+                )
+            })
+            .collect()
+    }
+
+    fn readme(&self) -> String {
+        let mut doc = Doc::new();
+        doc.heading(1, "regularity: rates against the regularity of the contact transition");
+        doc.paragraph(
+            "Both cones on a manufactured contact solution whose displacement has a singular part r^beta Phi_l(theta) at the point c = (0.5871, 1) where contact ends (src/analytical/singular.rs; the pressure ~ dist^(beta-1), the gap ~ dist^beta), for each beta, on 6 levels of uniform refinement with c a node of both meshes, measured against the exact solution. The load and the error integrals on the triangles at c split each integrand by power of r, one Gauss-Jacobi rule per power (src/quadrature/singular.rs).",
+        );
+        doc.heading(2, "What differs between the cones (Theorem 3.1's norm)");
+        doc.list(self.differences());
+        doc.paragraph("† Theorem 3.1 does not apply: for beta <= 1 the solution is not in H^2 and the body force ~ r^(beta-2) is not in L2 (it lies in V' only). Its rates 3/4 and 1/2 are claimed only for beta > 1; below, the study requires only convergence (rate >= 0).");
+        doc.heading(2, "Rates in h, mortar / nts, beside the best uniform-mesh rate");
+        let mut t = Table::new(
+            ["beta"]
+                .into_iter()
+                .map(String::from)
+                .chain(QUANTITIES.iter().map(|q| format!("`{q}`"))),
+        );
+        for (beta, _) in &self.members {
+            let dagger = if theorem_applies(*beta) { "" } else { " †" };
+            t.row(std::iter::once(format!("{beta}{dagger}")).chain(QUANTITIES.iter().map(|&q| {
+                let best = best_rate(q, *beta).map_or(String::new(), |b| format!(" (best {b:.2})"));
+                format!(
+                    "{} / {}{best}",
+                    cell(self.row(*beta, Method::Mortar, q)),
+                    cell(self.row(*beta, Method::Nts, q))
+                )
+            })));
+        }
+        doc.table(&t);
+        doc.paragraph("Best rates: min(1, beta) for the H1 and theorem norms; min(beta, 3/2) for the stress in the band of triangles along Gamma_C (pointwise h on a band of area O(h), h^(beta-1) on the triangles at c); min(beta - 1/2, 2) for the pressure in L2(Gamma_C), since p ~ dist^(beta-1). `cone_distance` is the distance between the two cones' solutions on the same meshes (docs/studies.md). A rate is printed only where the verdict supports one (fitted, or drifting); otherwise the verdict.");
+        let stalled: Vec<String> = self
+            .members
+            .iter()
+            .flat_map(|(beta, res)| {
+                res.rates
+                    .iter()
+                    .filter(|r| r.assessment.verdict == Verdict::NotConverging)
+                    .map(move |r| format!("beta = {beta}: {} `{}`", r.method, r.quantity))
+            })
+            .collect();
+        doc.heading(2, "Did not converge");
+        if stalled.is_empty() {
+            doc.paragraph("Every quantity converges.");
+        } else {
+            doc.list(stalled);
+        }
+        let slow: Vec<String> = self
+            .members
+            .iter()
+            .flat_map(|(beta, _)| {
+                QUANTITIES.iter().filter_map(move |&q| {
+                    best_rate(q, *beta)
+                        .filter(|b| *b < crate::verify::rates::STALLED)
+                        .map(|b| format!("`{q}` at beta = {beta} (best {b:.2})"))
+                })
+            })
+            .collect();
+        if !slow.is_empty() {
+            doc.paragraph(format!(
+                "Where the best rate itself lies below the rate rules' stall threshold {} ({}), \"does not converge\" cannot be told from convergence at that rate: the successive rates in the per-beta report show which.",
+                crate::verify::rates::STALLED,
+                slow.join(", ")
+            ));
+        }
+        doc.heading(2, "Rate against beta");
+        for q in QUANTITIES {
+            doc.image(&format!("{q} rate against beta"), &format!("rate_vs_beta_{q}.png"));
+        }
+        doc.heading(2, "Per beta");
+        doc.list(self.members.iter().map(|(beta, res)| {
+            format!(
+                "beta = {beta}: [beta-{beta:.2}/README.md](beta-{beta:.2}/README.md) ({:.0} s)",
+                res.wall_s
+            )
+        }));
+        doc.paragraph("Reproduce: `cargo run --release -- study regularity` (the scenes and the per-beta study files are written by `cargo run --release --example regularity_scenes`).");
+        doc.finish()
+    }
+
+    fn plots(&self, d: &Path) -> Result<()> {
+        for q in QUANTITIES {
+            let mut series = Vec::new();
+            for (i, m) in [Method::Mortar, Method::Nts].into_iter().enumerate() {
+                let points: Vec<(f64, f64)> = self
+                    .members
+                    .iter()
+                    .filter_map(|(beta, _)| {
+                        self.row(*beta, m, q).and_then(supported).map(|r| (*beta, r.0))
+                    })
+                    .collect();
+                if !points.is_empty() {
+                    series.push(Series {
+                        label: m.to_string(),
+                        points,
+                        markers: true,
+                        line: true,
+                        color: i,
+                        thin: false,
+                    });
+                }
+            }
+            if best_rate(q, 1.0).is_some() {
+                let points = (0..=30)
+                    .map(|k| 0.5 + 1.5 * k as f64 / 30.0)
+                    .filter_map(|b| best_rate(q, b).map(|r| (b, r)))
+                    .collect();
+                series.push(Series {
+                    label: "best uniform-mesh rate".into(),
+                    points,
+                    markers: false,
+                    line: true,
+                    color: 2,
+                    thin: true,
+                });
+            }
+            plot::lines(
+                &d.join(format!("rate_vs_beta_{q}.png")),
+                &format!("{q}: rate in h against beta"),
+                "beta",
+                "rate",
+                &series,
+            )?;
+        }
+        Ok(())
+    }
+}
+
+impl Outcome for Regularity {
+    fn write(&self, dir: &Path) -> Result<()> {
+        write_folder(dir, |d| {
+            let errors: Vec<ErrorRow> = self
+                .members
+                .iter()
+                .flat_map(|(beta, res)| {
+                    res.errors.iter().map(move |e| ErrorRow {
+                        beta: *beta,
+                        method: e.method.to_string(),
+                        level: e.level,
+                        h: e.h,
+                        dofs: e.dofs,
+                        quantity: e.quantity,
+                        error: e.error,
+                        wall_s: e.wall_s,
+                    })
+                })
+                .collect();
+            write(d, "errors.csv", &csv_bytes(&errors)?)?;
+            let rates: Vec<RateCsv> = self
+                .members
+                .iter()
+                .flat_map(|(beta, res)| rate_rows(*beta, res))
+                .collect();
+            write(d, "rates.csv", &csv_bytes(&rates)?)?;
+            self.plots(d)?;
+            for (beta, res) in &self.members {
+                crate::studies::convergence::report::write_study(res, &d.join(format!("beta-{beta:.2}")))?;
+            }
+            write(d, "README.md", self.readme().as_bytes())
+        })
+    }
+
+    fn console(&self, dir: &Path) -> String {
+        let mut out = String::new();
+        for line in self.differences() {
+            out.push_str(&line.replace("**", ""));
+            out.push('\n');
+        }
+        out.push_str(&format!("wrote {}\n", dir.display()));
+        out
+    }
+
+    fn failures(&self) -> Vec<String> {
+        self.members
+            .iter()
+            .flat_map(|(beta, res)| res.failures().into_iter().map(move |f| format!("beta = {beta}: {f}")))
+            .collect()
+    }
+}
