@@ -9,6 +9,7 @@ use crate::error::{Error, Result};
 use crate::report::markdown::{Doc, Table};
 use crate::solve::SolverKind;
 use crate::studies::convergence::{LevelInfo, TimeRun};
+use crate::studies::regularity::report::RateCsv as RegularityRate;
 use crate::studies::speed::report::SpeedRecord;
 use crate::studies::stability::StabilityRow;
 use crate::studies::two_size::SizePoint;
@@ -304,6 +305,7 @@ pub fn section(reports: &Path) -> Result<String> {
     for (name, what) in TWO_SIZE {
         two_size_section(&mut doc, &reports.join(name), name, what)?;
     }
+    regularity_section(&mut doc, reports)?;
     doc.heading(
         2,
         format!("[`paper`]({DOCS_REPORTS}/paper/README.md): the paper's three tests regenerated"),
@@ -520,6 +522,9 @@ pub fn headline(reports: &Path) -> Result<String> {
             distances.join(", ")
         ));
     }
+    doc.bullet(regularity_headline(&read(
+        &reports.join("regularity").join("rates.csv"),
+    )?));
     doc.bullet(format!(
         "**Does not converge:** {}.",
         listed(&stalled_anywhere(&studies), "; ", "nothing")
@@ -815,6 +820,100 @@ fn speed_section(doc: &mut Doc, reports: &Path) -> Result<()> {
         ranges.join(", ")
     ))
     .blank();
+    Ok(())
+}
+
+/// The theorem-norm rows of the regularity study's rates.csv of cone `m`, in beta order.
+fn regularity_theorem(rows: &[RegularityRate], m: Method) -> Vec<&RegularityRate> {
+    rows.iter()
+        .filter(|r| r.method == m && r.quantity == Quantity::Theorem)
+        .collect()
+}
+
+/// The betas of `rows` that follow (or not) their best rate, as text.
+fn betas_where(rows: &[&RegularityRate], follows: bool) -> Vec<String> {
+    rows.iter()
+        .filter(|r| r.follows_best == Some(follows))
+        .map(|r| format!("{}", r.beta))
+        .collect()
+}
+
+/// The headline's line on the regularity study: where each cone's theorem-norm rate follows
+/// min(1, beta), and the largest shortfall.
+fn regularity_headline(rows: &[RegularityRate]) -> String {
+    let cone = |m: Method| {
+        let theorem = regularity_theorem(rows, m);
+        let below = betas_where(&theorem, false);
+        let worst = theorem
+            .iter()
+            .filter(|r| r.follows_best == Some(false))
+            .filter_map(|r| Some((r.beta, r.best_rate? - r.rate?, r.rate?)))
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        match worst {
+            None => format!(
+                "{m}'s rate follows it at every beta ({})",
+                listed(&betas_where(&theorem, true), ", ", "none")
+            ),
+            Some((beta, short, rate)) => format!(
+                "{m}'s falls below it at beta = {} (by up to {short:.2}: {rate:.3} at beta = {beta}) and follows it at {}",
+                below.join(", "),
+                listed(&betas_where(&theorem, true), ", ", "no beta")
+            ),
+        }
+    };
+    format!(
+        "**Rates against the regularity of the contact transition** ([`regularity`](reports/regularity/README.md), u ~ r^beta where contact ends, Theorem 3.1's norm against the best uniform-mesh rate min(1, beta)): {}; {}.",
+        cone(Method::Mortar),
+        cone(Method::Nts)
+    )
+}
+
+/// The regularity study: its rate table, beta x cone x quantity, with verdicts.
+fn regularity_section(doc: &mut Doc, reports: &Path) -> Result<()> {
+    let rows: Vec<RegularityRate> = read(&reports.join("regularity").join("rates.csv"))?;
+    doc.heading(
+        2,
+        format!("[`regularity`]({DOCS_REPORTS}/regularity/README.md): rates against the regularity beta of the contact transition (u ~ r^beta there)"),
+    )
+    .bullet(regularity_headline(&rows).replace("(reports/", &format!("({DOCS_REPORTS}/")))
+    .bullet("Theorem 3.1 applies only for beta > 1 (u in H^2, f in L2); † marks the betas where it does not. A rate is shown where its verdict supports one, with \"follows\" where it reaches the best rate within 0.05 (or two standard errors).")
+    .blank();
+    let mut table = Table::new(["beta", "quantity", "best rate", "mortar", "nts"]);
+    let mut keys: Vec<(f64, Quantity)> = Vec::new();
+    for r in &rows {
+        if !keys.contains(&(r.beta, r.quantity)) {
+            keys.push((r.beta, r.quantity));
+        }
+    }
+    for (beta, q) in keys {
+        let of = |m: Method| rows.iter().find(|r| r.beta == beta && r.quantity == q && r.method == m);
+        let text = |r: Option<&RegularityRate>| match r {
+            Some(r) => match (r.rate, r.stderr) {
+                (Some(rate), Some(se)) => format!(
+                    "{rate:.3} ± {se:.3} {}{}",
+                    r.verdict.name(),
+                    match r.follows_best {
+                        Some(true) => ", follows",
+                        Some(false) => ", below",
+                        None => "",
+                    }
+                ),
+                _ => r.verdict.name().to_string(),
+            },
+            None => "-".into(),
+        };
+        let applies = of(Method::Mortar).is_some_and(|r| r.theorem_applies);
+        table.row([
+            format!("{beta}{}", if applies { "" } else { " †" }),
+            format!("`{q}`"),
+            of(Method::Mortar)
+                .and_then(|r| r.best_rate)
+                .map_or("-".into(), |b| format!("{b:.2}")),
+            text(of(Method::Mortar)),
+            text(of(Method::Nts)),
+        ]);
+    }
+    doc.table(&table);
     Ok(())
 }
 

@@ -459,3 +459,39 @@ fn failed_study_leaves_the_previous_report_intact() {
         .collect();
     assert!(left.is_empty(), "temporary folders left behind: {left:?}");
 }
+
+#[test]
+fn a_bad_singular_part_names_its_field_and_fix() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let text = std::fs::read_to_string(repo().join("scenes/regularity-0.60.toml")).unwrap();
+    let geo = repo().join("meshes/two_blocks_point.geo");
+    let text = text.replace(
+        "\"../meshes/two_blocks_point.geo\"",
+        &format!("{:?}", geo.display().to_string()),
+    );
+    let cases: Vec<(String, Vec<&str>)> = vec![
+        (
+            text.replace("exponent = 0.6", "exponent = 0.4"),
+            vec!["scene.toml", "exact.singular.exponent", "> 0.5"],
+        ),
+        (
+            text.replace("manufactured = true", "manufactured = false"),
+            vec!["scene.toml", "exact.singular", "exact.manufactured = true"],
+        ),
+        (
+            text.replace("young = 100.0", "young = 100.0\nlambda = 10.0\nyield_stress = 1.0"),
+            vec!["scene.toml", "exact.singular", "elastic bodies only"],
+        ),
+        (
+            text.replace("point = [0.5871, 1.0]", "point = [0.5871]"),
+            vec!["scene.toml", "exact.singular.point"],
+        ),
+    ];
+    for (text, needles) in cases {
+        let f = dir.path().join("scene.toml");
+        std::fs::write(&f, text).unwrap();
+        fails_with(&solve_scene(&f, &out, &[]), &needles);
+        assert!(!out.exists(), "no output after a failure");
+    }
+}

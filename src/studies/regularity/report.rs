@@ -13,7 +13,7 @@ use crate::studies::convergence::{RateRow, StudyResult};
 use crate::verify::kind::Outcome;
 use crate::verify::quantity::Quantity;
 use crate::verify::rates::Verdict;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// The quantities the report tabulates and plots, in order.
@@ -42,26 +42,33 @@ struct ErrorRow {
     wall_s: Option<f64>,
 }
 
-/// One row of rates.csv.
-#[derive(Debug, Serialize)]
-struct RateCsv {
-    beta: f64,
-    method: Method,
-    quantity: Quantity,
+/// One row of the regularity study's rates.csv.
+#[derive(Debug, Serialize, Deserialize)]
+pub struct RateCsv {
+    /// beta: u ~ r^beta at the transition point.
+    pub beta: f64,
+    /// The cone.
+    pub method: Method,
+    /// The quantity.
+    pub quantity: Quantity,
     /// The rate in h where the verdict supports one (fitted or drifting).
-    rate: Option<f64>,
-    stderr: Option<f64>,
-    verdict: Verdict,
-    levels_used: String,
+    pub rate: Option<f64>,
+    /// Its standard error.
+    pub stderr: Option<f64>,
+    /// What the errors support.
+    pub verdict: Verdict,
+    /// The levels of the fit, space separated.
+    pub levels_used: String,
     /// The best rate a uniform P1 mesh can give for this quantity at this beta.
-    best_rate: Option<f64>,
+    pub best_rate: Option<f64>,
     /// Whether the rate reaches the best rate (within the tolerance), where both exist.
-    follows_best: Option<bool>,
+    pub follows_best: Option<bool>,
     /// Whether Theorem 3.1's hypotheses hold (beta > 1).
-    theorem_applies: bool,
-    /// The study's threshold on the theorem norm and whether it is met.
-    threshold: Option<f64>,
-    pass: Option<bool>,
+    pub theorem_applies: bool,
+    /// The study's threshold on the theorem norm.
+    pub threshold: Option<f64>,
+    /// Whether it is met.
+    pub pass: Option<bool>,
 }
 
 /// The rate a row's verdict supports (fitted or drifting), with its standard error.
@@ -264,6 +271,20 @@ impl Regularity {
                     color: 2,
                     thin: true,
                 });
+            }
+            if q == Quantity::Theorem {
+                // Theorem 3.1's rates, where its hypotheses hold (beta > 1).
+                for (i, m) in [Method::Mortar, Method::Nts].into_iter().enumerate() {
+                    let r = m.theorem_rate();
+                    series.push(Series {
+                        label: format!("Theorem 3.1, {m}: {r} (beta > 1)"),
+                        points: vec![(1.0, r), (2.0, r)],
+                        markers: false,
+                        line: true,
+                        color: i,
+                        thin: true,
+                    });
+                }
             }
             plot::lines(
                 &d.join(format!("rate_vs_beta_{q}.png")),
