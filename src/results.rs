@@ -886,7 +886,10 @@ fn regularity_section(doc: &mut Doc, reports: &Path) -> Result<()> {
         }
     }
     for (beta, q) in keys {
-        let of = |m: Method| rows.iter().find(|r| r.beta == beta && r.quantity == q && r.method == m);
+        let of = |m: Method| {
+            rows.iter()
+                .find(|r| r.beta == beta && r.quantity == q && r.method == m)
+        };
         let text = |r: Option<&RegularityRate>| match r {
             Some(r) => match (r.rate, r.stderr) {
                 (Some(rate), Some(se)) => format!(
@@ -902,7 +905,8 @@ fn regularity_section(doc: &mut Doc, reports: &Path) -> Result<()> {
             },
             None => "-".into(),
         };
-        let applies = of(Method::Mortar).is_some_and(|r| r.theorem_applies);
+        // From any row of this beta: cone_distance has an nts row only.
+        let applies = rows.iter().any(|r| r.beta == beta && r.theorem_applies);
         table.row([
             format!("{beta}{}", if applies { "" } else { " †" }),
             format!("`{q}`"),

@@ -243,3 +243,40 @@ fn headline_cells_state_their_own_rows_rates() {
     println!("{checked} headline cells checked");
     assert!(checked >= 20);
 }
+
+/// docs/results.md's regularity table marks with † exactly the betas where the committed
+/// rates.csv says Theorem 3.1 does not apply, on every quantity's row (cone_distance has
+/// an nts row only).
+#[test]
+fn regularity_table_marks_the_theorem_rows_by_beta() {
+    let text = section(&root().join("reports")).unwrap();
+    let csv = std::fs::read_to_string(root().join("reports/regularity/rates.csv")).unwrap();
+    // Betas as numbers: rates.csv writes 2.0 where the table writes 2.
+    let applies: Vec<(f64, bool)> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (f[0].parse::<f64>().unwrap(), f[9] == "true")
+        })
+        .collect();
+    let rows: Vec<&str> = text
+        .lines()
+        .filter(|l| l.starts_with("| ") && l.contains(" | `"))
+        .filter(|l| {
+            let beta = l[2..].split(' ').next().unwrap().parse::<f64>();
+            beta.is_ok_and(|beta| applies.iter().any(|(b, _)| *b == beta))
+        })
+        .collect();
+    assert!(
+        rows.len() >= 30,
+        "the regularity table has its rows, got {}",
+        rows.len()
+    );
+    for row in rows {
+        let beta: f64 = row[2..].split(' ').next().unwrap().parse().unwrap();
+        let theorem = applies.iter().find(|(b, _)| *b == beta).unwrap().1;
+        let dagger = row.split(" | ").next().unwrap().ends_with('†');
+        assert_eq!(dagger, !theorem, "row {row}: † must mark beta <= 1 only");
+    }
+}
