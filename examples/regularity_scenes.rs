@@ -12,13 +12,19 @@ fn main() -> std::io::Result<()> {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     for &beta in BETAS {
         let member = SingularContact::new(beta);
-        let scene = root.join("scenes").join(format!("{}.toml", scene_name(beta)));
+        let scene = root
+            .join("scenes")
+            .join(format!("{}.toml", scene_name(beta)));
         std::fs::write(&scene, member.scene_toml(1))?;
         let study = study_path(beta);
         std::fs::create_dir_all(study.parent().expect("a folder"))?;
         // Theorem 3.1 needs u in H^2 and f in L2: beta > 1. Below, it claims no rate, and
         // the study asks only that the error converge (rate >= 0).
-        let (mortar, nts, tolerance) = if beta > 1.0 { (0.75, 0.5, 0.05) } else { (0.0, 0.0, 0.0) };
+        let (mortar, nts, tolerance) = if beta > 1.0 {
+            (0.75, 0.5, 0.05)
+        } else {
+            (0.0, 0.0, 0.0)
+        };
         let levels: Vec<String> = LEVELS.iter().map(|l| l.to_string()).collect();
         std::fs::write(
             &study,

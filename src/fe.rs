@@ -688,7 +688,9 @@ impl Model {
             for e in self.elements.iter().filter(|e| e.body == body) {
                 let p = e.nodes.map(|n| self.position(n));
                 let point = singular.map(|s| s.point);
-                for (part, rule) in quadrature::singular::rules(p, &kinks, &triangle, point, &powers) {
+                for (part, rule) in
+                    quadrature::singular::rules(p, &kinks, &triangle, point, &powers)
+                {
                     for &(l1, l2, w) in rule.iter() {
                         let lam = [1.0 - l1 - l2, l1, l2];
                         let x = lam[0] * p[0][0] + lam[1] * p[1][0] + lam[2] * p[2][0];

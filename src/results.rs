@@ -901,7 +901,7 @@ fn regularity_section(doc: &mut Doc, reports: &Path) -> Result<()> {
                         None => "",
                     }
                 ),
-                _ => r.verdict.name().to_string(),
+                _ => format!("{} (successive rates {})", r.verdict.name(), r.successive),
             },
             None => "-".into(),
         };

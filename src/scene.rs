@@ -705,13 +705,20 @@ fn singular_part(
         );
     }
     if sp.point.iter().any(|v| !v.is_finite()) {
-        return bad("exact.singular.point", "give the point as [x, y], two finite numbers");
+        return bad(
+            "exact.singular.point",
+            "give the point as [x, y], two finite numbers",
+        );
     }
     let d = &sp.displacement;
     let parsed = [0, 1].map(|b| {
         let i = order(b);
         [0, 1].map(|c| {
-            Expr::parse(&d[i][c], file, &format!("exact.singular.displacement[{i}][{c}]"))
+            Expr::parse(
+                &d[i][c],
+                file,
+                &format!("exact.singular.displacement[{i}][{c}]"),
+            )
         })
     });
     let [[a, b], [c, e]] = parsed;

@@ -476,7 +476,10 @@ fn a_bad_singular_part_names_its_field_and_fix() {
             vec!["scene.toml", "exact.singular.exponent", "> 0.5"],
         ),
         (
-            text.replace("young = 100.0", "young = 100.0\nlambda = 10.0\nyield_stress = 1.0"),
+            text.replace(
+                "young = 100.0",
+                "young = 100.0\nlambda = 10.0\nyield_stress = 1.0",
+            ),
             vec!["scene.toml", "exact.singular", "elastic bodies only"],
         ),
         (

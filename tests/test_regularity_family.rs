@@ -21,7 +21,10 @@ use contact_rates::verify::exact_error::ExactComparison;
 use contact_rates::verify::field::P1Field;
 
 fn exact_of(beta: f64) -> (Scene, SingularContact) {
-    (Scene::load(&scene_name(beta)).unwrap(), SingularContact::new(beta))
+    (
+        Scene::load(&scene_name(beta)).unwrap(),
+        SingularContact::new(beta),
+    )
 }
 
 #[test]
@@ -45,21 +48,39 @@ fn contact_conditions_hold_down_to_1e_6_from_the_transition_point() {
                 let (t1, t2) = (traction(s1, n), traction(s2, [0.0, 1.0]));
                 let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
                 let tol = 1e-9 * scale;
-                assert!(dot(t1, tau).abs() <= tol && dot(t2, tau).abs() <= tol, "beta {beta}: shear at d = {d:e}, side {side}");
+                assert!(
+                    dot(t1, tau).abs() <= tol && dot(t2, tau).abs() <= tol,
+                    "beta {beta}: shear at d = {d:e}, side {side}"
+                );
                 let gap = ex.gap_at(n, x[0], x[1], 1.0).unwrap();
                 let pressure = ex.pressure_at(n, x[0], x[1], 1.0).unwrap();
                 if side > 0.0 {
                     // Separated: no normal traction on either body, gap g d^beta.
-                    assert!(dot(t1, n).abs() <= tol && dot(t2, n).abs() <= tol, "beta {beta}: normal traction on the free side at d = {d:e}");
+                    assert!(
+                        dot(t1, n).abs() <= tol && dot(t2, n).abs() <= tol,
+                        "beta {beta}: normal traction on the free side at d = {d:e}"
+                    );
                     let want = gk * d.powf(beta);
-                    assert!(gap > 0.0 && (gap - want).abs() <= 1e-9 * want, "beta {beta}: gap {gap:e} vs {want:e} at d = {d:e}");
+                    assert!(
+                        gap > 0.0 && (gap - want).abs() <= 1e-9 * want,
+                        "beta {beta}: gap {gap:e} vs {want:e} at d = {d:e}"
+                    );
                 } else {
                     // Contact: equal normal tractions, no jump, pressure k d^(beta-1).
-                    assert!((dot(t1, n) + dot(t2, n)).abs() <= tol, "beta {beta}: normal tractions differ at d = {d:e}");
+                    assert!(
+                        (dot(t1, n) + dot(t2, n)).abs() <= tol,
+                        "beta {beta}: normal tractions differ at d = {d:e}"
+                    );
                     let u_scale = ex.displacement_at(0, x[0], x[1], 1.0).unwrap()[1].abs();
-                    assert!(gap.abs() <= 1e-9 * u_scale, "beta {beta}: jump {gap:e} at d = {d:e}");
+                    assert!(
+                        gap.abs() <= 1e-9 * u_scale,
+                        "beta {beta}: jump {gap:e} at d = {d:e}"
+                    );
                     let want = pk * d.powf(beta - 1.0);
-                    assert!(pressure > 0.0 && (pressure - want).abs() <= 1e-9 * want, "beta {beta}: pressure {pressure:e} vs {want:e} at d = {d:e}");
+                    assert!(
+                        pressure > 0.0 && (pressure - want).abs() <= 1e-9 * want,
+                        "beta {beta}: pressure {pressure:e} vs {want:e} at d = {d:e}"
+                    );
                 }
                 checked += 1;
             }
@@ -105,12 +126,17 @@ fn derived_loads_match_central_differences_away_from_the_point() {
                     let s = ex.stress_at(b, x, y, 1.0).unwrap();
                     let sd = sigma(x, y);
                     for k in 0..3 {
-                        assert!((s[k] - sd[k]).abs() <= 1e-6 * s.iter().fold(1.0f64, |m, v| m.max(v.abs())));
+                        assert!(
+                            (s[k] - sd[k]).abs()
+                                <= 1e-6 * s.iter().fold(1.0f64, |m, v| m.max(v.abs()))
+                        );
                     }
                 }
             }
         }
-        println!("beta {beta}: body force vs central differences, largest relative difference {worst:.1e}");
+        println!(
+            "beta {beta}: body force vs central differences, largest relative difference {worst:.1e}"
+        );
         assert!(worst < 1e-4, "beta {beta}: {worst:e}");
     }
 }
@@ -179,7 +205,10 @@ fn the_h1_error_of_the_nodal_interpolant_matches_an_independent_integration() {
     let field = P1Field::from_nodal(m, interface, 1.0, u.clone(), None, None).unwrap();
     // 8 x 8 points away from c: the 4 x 4 default leaves 1e-8 there at this coarse level
     // (measured: 1.6451859757e-4 with 4, 1.6451859922e-4 with 6, 8 and 10).
-    let got = ExactComparison::new(ex, 8).difference(m, interface, &field).difference.semi_u;
+    let got = ExactComparison::new(ex, 8)
+        .difference(m, interface, &field)
+        .difference
+        .semi_u;
     // Independent: the triangles at c by polar_brute_force, the others by a 10 x 10
     // collapsed Gauss rule on each of 4^4 sub-triangles where a vertex lies within 0.25 of
     // c, else on 4.
@@ -212,12 +241,20 @@ fn the_h1_error_of_the_nodal_interpolant_matches_an_independent_integration() {
                 .flat_map(|p| {
                     let mid = |a: [f64; 2], b: [f64; 2]| [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
                     let (m01, m12, m20) = (mid(p[0], p[1]), mid(p[1], p[2]), mid(p[2], p[0]));
-                    [[p[0], m01, m20], [m01, p[1], m12], [m20, m12, p[2]], [m12, m20, m01]]
+                    [
+                        [p[0], m01, m20],
+                        [m01, p[1], m12],
+                        [m20, m12, p[2]],
+                        [m12, m20, m01],
+                    ]
                 })
                 .collect();
         }
         for p in pieces {
-            let area = 0.5 * ((p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1])).abs();
+            let area = 0.5
+                * ((p[1][0] - p[0][0]) * (p[2][1] - p[0][1])
+                    - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]))
+                    .abs();
             for &(l1, l2, w) in rule.iter() {
                 let l0 = 1.0 - l1 - l2;
                 let x = [0, 1].map(|k| l0 * p[0][k] + l1 * p[1][k] + l2 * p[2][k]);
@@ -231,9 +268,14 @@ fn the_h1_error_of_the_nodal_interpolant_matches_an_independent_integration() {
             }
         }
     }
-    assert!(at_c >= 4, "the point is a vertex of both meshes' triangles ({at_c})");
+    assert!(
+        at_c >= 4,
+        "the point is a vertex of both meshes' triangles ({at_c})"
+    );
     let rel = (got - want).abs() / want;
-    println!("|u - I u|_H1^2: split Gauss-Jacobi {got:.12e}, independent {want:.12e}, relative difference {rel:.1e} ({at_c} triangles at c)");
+    println!(
+        "|u - I u|_H1^2: split Gauss-Jacobi {got:.12e}, independent {want:.12e}, relative difference {rel:.1e} ({at_c} triangles at c)"
+    );
     assert!(rel < 1e-10, "{rel:e}");
     let _ = gauss_jacobi;
 }

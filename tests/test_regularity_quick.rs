@@ -53,6 +53,9 @@ fn theorem_rates_where_it_applies_and_no_rate_beyond_the_regularity() {
     let best = best_rate(Quantity::Theorem, beta).unwrap();
     for m in [Method::Mortar, Method::Nts] {
         let rate = theorem_rate(&res, m);
-        assert!(rate > 0.0 && rate <= best + 0.05, "{m}: {rate} against the best {best}");
+        assert!(
+            rate > 0.0 && rate <= best + 0.05,
+            "{m}: {rate} against the best {best}"
+        );
     }
 }

@@ -119,7 +119,10 @@ fn single_terms_on_triangles_with_a_vertex_at_the_singular_point() {
                 let scale = polar_reference(t, v, gamma, 0.0).abs();
                 let rel = (got - want).abs() / scale;
                 worst = worst.max(rel);
-                assert!(rel < 1e-12, "gamma {gamma}, k {k}: {got:.15e} vs {want:.15e} ({rel:.1e})");
+                assert!(
+                    rel < 1e-12,
+                    "gamma {gamma}, k {k}: {got:.15e} vs {want:.15e} ({rel:.1e})"
+                );
             }
         }
     }
@@ -141,7 +144,10 @@ fn single_terms_on_a_segment_from_the_singular_point() {
         let want = len.powf(gamma + 1.0) / (gamma + 1.0) + len.powf(gamma + 2.0) / (gamma + 2.0);
         // 1e-12: r is computed from absolute coordinates near c = (0.5871, 1), as the
         // fields are (round-off 1e-16 / r at the innermost Jacobi point).
-        assert!(((got - want) / want).abs() < 1e-12, "gamma {gamma}: {got} vs {want}");
+        assert!(
+            ((got - want) / want).abs() < 1e-12,
+            "gamma {gamma}: {got} vs {want}"
+        );
     }
 }
 
@@ -170,4 +176,3 @@ fn a_triangle_next_to_the_singular_point_split_until_far() {
         assert!(rel < 1e-9, "gamma {gamma}: {got} vs {want} ({rel:.1e})");
     }
 }
-

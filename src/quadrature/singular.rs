@@ -23,7 +23,10 @@ use nalgebra::{DMatrix, SymmetricEigen};
 /// Gauss-Jacobi points and weights on [0, 1] for the weight s^b (b > -1) with `n` points:
 /// sum w_i g(s_i) = int_0^1 s^b g(s) ds for polynomials g of degree <= 2n - 1.
 pub fn gauss_jacobi(n: usize, b: f64) -> Vec<(f64, f64)> {
-    assert!(b > -1.0 && (1..=40).contains(&n), "weight s^b with b > -1, 1 to 40 points");
+    assert!(
+        b > -1.0 && (1..=40).contains(&n),
+        "weight s^b with b > -1, 1 to 40 points"
+    );
     // Monic recurrence of the Jacobi polynomials P^(0, b) on [-1, 1]: diagonal d_k,
     // off-diagonal e_k = sqrt(beta_k) (k >= 1), mu0 = int (1 + x)^b dx = 2^(b+1) / (b + 1).
     let d = |k: usize| {
@@ -67,7 +70,11 @@ pub fn gauss_jacobi(n: usize, b: f64) -> Vec<(f64, f64)> {
             for _ in 0..3 {
                 let (mut p, mut dp) = (vec![1.0 / mu0.sqrt()], vec![0.0]);
                 for k in 0..n {
-                    let (pp, dpp) = if k == 0 { (0.0, 0.0) } else { (e(k) * p[k - 1], e(k) * dp[k - 1]) };
+                    let (pp, dpp) = if k == 0 {
+                        (0.0, 0.0)
+                    } else {
+                        (e(k) * p[k - 1], e(k) * dp[k - 1])
+                    };
                     p.push(((x - d(k)) * p[k] - pp) / e(k + 1));
                     dp.push((p[k] + (x - d(k)) * dp[k] - dpp) / e(k + 1));
                 }
@@ -98,7 +105,10 @@ pub const SINGULAR_POINTS: usize = 12;
 /// sub-wedges of at most pi/6 (L(tau)^alpha is analytic but varies faster the wider the
 /// angle: measured, one 12-point rule over an angle of 2.2 rad was off by 5e-7).
 pub fn vertex_rule(t: &[[f64; 2]; 3], v: usize, alpha: f64, n: usize) -> Vec<(f64, f64, f64)> {
-    assert!(alpha > -2.0, "r^alpha is integrable on a triangle only for alpha > -2");
+    assert!(
+        alpha > -2.0,
+        "r^alpha is integrable on a triangle only for alpha > -2"
+    );
     let radial = gauss_jacobi(n, alpha + 1.0);
     let across = super::gauss_legendre(n);
     let (i1, i2) = ((v + 1) % 3, (v + 2) % 3);
@@ -106,7 +116,9 @@ pub fn vertex_rule(t: &[[f64; 2]; 3], v: usize, alpha: f64, n: usize) -> Vec<(f6
         [t[i1][0] - t[v][0], t[i1][1] - t[v][1]],
         [t[i2][0] - t[v][0], t[i2][1] - t[v][1]],
     );
-    let angle = (a[0] * b[1] - a[1] * b[0]).abs().atan2(a[0] * b[0] + a[1] * b[1]);
+    let angle = (a[0] * b[1] - a[1] * b[0])
+        .abs()
+        .atan2(a[0] * b[0] + a[1] * b[1]);
     let wedges = (angle / (std::f64::consts::PI / 6.0)).ceil().max(1.0) as usize;
     let mut rule = Vec::with_capacity(n * n * wedges);
     for k in 0..wedges {
@@ -157,7 +169,8 @@ fn distance(t: &[[f64; 2]; 3], c: [f64; 2]) -> f64 {
         .map(|i| {
             let (a, b) = (t[i], t[(i + 1) % 3]);
             let ab = [b[0] - a[0], b[1] - a[1]];
-            let s = (((c[0] - a[0]) * ab[0] + (c[1] - a[1]) * ab[1]) / (ab[0] * ab[0] + ab[1] * ab[1]))
+            let s = (((c[0] - a[0]) * ab[0] + (c[1] - a[1]) * ab[1])
+                / (ab[0] * ab[0] + ab[1] * ab[1]))
                 .clamp(0.0, 1.0);
             (a[0] + s * ab[0] - c[0]).hypot(a[1] + s * ab[1] - c[1])
         })
@@ -173,7 +186,12 @@ pub fn is_near(t: &[[f64; 2]; 3], c: [f64; 2]) -> bool {
 /// `base` (a rule of the reference triangle, weights summing to 1) on the pieces of `t`
 /// split into four recursively until each piece is at least two of its diameters from `c`
 /// (at most `depth` times), as barycentric pairs of `t` and weights summing to 1.
-pub fn near_rule(t: [[f64; 2]; 3], c: [f64; 2], base: &[(f64, f64, f64)], depth: usize) -> Vec<(f64, f64, f64)> {
+pub fn near_rule(
+    t: [[f64; 2]; 3],
+    c: [f64; 2],
+    base: &[(f64, f64, f64)],
+    depth: usize,
+) -> Vec<(f64, f64, f64)> {
     // Pieces in barycentric coordinates (l1, l2) of t, with their area fraction.
     let mut out = Vec::new();
     let to_x = |l: [f64; 2]| {
@@ -186,7 +204,12 @@ pub fn near_rule(t: [[f64; 2]; 3], c: [f64; 2], base: &[(f64, f64, f64)], depth:
         if level < depth && is_near(&x, c) {
             let mid = |a: [f64; 2], b: [f64; 2]| [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
             let (m01, m12, m20) = (mid(p[0], p[1]), mid(p[1], p[2]), mid(p[2], p[0]));
-            for child in [[p[0], m01, m20], [m01, p[1], m12], [m20, m12, p[2]], [m12, m20, m01]] {
+            for child in [
+                [p[0], m01, m20],
+                [m01, p[1], m12],
+                [m20, m12, p[2]],
+                [m12, m20, m01],
+            ] {
                 stack.push((child, 0.25 * fraction, level + 1));
             }
             continue;

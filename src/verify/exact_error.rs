@@ -150,7 +150,8 @@ impl<'a> ExactComparison<'a> {
                         let mut ge_all = [[(0.0, 0.0); 2]; 2];
                         for c in 0..2 {
                             let ue = u[b][c].eval(x[0], x[1], t);
-                            let us = sing.map_or(0.0, |sg| sg.displacement[b][c].eval(x[0], x[1], t));
+                            let us =
+                                sing.map_or(0.0, |sg| sg.displacement[b][c].eval(x[0], x[1], t));
                             let uhc: f64 = (0..3).map(|a| lam[a] * uh[a][c]).sum();
                             if let Some(p) = u_part {
                                 out.difference.l2_u += w * p.square(uhc - ue, -us);
@@ -158,7 +159,8 @@ impl<'a> ExactComparison<'a> {
                             }
                             for d in 0..2 {
                                 let ge = g[b][c][d].eval(x[0], x[1], t);
-                                let gs = sing.map_or(0.0, |sg| sg.gradient[b][c][d].eval(x[0], x[1], t));
+                                let gs =
+                                    sing.map_or(0.0, |sg| sg.gradient[b][c][d].eval(x[0], x[1], t));
                                 if let Some(p) = g_part {
                                     out.difference.semi_u += w * p.square(grad_h[c][d] - ge, -gs);
                                     out.exact.semi_u += w * p.square(ge, gs);
@@ -175,10 +177,15 @@ impl<'a> ExactComparison<'a> {
                         });
                         if let Some(g) = grad_e {
                             // sigma : eps(u) = s11 e11 + s22 e22 + 2 s12 e12.
-                            let eps = [g[0][0], g[1][1], (g[0][1].0 + g[1][0].0, g[0][1].1 + g[1][0].1)];
-                            out.energy += w * (0..3)
-                                .map(|k| p.product((se[k], ss[k]), eps[k]))
-                                .sum::<f64>();
+                            let eps = [
+                                g[0][0],
+                                g[1][1],
+                                (g[0][1].0 + g[1][0].0, g[0][1].1 + g[1][0].1),
+                            ];
+                            out.energy += w
+                                * (0..3)
+                                    .map(|k| p.product((se[k], ss[k]), eps[k]))
+                                    .sum::<f64>();
                         }
                         let dk = [0, 1, 2].map(|k| (sh[k] - se[k], -ss[k]));
                         let (d, n) = (

@@ -59,6 +59,8 @@ pub struct RateCsv {
     pub verdict: Verdict,
     /// The levels of the fit, space separated.
     pub levels_used: String,
+    /// Successive rates between neighbouring levels, space separated.
+    pub successive: String,
     /// The best rate a uniform P1 mesh can give for this quantity at this beta.
     pub best_rate: Option<f64>,
     /// Whether the rate reaches the best rate (within the tolerance), where both exist.
@@ -77,6 +79,16 @@ fn supported(r: &RateRow) -> Option<(f64, f64)> {
         .then_some(r.assessment.fit)
         .flatten()
         .map(|f| (f.rate, f.stderr))
+}
+
+/// The successive rates of a row, space separated ("-" next to a level at round-off).
+fn successive(r: &RateRow) -> String {
+    r.assessment
+        .successive
+        .iter()
+        .map(|s| s.map_or("-".into(), |s| format!("{s:.3}")))
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 /// Whether a supported rate reaches `best` (within [`FOLLOW_TOLERANCE`] or 2 standard errors).
@@ -98,6 +110,7 @@ fn rate_rows(beta: f64, res: &StudyResult) -> Vec<RateCsv> {
                 stderr: rate.map(|x| x.1),
                 verdict: r.assessment.verdict,
                 levels_used: crate::verify::table::join(&r.assessment.used),
+                successive: successive(r),
                 best_rate: best,
                 follows_best: rate.zip(best).map(|(x, b)| follows(x, b)),
                 theorem_applies: theorem_applies(beta),
@@ -203,23 +216,29 @@ impl Regularity {
         } else {
             doc.list(stalled);
         }
+        // Where the best rate itself is below the rules' stall threshold, the verdict
+        // cannot tell slow convergence from none: the successive rates say which.
         let slow: Vec<String> = self
             .members
             .iter()
-            .flat_map(|(beta, _)| {
+            .flat_map(|(beta, res)| {
                 QUANTITIES.iter().filter_map(move |&q| {
-                    best_rate(q, *beta)
-                        .filter(|b| *b < crate::verify::rates::STALLED)
-                        .map(|b| format!("`{q}` at beta = {beta} (best {b:.2})"))
+                    let best = best_rate(q, *beta).filter(|b| *b < crate::verify::rates::STALLED)?;
+                    let successive = |m: Method| res.rate(m, q).map_or("-".into(), successive);
+                    Some(format!(
+                        "`{q}` at beta = {beta} (best {best:.2}): successive rates mortar {}, nts {}",
+                        successive(Method::Mortar),
+                        successive(Method::Nts)
+                    ))
                 })
             })
             .collect();
         if !slow.is_empty() {
             doc.paragraph(format!(
-                "Where the best rate itself lies below the rate rules' stall threshold {} ({}), \"does not converge\" cannot be told from convergence at that rate: the successive rates in the per-beta report show which.",
-                crate::verify::rates::STALLED,
-                slow.join(", ")
+                "Where the best rate itself lies below the rate rules' stall threshold {}, their verdict \"not converging\" cannot be told from convergence at that rate; the successive rates say which:",
+                crate::verify::rates::STALLED
             ));
+            doc.list(slow);
         }
         doc.heading(2, "Rate against beta");
         for q in QUANTITIES {
