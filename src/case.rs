@@ -512,6 +512,7 @@ pub fn verify_exact(
     let supports = support_samples(model, raw);
     let scales = exact_scales(ex, &contact, &supports, &times);
     check_symmetry(model, ex, &times, scales.0)?;
+    check_singular_point(model, ex)?;
     for &t in &times {
         let failure = contact
             .iter()
@@ -534,6 +535,36 @@ pub fn verify_exact(
                 format!(
                     "the exact solution is not a solution of the contact problem: {what} at (x, y) = ({:.6}, {:.6}), t = {t}; fix the [exact] fields",
                     x[0], x[1]
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Refuse a singular point that is not a node of both meshes: the rules split by power of
+/// r only on triangles with a vertex there, and a triangle straddling the point would be
+/// integrated without them.
+fn check_singular_point(model: &Model, ex: &Exact) -> Result<()> {
+    let Some(s) = &ex.singular else {
+        return Ok(());
+    };
+    for (b, mesh) in model.meshes.iter().enumerate() {
+        let scale = mesh
+            .nodes
+            .iter()
+            .fold(0.0f64, |m, x| m.max(x[0].abs()).max(x[1].abs()));
+        if !mesh
+            .nodes
+            .iter()
+            .any(|x| s.distance(x[0], x[1]) <= 1e-12 * scale.max(1.0))
+        {
+            return Err(Error::input(
+                &model.scene.file,
+                "exact.singular.point",
+                format!(
+                    "the singular point ({}, {}) is not a node of body '{}'; put a geometry point there in the .geo, on both bodies (as meshes/two_blocks_point.geo does)",
+                    s.point[0], s.point[1], model.scene.bodies[b].surface
                 ),
             ));
         }

@@ -486,6 +486,15 @@ fn a_bad_singular_part_names_its_field_and_fix() {
             text.replace("point = [0.5871, 1.0]", "point = [0.5871]"),
             vec!["scene.toml", "exact.singular.point"],
         ),
+        (
+            text.replace("point = [0.5871, 1.0]", "point = [0.5, 1.0]"),
+            vec![
+                "scene.toml",
+                "exact.singular.point",
+                "not a node of body 'upper'",
+                ".geo",
+            ],
+        ),
     ];
     for (text, needles) in cases {
         let f = dir.path().join("scene.toml");
