@@ -81,6 +81,15 @@ impl Split {
     fn square(self, a: f64, a_s: f64) -> f64 {
         self.product((a, a_s), (a, a_s))
     }
+
+    /// `w` times [`Split::square`]; the whole one as (w a) a, the order the exact norms have
+    /// always been summed in, so that scenes without a singular part keep their digits.
+    fn weighted_square(self, w: f64, a: f64, a_s: f64) -> f64 {
+        match self {
+            Split::Whole => w * a * a,
+            _ => w * self.square(a, a_s),
+        }
+    }
 }
 
 /// s11^2 + s22^2 + 2 s12^2, its part `p`, each component as (whole, singular part).
@@ -116,6 +125,7 @@ impl<'a> ExactComparison<'a> {
         let beta = singular.map_or(1.0, |sg| sg.exponent);
         // The powers of r of SPLIT_PARTS's rules.
         let powers = [0.0, beta - 1.0, beta, 2.0 * beta - 2.0, 2.0 * beta];
+        let point = singular.map(|sg| sg.point);
         for (i, el) in m.elements.iter().enumerate() {
             let b = el.body;
             let pos = el.nodes.map(|n| m.position(n));
@@ -129,7 +139,6 @@ impl<'a> ExactComparison<'a> {
                 }
             }
             let sh = [s.stress[i][0], s.stress[i][1], s.stress[i][2]];
-            let point = singular.map(|sg| sg.point);
             for (part, rule) in
                 quadrature::singular::rules(pos, &kinks[b], &self.triangle, point, &powers)
             {
@@ -155,7 +164,7 @@ impl<'a> ExactComparison<'a> {
                             let uhc: f64 = (0..3).map(|a| lam[a] * uh[a][c]).sum();
                             if let Some(p) = u_part {
                                 out.difference.l2_u += w * p.square(uhc - ue, -us);
-                                out.exact.l2_u += w * p.square(ue, us);
+                                out.exact.l2_u += p.weighted_square(w, ue, us);
                             }
                             for d in 0..2 {
                                 let ge = g[b][c][d].eval(x[0], x[1], t);
@@ -163,7 +172,7 @@ impl<'a> ExactComparison<'a> {
                                     sing.map_or(0.0, |sg| sg.gradient[b][c][d].eval(x[0], x[1], t));
                                 if let Some(p) = g_part {
                                     out.difference.semi_u += w * p.square(grad_h[c][d] - ge, -gs);
-                                    out.exact.semi_u += w * p.square(ge, gs);
+                                    out.exact.semi_u += p.weighted_square(w, ge, gs);
                                 }
                                 ge_all[c][d] = (ge, gs);
                             }
