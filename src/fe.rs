@@ -685,9 +685,9 @@ impl Model {
             // rest of the load, each with its own rule on the triangles at the point.
             let singular = exact.and_then(|e| e.singular.as_ref());
             let powers = singular.map_or([0.0; 2], |s| [0.0, s.exponent - 2.0]);
+            let point = singular.map(|s| s.point);
             for e in self.elements.iter().filter(|e| e.body == body) {
                 let p = e.nodes.map(|n| self.position(n));
-                let point = singular.map(|s| s.point);
                 for (part, rule) in
                     quadrature::singular::rules(p, &kinks, &triangle, point, &powers)
                 {

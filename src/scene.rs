@@ -710,19 +710,7 @@ fn singular_part(
             "give the point as [x, y], two finite numbers",
         );
     }
-    let d = &sp.displacement;
-    let parsed = [0, 1].map(|b| {
-        let i = order(b);
-        [0, 1].map(|c| {
-            Expr::parse(
-                &d[i][c],
-                file,
-                &format!("exact.singular.displacement[{i}][{c}]"),
-            )
-        })
-    });
-    let [[a, b], [c, e]] = parsed;
-    Ok([[a?, b?], [c?, e?]])
+    parse_displacement(&sp.displacement, order, file, "exact.singular.displacement")
 }
 
 /// `exact.displacement` per body in slave-first order (`order` maps it to file order).
@@ -731,16 +719,25 @@ fn exact_displacement(
     order: impl Fn(usize) -> usize,
     file: &Path,
 ) -> Result<Option<[[Expr; 2]; 2]>> {
-    let displacement = spec.displacement.as_ref().map(|d| {
-        [0, 1].map(|b| {
-            let i = order(b);
-            [0, 1].map(|c| Expr::parse(&d[i][c], file, &format!("exact.displacement[{i}][{c}]")))
-        })
+    spec.displacement
+        .as_ref()
+        .map(|d| parse_displacement(d, order, file, "exact.displacement"))
+        .transpose()
+}
+
+/// A displacement [[u_x, u_y], [u_x, u_y]] in file order parsed into slave-first order
+/// (`order` maps it to file order); `field` names it in errors (`field[i][c]`).
+fn parse_displacement(
+    d: &[[String; 2]; 2],
+    order: impl Fn(usize) -> usize,
+    file: &Path,
+    field: &str,
+) -> Result<[[Expr; 2]; 2]> {
+    let [[a, b], [c, e]] = [0, 1].map(|b| {
+        let i = order(b);
+        [0, 1].map(|c| Expr::parse(&d[i][c], file, &format!("{field}[{i}][{c}]")))
     });
-    Ok(match displacement {
-        Some([[a, b], [c, d]]) => Some([[a?, b?], [c?, d?]]),
-        None => None,
-    })
+    Ok([[a?, b?], [c?, e?]])
 }
 
 /// An exact stress [s11, s22, s12] per body, slave first.

@@ -132,13 +132,7 @@ fn round_trip_of_this_projects_solves_gives_the_study_errors() {
     .unwrap();
     let mine = errors_of(&g, "outside");
     // A distance between the cones is no property of one solution: not graded.
-    let graded: Vec<Quantity> = study
-        .file
-        .quantities
-        .iter()
-        .copied()
-        .filter(|q| !q.is_distance())
-        .collect();
+    let graded: Vec<Quantity> = study.file.solution_quantities().collect();
     assert_eq!(mine.len(), 3 * graded.len());
     let mut worst = 0.0f64;
     for r in &mine {

@@ -52,39 +52,36 @@ pub fn gauss_jacobi(n: usize, b: f64) -> Vec<(f64, f64)> {
         }
     }
     let eig = SymmetricEigen::new(jacobi);
-    // p_0 .. p_n orthonormal at x: p_{k+1} e_{k+1} = (x - d_k) p_k - e_k p_{k-1}.
+    // p_0 .. p_n orthonormal at x, p_{k+1} e_{k+1} = (x - d_k) p_k - e_k p_{k-1}, and
+    // their derivatives (the recurrence differentiated).
     let orthonormal = |x: f64| {
-        let mut p = vec![1.0 / mu0.sqrt(); 1];
+        let (mut p, mut dp) = (vec![1.0 / mu0.sqrt()], vec![0.0]);
         for k in 0..n {
-            let prev = if k == 0 { 0.0 } else { e(k) * p[k - 1] };
-            p.push(((x - d(k)) * p[k] - prev) / e(k + 1));
+            let (pp, dpp) = if k == 0 {
+                (0.0, 0.0)
+            } else {
+                (e(k) * p[k - 1], e(k) * dp[k - 1])
+            };
+            p.push(((x - d(k)) * p[k] - pp) / e(k + 1));
+            dp.push((p[k] + (x - d(k)) * dp[k] - dpp) / e(k + 1));
         }
-        p
+        (p, dp)
     };
     let mut rule: Vec<(f64, f64)> = eig
         .eigenvalues
         .iter()
         .map(|&x0| {
-            // Newton on p_n (p_n' by differentiating the recurrence).
+            // Newton on p_n.
             let mut x = x0;
             for _ in 0..3 {
-                let (mut p, mut dp) = (vec![1.0 / mu0.sqrt()], vec![0.0]);
-                for k in 0..n {
-                    let (pp, dpp) = if k == 0 {
-                        (0.0, 0.0)
-                    } else {
-                        (e(k) * p[k - 1], e(k) * dp[k - 1])
-                    };
-                    p.push(((x - d(k)) * p[k] - pp) / e(k + 1));
-                    dp.push((p[k] + (x - d(k)) * dp[k] - dpp) / e(k + 1));
-                }
+                let (p, dp) = orthonormal(x);
                 if dp[n] != 0.0 {
                     x -= p[n] / dp[n];
                 }
             }
             // Christoffel: w = 1 / sum_{k < n} p_k(x)^2 for the weight (1 + x)^b on [-1, 1];
             // on [0, 1] with s^b the weights scale by 2^-(b+1).
-            let p = orthonormal(x);
+            let (p, _) = orthonormal(x);
             let w = 1.0 / p[..n].iter().map(|v| v * v).sum::<f64>();
             (0.5 * (1.0 + x), w * 2f64.powf(-(b + 1.0)))
         })
@@ -157,11 +154,8 @@ fn diameter(t: &[[f64; 2]; 3]) -> f64 {
 
 /// Distance from `c` to the triangle `t` (0 inside).
 fn distance(t: &[[f64; 2]; 3], c: [f64; 2]) -> f64 {
-    let twice_area = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| {
-        (q[0] - p[0]) * (r[1] - p[1]) - (r[0] - p[0]) * (q[1] - p[1])
-    };
-    let full = twice_area(t[0], t[1], t[2]);
-    let inside = (0..3).all(|i| twice_area(t[i], t[(i + 1) % 3], c) * full >= 0.0);
+    let full = super::twice_area(t);
+    let inside = (0..3).all(|i| super::twice_area(&[t[i], t[(i + 1) % 3], c]) * full >= 0.0);
     if inside {
         return 0.0;
     }

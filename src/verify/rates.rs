@@ -570,6 +570,16 @@ pub fn fit_power_sum(points: &[(f64, f64, f64)]) -> Option<PowerSumFit> {
 }
 
 impl Assessment {
+    /// The successive rates, space separated, 3 decimals ("-" next to a level at
+    /// round-off), as rates.csv and the reports write them.
+    pub fn successive_text(&self) -> String {
+        self.successive
+            .iter()
+            .map(|s| s.map_or("-".into(), |s| format!("{s:.3}")))
+            .collect::<Vec<_>>()
+            .join(" ")
+    }
+
     /// The judged rate with its standard error, or the verdict that replaces it, as reports
     /// write it.
     pub fn describe(&self) -> String {

@@ -237,6 +237,12 @@ pub fn resolve(name_or_path: &str) -> Option<PathBuf> {
 }
 
 impl StudyFile {
+    /// The file's quantities measured on one solution: all but the distances between the
+    /// cones (which are measured between two).
+    pub fn solution_quantities(&self) -> impl Iterator<Item = Quantity> + '_ {
+        self.quantities.iter().copied().filter(|q| !q.is_distance())
+    }
+
     /// Read and validate a study file.
     pub fn load(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;

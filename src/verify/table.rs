@@ -188,12 +188,7 @@ impl RateRecord {
             threshold,
             pass,
             rate_dofs: a.fit_dofs.map(|f| -f.rate),
-            successive: a
-                .successive
-                .iter()
-                .map(|s| s.map_or("-".into(), |s| format!("{s:.3}")))
-                .collect::<Vec<_>>()
-                .join(" "),
+            successive: a.successive_text(),
             verdict: a.verdict,
             rate_all_levels: a.fit_all.and_then(|f| finite(f.rate)),
             observed_order: a.celik.and_then(|c| finite(c.order)),

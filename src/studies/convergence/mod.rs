@@ -619,10 +619,8 @@ fn error_rows(
     sol: &Solution,
     errors: &BTreeMap<Quantity, f64>,
 ) -> Result<Vec<ErrorRecord>> {
-    sf.quantities
-        .iter()
-        .filter(|q| !q.is_distance())
-        .map(|&quantity| {
+    sf.solution_quantities()
+        .map(|quantity| {
             let error = errors[&quantity];
             if !error.is_finite() {
                 return Err(Error::NotConverged(format!(

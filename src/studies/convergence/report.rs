@@ -41,15 +41,6 @@ fn rate_record(r: &RateRow) -> RateRecord {
     )
 }
 
-fn successive(r: &RateRow) -> String {
-    r.assessment
-        .successive
-        .iter()
-        .map(|s| s.map_or("-".into(), |s| format!("{s:.3}")))
-        .collect::<Vec<_>>()
-        .join(" ")
-}
-
 /// "rate >= 0.70" or "error <= 1e-9", with `digits` decimals for a rate.
 fn threshold_text(t: Threshold, digits: usize) -> String {
     match t {
@@ -458,13 +449,7 @@ fn quantities_compared(res: &StudyResult) -> (Vec<Quantity>, Vec<String>) {
             .all(|&m| rate_row(res, m, q).is_some_and(|r| r.assessment.verdict.compares_cones()))
     };
     // The distances between the cones have a section of their own.
-    let quantities: Vec<Quantity> = res
-        .file
-        .quantities
-        .iter()
-        .copied()
-        .filter(|q| !q.is_distance())
-        .collect();
+    let quantities: Vec<Quantity> = res.file.solution_quantities().collect();
     let ordered = quantities
         .iter()
         .filter(|q| q.is_contact())
@@ -548,7 +533,7 @@ fn rates_table(doc: &mut Doc, res: &StudyResult) {
             fmt_rate(r),
             join(&a.used),
             fmt3(r.rate_dofs().unwrap_or(f64::NAN)),
-            successive(r),
+            r.assessment.successive_text(),
             fmt_order(r),
             a.celik
                 .map_or("-".into(), |c| format!("{:.2e}", c.gci_fine)),
@@ -713,7 +698,7 @@ fn families_table(res: &StudyResult) -> Table {
             let mut cells = vec![q.to_string(), m.to_string()];
             cells.extend(rows.iter().map(|r| {
                 r.map_or("-".into(), |r| {
-                    format!("{} ({})", verdict_text(r), successive(r))
+                    format!("{} ({})", verdict_text(r), r.assessment.successive_text())
                 })
             }));
             let fitted: Vec<f64> = rows

@@ -81,16 +81,6 @@ fn supported(r: &RateRow) -> Option<(f64, f64)> {
         .map(|f| (f.rate, f.stderr))
 }
 
-/// The successive rates of a row, space separated ("-" next to a level at round-off).
-fn successive(r: &RateRow) -> String {
-    r.assessment
-        .successive
-        .iter()
-        .map(|s| s.map_or("-".into(), |s| format!("{s:.3}")))
-        .collect::<Vec<_>>()
-        .join(" ")
-}
-
 /// Whether a supported rate reaches `best` (within [`FOLLOW_TOLERANCE`] or 2 standard errors).
 fn follows(rate: (f64, f64), best: f64) -> bool {
     rate.0 >= best - FOLLOW_TOLERANCE.max(2.0 * rate.1)
@@ -110,7 +100,7 @@ fn rate_rows(beta: f64, res: &StudyResult) -> Vec<RateCsv> {
                 stderr: rate.map(|x| x.1),
                 verdict: r.assessment.verdict,
                 levels_used: crate::verify::table::join(&r.assessment.used),
-                successive: successive(r),
+                successive: r.assessment.successive_text(),
                 best_rate: best,
                 follows_best: rate.zip(best).map(|(x, b)| follows(x, b)),
                 theorem_applies: theorem_applies(beta),
@@ -224,7 +214,9 @@ impl Regularity {
             .flat_map(|(beta, res)| {
                 QUANTITIES.iter().filter_map(move |&q| {
                     let best = best_rate(q, *beta).filter(|b| *b < crate::verify::rates::STALLED)?;
-                    let successive = |m: Method| res.rate(m, q).map_or("-".into(), successive);
+                    let successive = |m: Method| {
+                        res.rate(m, q).map_or("-".into(), |r| r.assessment.successive_text())
+                    };
                     Some(format!(
                         "`{q}` at beta = {beta} (best {best:.2}): successive rates mortar {}, nts {}",
                         successive(Method::Mortar),
