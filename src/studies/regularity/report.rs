@@ -283,20 +283,6 @@ impl Regularity {
                     thin: true,
                 });
             }
-            if q == Quantity::Theorem {
-                // Theorem 3.1's rates, where its hypotheses hold (beta > 1).
-                for (i, m) in [Method::Mortar, Method::Nts].into_iter().enumerate() {
-                    let r = m.theorem_rate();
-                    series.push(Series {
-                        label: format!("Theorem 3.1, {m}: {r} (beta > 1)"),
-                        points: vec![(1.0, r), (2.0, r)],
-                        markers: false,
-                        line: true,
-                        color: i,
-                        thin: true,
-                    });
-                }
-            }
             plot::lines(
                 &d.join(format!("rate_vs_beta_{q}.png")),
                 &format!("{q}: rate in h against beta"),
