@@ -13,8 +13,8 @@
 use contact_rates::case::Case;
 use contact_rates::contact::Method;
 use contact_rates::scene::Scene;
+use contact_rates::solve::floor::shifted_stiffness;
 use contact_rates::solve::linear::OrderedCholesky;
-use contact_rates::solve::newton::FLOOR_SHIFT;
 use contact_rates::solve::ordering;
 use std::io::Write;
 use std::time::Instant;
@@ -37,14 +37,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let case = Case::build(&scene, level, Method::Mortar, &params)?;
     let model = &case.problem.model;
     let n = model.n_free;
-    let (pattern, slots) = model.stiffness_pattern(&[], n);
-    let mut values = vec![0.0; pattern.nnz()];
-    model.add_tangent(&model.elastic_tangents(), &slots, &mut values);
-    let diagonal: Vec<usize> = (0..n).map(|i| pattern.slot(i, i)).collect();
-    let shift = FLOOR_SHIFT * diagonal.iter().map(|&s| values[s]).sum::<f64>() / n as f64;
-    for &s in &diagonal {
-        values[s] += shift;
-    }
+    let (pattern, values, _) = shifted_stiffness(model);
     std::fs::create_dir_all(dir)?;
     println!("level {level}: {n} dofs");
     for (b, range) in pattern.diagonal_blocks().into_iter().enumerate() {

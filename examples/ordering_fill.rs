@@ -13,7 +13,7 @@
 //! (sequential, bodies one after the other). Timings are single runs: read them with the
 //! flops beside them.
 use contact_rates::solve::ordering::{self, Method};
-use contact_rates::solve::{Problem, newton::FLOOR_SHIFT};
+use contact_rates::solve::{Problem, floor::shifted_stiffness};
 use contact_rates::{case::Case, contact::Method as ContactMethod, fe::Pattern, scene::Scene};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
@@ -97,14 +97,8 @@ fn main() {
         let p: &Problem = &case.problem;
         let model = &p.model;
         let n = model.n_free;
-        let (pattern, slots) = model.stiffness_pattern(&[], n);
-        let mut values = vec![0.0; pattern.nnz()];
-        model.add_tangent(&model.elastic_tangents(), &slots, &mut values);
         // The floor's shift: a body held only by contact stays factorizable.
-        let mean = (0..n).map(|i| values[pattern.slot(i, i)]).sum::<f64>() / n as f64;
-        for i in 0..n {
-            values[pattern.slot(i, i)] += FLOOR_SHIFT * mean;
-        }
+        let (pattern, values, _) = shifted_stiffness(model);
         let mut on_interface = vec![false; n];
         for row in &p.rows {
             for &(d, _) in &row.entries {

@@ -126,9 +126,20 @@ fn body() -> contact_rates::error::Result<()> {
             continue;
         }
         let before = usage();
-        let floor = solve::floor_time(&case.problem, 4)?;
+        let floor = solve::floor(&case.problem, 4)?;
         println!("{}", usage_line("floor", before));
-        println!("run {r} floor total={floor:.4} {}", pieces_line());
+        println!(
+            "run {r} floor total={:.4} ({:?}) double={:.4} single={} systems={} applications={} {}",
+            floor.seconds,
+            floor.precision,
+            floor.double_s,
+            floor
+                .single_s
+                .map_or("missed".into(), |s| format!("{s:.4}")),
+            floor.systems,
+            floor.single_applications,
+            pieces_line()
+        );
     }
     Ok(())
 }

@@ -543,6 +543,15 @@ impl InterfaceFactorization {
             .sum()
     }
 
+    /// The multiply-adds of one numeric factorization of the blocks, summed
+    /// ([`ordering::flops`]).
+    pub fn factor_flops(&self) -> f64 {
+        self.blocks
+            .iter()
+            .map(|b| ordering::flops(b.supernodal()))
+            .sum()
+    }
+
     /// Order the stiffness with pattern `pattern` (n x n, both triangles) with the interface
     /// of `rows` (contact rows as (equation, coefficient)) last in each of its diagonal
     /// blocks, and analyze the blocks (on rayon's threads).

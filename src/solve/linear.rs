@@ -7,6 +7,7 @@
 use crate::error::{Error, Result};
 use crate::fe::{Pattern, split_ranges_mut};
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::perm::PermRef;
 use faer::sparse::SparseColMatRef;
 use faer::sparse::linalg::cholesky::{
@@ -251,12 +252,14 @@ impl SymmetricProduct {
 }
 
 /// A sparse Cholesky factorization L L^T of a symmetric positive definite matrix in a given
-/// elimination order (the floor's: see [`super::floor_time`]): faer's symbolic analysis,
+/// elimination order (the floor's: see [`super::floor`]): faer's symbolic analysis,
 /// numeric factorization and substitutions, timed apart.
 pub struct OrderedCholesky {
     pattern: SymbolicSparseColMat<usize>,
     symbolic: SymbolicCholesky<usize>,
     values: Vec<f64>,
+    /// The single-precision factor ([`OrderedCholesky::factor_single`]), if any.
+    values_single: Vec<f32>,
     /// Seconds in the numeric factorizations.
     pub factor_s: f64,
     /// Seconds in the symbolic analysis (the ordering given).
@@ -267,6 +270,11 @@ impl OrderedCholesky {
     /// The fill of the factor ([`super::ordering::factor_entries`]).
     pub fn factor_entries(&self) -> usize {
         super::ordering::factor_entries(&self.symbolic)
+    }
+
+    /// The multiply-adds of one numeric factorization ([`super::ordering::factor_flops`]).
+    pub fn factor_flops(&self) -> f64 {
+        super::ordering::factor_flops(&self.symbolic)
     }
 
     /// The symbolic analysis of `pattern` (both triangles; the lower one is read) in the
@@ -296,6 +304,7 @@ impl OrderedCholesky {
             pattern,
             symbolic,
             values: Vec::new(),
+            values_single: Vec::new(),
             factor_s: 0.0,
             symbolic_s: t.elapsed().as_secs_f64(),
         })
@@ -304,30 +313,56 @@ impl OrderedCholesky {
     /// Factorize the matrix whose values (pattern order) are `values`.
     pub fn factor(&mut self, values: &[f64]) -> Result<()> {
         let t = Instant::now();
-        self.values.clear();
-        self.values.resize(self.symbolic.len_val(), 0.0);
-        let mut buffer = MemBuffer::try_new(
-            self.symbolic
-                .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
-        )
-        .map_err(|_| Error::NotConverged("out of memory in the Cholesky".into()))?;
-        self.symbolic
-            .factorize_numeric_llt(
-                &mut self.values,
-                SparseColMatRef::new(self.pattern.as_ref(), values),
-                Side::Lower,
-                Default::default(),
-                Par::Seq,
-                MemStack::new(&mut buffer),
-                Default::default(),
-            )
-            .map_err(|e| {
-                Error::NotConverged(format!(
-                    "the matrix is not positive definite ({e:?}): is a body free to move?"
-                ))
-            })?;
+        let mut factor = std::mem::take(&mut self.values);
+        numeric_llt(&self.symbolic, &self.pattern, values, &mut factor, None)?;
+        self.values = factor;
         self.factor_s += t.elapsed().as_secs_f64();
         Ok(())
+    }
+
+    /// Factorize in single precision the matrix whose values, rounded to f32, are
+    /// `values`: half the bytes and twice the SIMD lanes of [`OrderedCholesky::factor`],
+    /// for a preconditioner ([`OrderedCholesky::solve_single`]). A pivot below
+    /// `pivot_epsilon` (relative to the matrix's scale, as faer reads it) is replaced by
+    /// `pivot_replacement`: f32's rounding (6e-8 relative) exceeds the 1e-8 shift that
+    /// makes a body held only by contact definite, and leaves its rigid mode's pivot at
+    /// the rounding's noise, of either sign.
+    pub fn factor_single(
+        &mut self,
+        values: &[f32],
+        pivot_epsilon: f32,
+        pivot_replacement: f32,
+    ) -> Result<()> {
+        let t = Instant::now();
+        let mut factor = std::mem::take(&mut self.values_single);
+        let regularization = Some((pivot_epsilon, pivot_replacement));
+        numeric_llt(
+            &self.symbolic,
+            &self.pattern,
+            values,
+            &mut factor,
+            regularization,
+        )?;
+        self.values_single = factor;
+        self.factor_s += t.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// Solve with the single-precision factorization, in place.
+    pub fn solve_single(&self, rhs: &mut [f32]) {
+        let n = rhs.len();
+        let mut buffer = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f32>(1, Par::Seq));
+        LltRef::new(&self.symbolic, &self.values_single).solve_in_place_with_conj(
+            Conj::No,
+            faer::MatMut::from_column_major_slice_mut(rhs, n, 1),
+            Par::Seq,
+            MemStack::new(&mut buffer),
+        );
+    }
+
+    /// Drop the double-precision factor (its memory handed back).
+    pub fn drop_double(&mut self) {
+        self.values = Vec::new();
     }
 
     /// Solve with the factorization, in place.
@@ -341,6 +376,47 @@ impl OrderedCholesky {
             MemStack::new(&mut buffer),
         );
     }
+}
+
+/// faer's numeric L L^T of `values` (pattern order, lower triangle read) into `factor`
+/// (resized), in the precision of `T`, with dynamic regularization (pivot epsilon,
+/// replacement) if given.
+fn numeric_llt<T: super::substitution::Value>(
+    symbolic: &SymbolicCholesky<usize>,
+    pattern: &SymbolicSparseColMat<usize>,
+    values: &[T],
+    factor: &mut Vec<T>,
+    regularization: Option<(T, T)>,
+) -> Result<()> {
+    factor.clear();
+    factor.resize(symbolic.len_val(), T::from_f64(0.0));
+    let mut buffer = MemBuffer::try_new(
+        symbolic.factorize_numeric_llt_scratch::<T>(Par::Seq, Default::default()),
+    )
+    .map_err(|_| Error::NotConverged("out of memory in the Cholesky".into()))?;
+    let regularization = match regularization {
+        Some((epsilon, delta)) => LltRegularization {
+            dynamic_regularization_delta: delta,
+            dynamic_regularization_epsilon: epsilon,
+        },
+        None => Default::default(),
+    };
+    symbolic
+        .factorize_numeric_llt(
+            factor,
+            SparseColMatRef::new(pattern.as_ref(), values),
+            Side::Lower,
+            regularization,
+            Par::Seq,
+            MemStack::new(&mut buffer),
+            Default::default(),
+        )
+        .map_err(|e| {
+            Error::NotConverged(format!(
+                "the matrix is not positive definite ({e:?}): is a body free to move?"
+            ))
+        })?;
+    Ok(())
 }
 
 /// Solve `A x = b` by GMRES (`matvec`: y = A x), right-preconditioned with

@@ -4,12 +4,15 @@
 
 pub mod elimination;
 pub mod fixed_point;
+pub mod floor;
 pub mod interface;
 pub mod linear;
 pub mod newton;
 pub mod ordering;
 pub mod pieces;
 pub mod substitution;
+
+pub use floor::{Floor, floor, floor_time};
 
 use crate::contact::{self, Interface, Method, Row};
 use crate::error::{Error, Result};
@@ -188,6 +191,10 @@ pub struct Timings {
     /// 0 for a solver without one.
     #[serde(default)]
     pub factor_entries: usize,
+    /// Multiply-adds of one numeric factorization of the stiffness
+    /// ([`ordering::flops`]); 0 for a solver without one.
+    #[serde(default)]
+    pub factor_flops: f64,
 }
 
 /// Run `f`, adding its wall time to `cell`.
@@ -229,32 +236,6 @@ impl Solution {
     pub fn active_set_changes(&self) -> usize {
         self.reports.iter().map(|r| r.active_set_changes).sum()
     }
-}
-
-/// The floor a solver is judged by (SPEC section 7), measured on the same mesh and
-/// machine: what the problem cannot avoid, from scratch: the pattern and values of the
-/// elastic stiffness (assembled once), one sparse Cholesky factorization (ordering by
-/// [`ordering::order`], symbolic and numeric) and two triangular solves (one forward-backward pair)
-/// per time step. Seconds. The stiffness is shifted by [`newton::FLOOR_SHIFT`] times its
-/// mean diagonal, so that a body held only by contact does not make it singular. Compare
-/// it with a solver's set-up plus time loop (`RunSummary::ratio_to_floor`).
-pub fn floor_time(p: &Problem, steps: usize) -> Result<f64> {
-    Ok(newton::floor(p, steps)?.seconds)
-}
-
-/// The floor of [`floor_time`] with the fill of its factor.
-#[derive(Debug, Clone, Copy)]
-pub struct Floor {
-    /// Wall time (s).
-    pub seconds: f64,
-    /// Entries of the Cholesky factor L, summed over the bodies' blocks
-    /// ([`ordering::factor_entries`]).
-    pub factor_entries: usize,
-}
-
-/// [`floor_time`] with the fill of the floor's factor.
-pub fn floor(p: &Problem, steps: usize) -> Result<Floor> {
-    newton::floor(p, steps)
 }
 
 /// One solver's per-step interface.

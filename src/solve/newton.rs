@@ -14,10 +14,10 @@
 
 use super::elimination::{Elimination, Increment};
 use super::interface::{ActiveSet, InterfaceFactorization, Precision};
-use super::linear::{OrderedCholesky, SparseSystem, SymmetricProduct, gmres};
+use super::linear::{SparseSystem, SymmetricProduct, gmres};
+use super::pieces;
 use super::{Problem, Settings, State, StepReport, StepSolver, inf_norm};
 use super::{Timings, timed};
-use super::{ordering, pieces};
 use crate::contact;
 use crate::error::{Error, Result};
 use crate::fe::{FIXED, Pattern, TangentChange};
@@ -220,54 +220,6 @@ impl KktMatrix {
         }
         self.system.factor_lu()
     }
-}
-
-/// Shift added to the stiffness diagonal for the floor's Cholesky, relative to its mean
-/// diagonal: it makes the stiffness of a body held only by contact positive definite and
-/// changes nothing the floor measures (its cost).
-pub const FLOOR_SHIFT: f64 = 1e-8;
-
-/// See [`super::floor`].
-pub fn floor(p: &Problem, steps: usize) -> Result<super::Floor> {
-    let t0 = std::time::Instant::now();
-    let model = &p.model;
-    let n = model.n_free;
-    let (pattern, slots) = pieces::time("floor.pattern", 0, || model.stiffness_pattern(&[], n));
-    let values = pieces::time("floor.values", 0, || {
-        let mut values = vec![0.0; pattern.nnz()];
-        model.add_tangent(&model.elastic_tangents(), &slots, &mut values);
-        let diagonal: Vec<usize> = (0..n).map(|i| pattern.slot(i, i)).collect();
-        let shift =
-            FLOOR_SHIFT * diagonal.iter().map(|&s| values[s]).sum::<f64>() / n.max(1) as f64;
-        for &s in &diagonal {
-            values[s] += shift;
-        }
-        values
-    });
-    // The stiffness is block diagonal (one block per body): the best the machine can do
-    // factorizes the blocks apart, on rayon's threads, as the solver does.
-    let entries = ordering::largest_first(pattern.diagonal_blocks(), |range| {
-        let first = range.start;
-        let (block, entries) = pieces::time("floor.block", first, || pattern.block(&range));
-        let order = ordering::order(&block, &vec![false; block.n], None, first)?;
-        let mut system = OrderedCholesky::new(&block, &order)?;
-        system.factor(&values[entries])?;
-        pieces::record("floor.symbolic", first, system.symbolic_s);
-        pieces::record("floor.numeric", first, system.factor_s);
-        let mut rhs = vec![1.0; range.len()];
-        pieces::time("floor.solves", first, || {
-            for _ in 0..steps {
-                system.solve(&mut rhs);
-            }
-        });
-        Ok(system.factor_entries())
-    })?;
-    let seconds = t0.elapsed().as_secs_f64();
-    pieces::record("floor.total", 0, seconds);
-    Ok(super::Floor {
-        seconds,
-        factor_entries: entries.iter().sum(),
-    })
 }
 
 impl<'a> Newton<'a> {
@@ -1147,6 +1099,7 @@ impl StepSolver for Newton<'_> {
             solves: self.solves(),
             setup_s: self.setup_s,
             factor_entries: self.factorization.factor_entries(),
+            factor_flops: self.factorization.factor_flops(),
         }
     }
 }

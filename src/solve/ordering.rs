@@ -245,6 +245,25 @@ pub fn flops(symbolic: &SymbolicSupernodalCholesky<usize>) -> f64 {
         .sum()
 }
 
+/// The multiply-adds of one numeric factorization with `symbolic`: [`flops`] for a
+/// supernodal factor, and for a simplicial one the same count per column (a supernode of
+/// one column).
+pub fn factor_flops(symbolic: &SymbolicCholesky<usize>) -> f64 {
+    match symbolic.raw() {
+        SymbolicCholeskyRaw::Simplicial(s) => {
+            let col_ptr = s.col_ptr();
+            (0..s.ncols())
+                .map(|j| {
+                    // Entries below the diagonal of column j.
+                    let r = (col_ptr[j + 1] - col_ptr[j]).saturating_sub(1) as f64;
+                    1.0 / 3.0 + r + r * r
+                })
+                .sum()
+        }
+        SymbolicCholeskyRaw::Supernodal(s) => flops(s),
+    }
+}
+
 /// The fill of a Cholesky factor: the entries of L on and below its diagonal that the
 /// factor stores and computes with. A simplicial factor stores exactly the structural
 /// nonzeros; a supernodal one (faer's, with relaxed supernodes) also the explicit zeros

@@ -42,9 +42,10 @@ pub struct SpeedRun {
     /// At the largest level, with more than one thread: the same run and floor on one
     /// thread, (set-up + time loop, floor) in s.
     pub one_thread: Option<(f64, f64)>,
-    /// The fill of the floor's Cholesky factor (entries of L, both bodies); the solver's
-    /// own is in `run`'s timings.
-    pub floor_entries: usize,
+    /// The floor measured beside the run: each way at its fastest over the repeats, the
+    /// faster of the two as `seconds` ([`solve::Floor`]); the solver's fill and flops are
+    /// in `run`'s timings.
+    pub floor: solve::Floor,
 }
 
 /// A family of meshes: a scene and its level-0 sizes, refined level by level.
@@ -87,6 +88,98 @@ pub struct SpeedResult {
     /// Threads of rayon's pool (RAYON_NUM_THREADS, or the machine's cores), used alike by
     /// the solver and the floor.
     pub threads: usize,
+    /// The machine's measured limits the bounds divide by.
+    pub limits: Limits,
+}
+
+/// What the machine can do at most, measured on rayon's threads at the start of the
+/// study: the bounds of the report divide each side's bytes and flops by these.
+#[derive(Debug, Clone, Copy)]
+pub struct Limits {
+    /// Streaming read bandwidth (bytes/s): the fastest of 3 sums over [`STREAM_BYTES`] of
+    /// f64, twice the largest last-level cache of the machines measured so far.
+    pub bandwidth: f64,
+    /// Dense f64 matrix product rate (flop/s; a multiply-add is 2): the fastest of 3 of
+    /// faer's product of two [`PEAK_SIZE`]-square matrices.
+    pub peak_f64: f64,
+    /// The same in f32.
+    pub peak_f32: f64,
+}
+
+/// Bytes read by the bandwidth measurement ([`Limits::bandwidth`]).
+pub const STREAM_BYTES: usize = 1 << 30;
+/// Order of the matrices of the peak measurement ([`Limits::peak_f64`]).
+pub const PEAK_SIZE: usize = 2048;
+
+/// Measure the machine's [`Limits`] (about 3 s).
+pub fn measure_limits() -> Limits {
+    use rayon::prelude::*;
+    let fastest = |f: &mut dyn FnMut()| {
+        (0..3)
+            .map(|_| {
+                let t = std::time::Instant::now();
+                f();
+                t.elapsed().as_secs_f64()
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let data = vec![1.0f64; STREAM_BYTES / 8];
+    let sum = std::sync::atomic::AtomicU64::new(0);
+    let stream = fastest(&mut || {
+        // Eight partial sums per chunk: the adds keep up with the loads.
+        let total: f64 = data
+            .par_chunks(1 << 16)
+            .map(|c| {
+                let mut s = [0.0; 8];
+                for block in c.chunks_exact(8) {
+                    for k in 0..8 {
+                        s[k] += block[k];
+                    }
+                }
+                s.iter().sum::<f64>()
+            })
+            .sum();
+        sum.fetch_add(total as u64, std::sync::atomic::Ordering::Relaxed);
+    });
+    drop(data);
+    let par = faer::Par::rayon(rayon::current_num_threads());
+    let flops = 2.0 * (PEAK_SIZE as f64).powi(3);
+    let peak = |single: bool| {
+        let n = PEAK_SIZE;
+        let seconds = if single {
+            let a = faer::Mat::<f32>::from_fn(n, n, |i, j| ((i + 2 * j) % 7) as f32 - 3.0);
+            let mut c = faer::Mat::<f32>::zeros(n, n);
+            fastest(&mut || {
+                faer::linalg::matmul::matmul(
+                    c.as_mut(),
+                    faer::Accum::Replace,
+                    a.as_ref(),
+                    a.as_ref(),
+                    1.0,
+                    par,
+                )
+            })
+        } else {
+            let a = faer::Mat::<f64>::from_fn(n, n, |i, j| ((i + 2 * j) % 7) as f64 - 3.0);
+            let mut c = faer::Mat::<f64>::zeros(n, n);
+            fastest(&mut || {
+                faer::linalg::matmul::matmul(
+                    c.as_mut(),
+                    faer::Accum::Replace,
+                    a.as_ref(),
+                    a.as_ref(),
+                    1.0,
+                    par,
+                )
+            })
+        };
+        flops / seconds
+    };
+    Limits {
+        bandwidth: STREAM_BYTES as f64 / stream,
+        peak_f64: peak(false),
+        peak_f32: peak(true),
+    }
 }
 
 /// Levels at which newton is timed (level 7: 2,196,480 dofs).
@@ -131,8 +224,8 @@ pub fn repeats(dofs: usize) -> usize {
 }
 
 /// Solve `case` with `kind` and measure the floor, `repeats` times alternately: the
-/// solution (deterministic) of the first run with the fastest run's timings, the fastest
-/// floor (its time and its fill), and the largest peak memory of the solves.
+/// solution (deterministic) of the first run with the fastest run's timings, the floor
+/// with each way at its fastest, and the largest peak memory of the solves.
 fn timed_runs(
     case: &Case,
     kind: SolverKind,
@@ -155,10 +248,8 @@ fn timed_runs(
             best.timings = sol.timings;
         }
         release_free_heap();
-        // Same ordering, same fill: only the time changes from run to run.
-        floor.seconds = floor
-            .seconds
-            .min(solve::floor(&case.problem, STEPS)?.seconds);
+        // Same ordering, same fill, same iterations: only the times change.
+        floor = floor.fastest(&solve::floor(&case.problem, STEPS)?);
     }
     Ok((best, floor, peak))
 }
@@ -184,6 +275,7 @@ fn sizes(family: &Family, matching: bool) -> Vec<(String, f64)> {
 pub fn run() -> Result<SpeedResult> {
     let t0 = std::time::Instant::now();
     let threads = rayon::current_num_threads();
+    let limits = measure_limits();
     // Timings first, on a quiet heap (the reference is solved afterwards); the solutions
     // of the levels that get an error are kept until the reference exists.
     let mut rows = Vec::new();
@@ -227,7 +319,7 @@ pub fn run() -> Result<SpeedResult> {
                         error: None,
                         family,
                         one_thread,
-                        floor_entries: floor.factor_entries,
+                        floor,
                     });
                     // Errors only where the reference is at least 3 levels finer.
                     if viscoplastic && level + 3 <= REFERENCE_LEVEL {
@@ -254,6 +346,7 @@ pub fn run() -> Result<SpeedResult> {
         wall_s: t0.elapsed().as_secs_f64(),
         machine: machine(),
         threads,
+        limits,
     })
 }
 

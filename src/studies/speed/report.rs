@@ -7,8 +7,8 @@ use crate::io::csv_bytes;
 use crate::report::folder::{write, write_folder};
 use crate::report::markdown::{Doc, Table};
 use crate::report::plot::{self, Series};
-use crate::solve::SolverKind;
-use crate::studies::speed::{FAMILIES, Family, SpeedResult, SpeedRun};
+use crate::solve::{SolverKind, interface::Precision};
+use crate::studies::speed::{FAMILIES, Family, Limits, SpeedResult, SpeedRun};
 use serde::Serialize;
 use std::path::Path;
 use crate::verify::kind::Outcome;
@@ -55,12 +55,38 @@ pub struct SpeedRecord {
     pub factor_entries: usize,
     /// Fill of the floor's Cholesky factor: entries of L, both bodies.
     pub floor_factor_entries: usize,
+    /// The floor's faster way: `double` (f64 Cholesky, one substitution per system) or
+    /// `single` (f32 Cholesky preconditioning conjugate gradients to the tolerance).
+    pub floor_way: String,
+    /// The floor by the double way (s).
+    pub floor_double_s: f64,
+    /// The floor by the single way (s); empty where it missed the tolerance.
+    pub floor_single_s: Option<f64>,
+    /// Systems the floor solves (distinct right-hand sides).
+    pub floor_systems: usize,
+    /// The single way's applications of its f32 factor (the most of any body).
+    pub floor_applications: usize,
+    /// Applications of the solver's factorization (solves with it).
+    pub solves: usize,
+    /// Multiply-adds of one numeric factorization: the solver's, the floor's.
+    pub factor_flops: f64,
+    pub floor_factor_flops: f64,
+    /// The floor's bytes (its faster way's) over the measured bandwidth (s).
+    pub floor_memory_bound_s: f64,
+    /// The floor's factorization flops over the measured peak in its precision (s).
+    pub floor_compute_bound_s: f64,
+    /// The solver's bytes (factor twice per application, stiffness once) over the
+    /// bandwidth (s); empty for the paper's solver.
+    pub memory_bound_s: Option<f64>,
+    /// The solver's factorization flops over the measured f32 peak (s).
+    pub compute_bound_s: Option<f64>,
 }
 
 impl SpeedRecord {
-    fn new(r: &SpeedRun, threads: usize) -> Self {
+    fn new(r: &SpeedRun, threads: usize, limits: &Limits) -> Self {
         let run = &r.run;
         let t = &run.timings;
+        let b = bounds(r, limits);
         SpeedRecord {
             scene: run.scene.clone(),
             method: run.method,
@@ -86,8 +112,59 @@ impl SpeedRecord {
             one_thread_s: r.one_thread.map(|o| o.0),
             one_thread_floor_s: r.one_thread.map(|o| o.1),
             factor_entries: t.factor_entries,
-            floor_factor_entries: r.floor_entries,
+            floor_factor_entries: r.floor.factor_entries,
+            floor_way: way(r.floor.precision).to_string(),
+            floor_double_s: r.floor.double_s,
+            floor_single_s: r.floor.single_s,
+            floor_systems: r.floor.systems,
+            floor_applications: r.floor.single_applications,
+            solves: t.solves,
+            factor_flops: t.factor_flops,
+            floor_factor_flops: r.floor.factor_flops,
+            floor_memory_bound_s: b.floor_memory,
+            floor_compute_bound_s: b.floor_compute,
+            memory_bound_s: b.memory,
+            compute_bound_s: b.compute,
         }
+    }
+}
+
+/// The floor's way by name.
+fn way(p: Precision) -> &'static str {
+    match p {
+        Precision::Double => "double",
+        Precision::Single => "single",
+    }
+}
+
+/// How far a run and its floor are from the machine's limits (s): bytes over the
+/// streaming bandwidth, factorization flops over the dense peak in their precision.
+struct Bounds {
+    floor_memory: f64,
+    floor_compute: f64,
+    /// None for a solver without a factorization of the stiffness (the paper's).
+    memory: Option<f64>,
+    compute: Option<f64>,
+}
+
+/// The [`Bounds`] of `r` on a machine with `limits`. The solver's bytes: its f32 factor
+/// read twice per application (4 bytes an entry) and the stiffness once per application
+/// (GMRES pairs each with one product; 8 bytes an entry); the floor's: see
+/// [`crate::solve::Floor::double_bytes`]. Index arrays are left out: lower bounds.
+fn bounds(r: &SpeedRun, limits: &Limits) -> Bounds {
+    let (f, t) = (&r.floor, &r.run.timings);
+    let (floor_bytes, floor_peak) = match f.precision {
+        Precision::Double => (f.double_bytes, limits.peak_f64),
+        Precision::Single => (f.single_bytes, limits.peak_f32),
+    };
+    let has_factor = t.factor_entries > 0;
+    let bytes = t.solves as f64 * (2.0 * 4.0 * t.factor_entries as f64 + 8.0 * f.stiffness_entries as f64);
+    Bounds {
+        floor_memory: floor_bytes / limits.bandwidth,
+        floor_compute: 2.0 * f.factor_flops / floor_peak,
+        memory: has_factor.then(|| bytes / limits.bandwidth),
+        compute: has_factor
+            .then(|| 2.0 * t.factor_flops * t.factorizations as f64 / limits.peak_f32),
     }
 }
 
@@ -149,7 +226,7 @@ pub fn write_speed(res: &SpeedResult, dir: &Path) -> Result<()> {
         let rows: Vec<SpeedRecord> = res
             .rows
             .iter()
-            .map(|r| SpeedRecord::new(r, res.threads))
+            .map(|r| SpeedRecord::new(r, res.threads, &res.limits))
             .collect();
         write(d, "speed.csv", &csv_bytes(&rows)?)?;
         work_precision(res, d)?;
@@ -236,6 +313,7 @@ fn readme(res: &SpeedResult) -> String {
         .table(&ratios_table(res))
         .paragraph(floor_spread(res));
     machine_and_threads(&mut doc, res);
+    doc.table(&bounds_table(res));
     doc.image("work precision", "work_precision.png")
         .image("time against dofs", "time_vs_dofs.png")
         .table(&runs_table(res));
@@ -253,7 +331,7 @@ fn what_is_measured(res: &SpeedResult) -> String {
         .map(|(below, times)| format!("{times} below {below} dofs"))
         .collect();
     format!(
-        "What each accuracy costs, on two families of the same non-matching meshes (h1/h2 = 1.4142, h_upper = 0.28 at level 0, every level splits each triangle in 4), {STEPS} time steps: `rates` (viscoplastic, about half the domain flows) and `rates-elastic` (no yield stress). Each run's cost, the solver's set-up (pattern, symbolic analysis) plus its time loop, is compared with the floor measured on the same mesh: what the problem cannot avoid, from scratch: the elastic stiffness's pattern and values, one sparse Cholesky of it (faer; ordering, symbolic and numeric; shifted by 1e-8 of its mean diagonal so that a body held only by contact does not make it singular), and one solve (two triangular solves) per time step. newton's runs are timed {} times, larger ones {REPEATS_ABOVE} times, solver and floor alternately (the paper's solver once), each on a heap handed back to the system as in a fresh process, and the fastest of each is kept (single timings of 0.01-1 s scatter by up to a factor 2 on this shared 2-core machine). Errors (viscoplastic family) are in the theorem norm against a matching-mesh reference at level {REFERENCE_LEVEL} ({} dofs), shown where the reference is at least 3 levels finer. `peak RSS` is the process's peak during the solve (reset before it). Regenerate with `cargo run --release -- study speed` ({:.0} s).",
+        "What each accuracy costs, on two families of the same non-matching meshes (h1/h2 = 1.4142, h_upper = 0.28 at level 0, every level splits each triangle in 4), {STEPS} time steps: `rates` (viscoplastic, about half the domain flows) and `rates-elastic` (no yield stress). Each run's cost, the solver's set-up (pattern, symbolic analysis) plus its time loop, is compared with the floor measured on the same mesh: what the problem cannot avoid, from scratch (`solve::floor`). That is the elastic stiffness's pattern and values, its ordering and symbolic analysis (faer; shifted by 1e-8 of its mean diagonal so that a body held only by contact does not make it singular), and then the faster of two ways to solve the systems the problem needs to the solver's tolerance 1e-10: *double*, one f64 Cholesky and one forward-backward substitution per system; *single*, one f32 Cholesky preconditioning conjugate gradients in f64 per system (counted only where they reach the tolerance in 30 applications). The systems are one per distinct right-hand side: one for the elastic family (its proportional load's steps are scalings of one solution), one per step for the viscoplastic one (a body with no load of its own gets ones). Both ways are timed in every measurement and both times are in speed.csv and the table below. newton's runs are timed {} times, larger ones {REPEATS_ABOVE} times, solver and floor alternately (the paper's solver once), each on a heap handed back to the system as in a fresh process, and the fastest of each is kept (single timings of 0.01-1 s scatter by up to a factor 2 on this shared 2-core machine). Errors (viscoplastic family) are in the theorem norm against a matching-mesh reference at level {REFERENCE_LEVEL} ({} dofs), shown where the reference is at least 3 levels finer. `peak RSS` is the process's peak during the solve (reset before it). Regenerate with `cargo run --release -- study speed` ({:.0} s).",
         repeats.join(", "),
         res.reference_dofs,
         res.wall_s
@@ -279,7 +357,7 @@ fn ratios_table(res: &SpeedResult) -> Table {
             let Some(last) = runs.last() else { continue };
             let (entries, floor_entries) = (
                 last.run.timings.factor_entries as f64,
-                last.floor_entries as f64,
+                last.floor.factor_entries as f64,
             );
             table.row([
                 family.label.to_string(),
@@ -290,11 +368,12 @@ fn ratios_table(res: &SpeedResult) -> Table {
                     ratios.iter().copied().fold(0.0, f64::max)
                 ),
                 format!(
-                    "{:.2} at {} dofs ({:.1} s, floor {:.1} s)",
+                    "{:.2} at {} dofs ({:.1} s, floor {:.1} s, {})",
                     ratio(last),
                     last.run.dofs,
                     last.run.time_loop_s + last.run.timings.setup_s,
-                    floor_of(last)
+                    floor_of(last),
+                    way(last.floor.precision)
                 ),
                 format!(
                     "{entries:.3e} / {floor_entries:.3e} = {:.2}",
@@ -338,18 +417,75 @@ fn floor_spread(res: &SpeedResult) -> String {
 /// The machine the ratios depend on, the threads and how both sides use them, and the runs
 /// timed on one thread as well.
 fn machine_and_threads(doc: &mut Doc, res: &SpeedResult) {
+    let l = &res.limits;
     doc.paragraph(format!(
-        "Machine: {}. The ratios depend on it: newton's runs are about 24 preconditioner applications (each reads the whole factor from memory) against the floor's 4 solves, so a machine with less memory bandwidth per core reads higher ratios for the same code (`studies::speed::machine` gives a measured example).",
-        res.machine
+        "Machine: {}; measured at the start of the study (`studies::speed::measure_limits`): streaming read bandwidth {:.1} GB/s (a sum over 1 GiB), dense product peak {:.1} GFLOP/s in f64 and {:.1} GFLOP/s in f32 (faer's 2048 x 2048 product). The ratios depend on the machine: newton's runs apply their f32 factor about 24 times (each reads the whole factor from memory) against the floor's 4 substitutions (viscoplastic, double) or 5 applications (elastic, single), so a machine with less memory bandwidth per core reads higher ratios for the same code (`studies::speed::machine` gives a measured example). The bounds table divides each side's bytes by the bandwidth and its factorization's flops by the peak in its precision: how far each is from the machine's limits, not only from the other.",
+        res.machine,
+        l.bandwidth / 1e9,
+        l.peak_f64 / 1e9,
+        l.peak_f32 / 1e9
     ))
     .paragraph(format!(
-        "Threads: {} (rayon's pool; `RAYON_NUM_THREADS` sets it), the same for the solver and the floor. The stiffness is block diagonal, one block per body (they meet only through the contact rows): both sides factorize the blocks apart and side by side, in the same ordering (`solve::ordering`: METIS's nested dissection of the nodes for a block of 500,000 equations or more, faer's AMD below), the floor of each whole block, newton of the block's interior with its contact-interface unknowns last; newton's substitutions run as tasks on the threads, one per subtree of the blocks' elimination trees (`solve::substitution`: split until no subtree holds more than a fifth of the work, so that the larger body does not set the time), the floor's (4 per run) as faer's solve of each block, side by side. Newton factorizes in single precision (faer's LDL^T in f32 of the stiffness scaled to unit diagonal; the substitutions' arithmetic in f64) and reaches the tolerance 1e-10 through its Newton and GMRES iterations; the floor is the double-precision Cholesky and its two triangular solves per step, a double-precision answer with no iteration. The fill is the number of entries of the factor L on and below its diagonal (both bodies; newton's includes its interface rows).",
+        "Threads: {} (rayon's pool; `RAYON_NUM_THREADS` sets it), the same for the solver and the floor. The stiffness is block diagonal, one block per body (they meet only through the contact rows): both sides factorize the blocks apart and side by side, in the same ordering (`solve::ordering`: METIS's nested dissection of the nodes for a block of 500,000 equations or more, faer's AMD below), the floor of each whole block, newton of the block's interior with its contact-interface unknowns last; newton's substitutions run as tasks on the threads, one per subtree of the blocks' elimination trees (`solve::substitution`: split until no subtree holds more than a fifth of the work, so that the larger body does not set the time), the floor's as faer's solve of each block, side by side. Newton factorizes in single precision (faer's LDL^T in f32 of the stiffness scaled to unit diagonal; the substitutions' arithmetic in f64) and reaches the tolerance 1e-10 through its Newton and GMRES iterations. The fill is the number of entries of the factor L on and below its diagonal (both bodies; newton's includes its interface rows).",
         res.threads
     ));
     let one = one_thread_table(res);
     if !one.is_empty() {
         doc.table(&one);
     }
+}
+
+/// Per family and level from 1e4 dofs (mortar's runs: the floor is the same for both
+/// cones), the floor's two ways and newton, each measured and against its bounds.
+fn bounds_table(res: &SpeedResult) -> Table {
+    let mut table = Table::new([
+        "family",
+        "level",
+        "dofs",
+        "floor: double / single (s)",
+        "floor used",
+        "floor's bound: memory + compute (s)",
+        "newton (s)",
+        "newton's bound: memory + compute (s)",
+        "newton's factorization (s), its compute bound (s)",
+        "applications: newton / floor's single way",
+    ]);
+    for family in &FAMILIES {
+        for r in family_runs(res, family, Method::Mortar, SolverKind::Newton)
+            .filter(|r| r.run.dofs >= 10_000)
+        {
+            let (f, t) = (&r.floor, &r.run.timings);
+            let b = bounds(r, &res.limits);
+            let (memory, compute) = (b.memory.unwrap_or(0.0), b.compute.unwrap_or(0.0));
+            table.row([
+                family.label.to_string(),
+                r.run.level.to_string(),
+                r.run.dofs.to_string(),
+                format!(
+                    "{} / {}",
+                    seconds(f.double_s),
+                    f.single_s.map_or("missed the tolerance".into(), seconds)
+                ),
+                way(f.precision).to_string(),
+                format!(
+                    "{} + {} = {}",
+                    seconds(b.floor_memory),
+                    seconds(b.floor_compute),
+                    seconds(b.floor_memory + b.floor_compute)
+                ),
+                seconds(r.run.time_loop_s + t.setup_s),
+                format!(
+                    "{} + {} = {}",
+                    seconds(memory),
+                    seconds(compute),
+                    seconds(memory + compute)
+                ),
+                format!("{}, {}", seconds(t.factor_s), seconds(compute)),
+                format!("{} / {}", t.solves, f.single_applications),
+            ]);
+        }
+    }
+    table
 }
 
 /// The runs timed on one thread as well: newton's and the floor's speed-up.
@@ -466,7 +602,7 @@ fn runs_table(res: &SpeedResult) -> Table {
             format!("{:.3}", t.solve_s),
             format!("{:.3}", t.assembly_s),
             format!("{:.3}", t.constitutive_s),
-            fill(t.factor_entries, r.floor_entries),
+            fill(t.factor_entries, r.floor.factor_entries),
             gib(run.peak_rss_gib),
             r.error.map(|e| format!("{e:.3e}")).unwrap_or_default(),
         ]);
