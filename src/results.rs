@@ -813,7 +813,7 @@ fn speed_section(doc: &mut Doc, reports: &Path) -> Result<()> {
     });
     doc.heading(
         2,
-        format!("[`speed`]({DOCS_REPORTS}/speed/README.md): cost against the floor (one Cholesky of the stiffness)"),
+        format!("[`speed`]({DOCS_REPORTS}/speed/README.md): cost against the floor (the faster of an f64 Cholesky and an f32 Cholesky with conjugate gradients)"),
     )
     .bullet(format!(
         "newton's (set-up + time loop) / floor from 1e4 to {top} dofs{threads}: {}.",

@@ -50,6 +50,9 @@ pub struct Floor {
     pub seconds: f64,
     /// The way that was faster.
     pub precision: Precision,
+    /// The shared part: the stiffness's pattern and values, each block's ordering and
+    /// symbolic analysis (s).
+    pub shared_s: f64,
     /// The shared part plus the double way (s).
     pub double_s: f64,
     /// The shared part plus the single way (s); None where conjugate gradients missed the
@@ -81,6 +84,7 @@ impl Floor {
     /// the same systems, fill and iterations), and the floor as the faster way.
     pub fn fastest(&self, other: &Floor) -> Floor {
         let double_s = self.double_s.min(other.double_s);
+        let shared_s = self.shared_s.min(other.shared_s);
         let single_s = match (self.single_s, other.single_s) {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
@@ -92,6 +96,7 @@ impl Floor {
         Floor {
             seconds,
             precision,
+            shared_s,
             double_s,
             single_s,
             ..*self
@@ -221,6 +226,7 @@ pub fn floor(p: &Problem, steps: usize) -> Result<Floor> {
     Ok(Floor {
         seconds,
         precision,
+        shared_s,
         double_s,
         single_s,
         systems: loads.len(),

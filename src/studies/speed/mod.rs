@@ -1,7 +1,7 @@
 //! `study speed`: what each accuracy costs. Every run's wall time is split into its parts
 //! and compared with the floor measured in the same run on the same mesh (the stiffness
-//! assembled once, one sparse Cholesky factorization, two triangular solves per time step;
-//! see [`solve::floor_time`]).
+//! assembled and factorized once, in f64 or in f32 with conjugate gradients, whichever is
+//! faster; see [`solve::floor`]), and both with the machine's measured limits.
 
 pub mod report;
 
@@ -25,7 +25,7 @@ use crate::solve::{self, Solution, SolverKind};
 use crate::verify::solve_case;
 
 /// One line for `study list`.
-pub const DESCRIPTION: &str = "What each accuracy costs: time split and ratio to the Cholesky floor, viscoplastic and elastic families up to 2.2e6 dofs, newton against the paper's solver";
+pub const DESCRIPTION: &str = "What each accuracy costs: time split, ratio to the floor (f64 or f32 Cholesky, the faster) and the machine's bounds, viscoplastic and elastic families up to 2.2e6 dofs, newton against the paper's solver";
 
 /// One timed run of the speed study.
 #[derive(Debug, Clone)]

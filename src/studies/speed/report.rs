@@ -58,6 +58,8 @@ pub struct SpeedRecord {
     /// The floor's faster way: `double` (f64 Cholesky, one substitution per system) or
     /// `single` (f32 Cholesky preconditioning conjugate gradients to the tolerance).
     pub floor_way: String,
+    /// The floor's shared part: pattern, values, ordering, symbolic analysis (s).
+    pub floor_shared_s: f64,
     /// The floor by the double way (s).
     pub floor_double_s: f64,
     /// The floor by the single way (s); empty where it missed the tolerance.
@@ -114,6 +116,7 @@ impl SpeedRecord {
             factor_entries: t.factor_entries,
             floor_factor_entries: r.floor.factor_entries,
             floor_way: way(r.floor.precision).to_string(),
+            floor_shared_s: r.floor.shared_s,
             floor_double_s: r.floor.double_s,
             floor_single_s: r.floor.single_s,
             floor_systems: r.floor.systems,
@@ -385,23 +388,26 @@ fn ratios_table(res: &SpeedResult) -> Table {
     table
 }
 
-/// The spread the specification asks for: every row of a mesh times the same floor; its
-/// fastest time per row, smallest and largest, per mesh from 1e4 dofs.
+/// The spread the specification asks for: every row of a family's mesh times the same
+/// floor (the same stiffness and systems, whatever the cone and solver); its fastest time
+/// per row, smallest and largest, per family and mesh from 1e4 dofs.
 fn floor_spread(res: &SpeedResult) -> String {
-    let mut floors: std::collections::BTreeMap<usize, (f64, f64)> = Default::default();
+    let mut floors: std::collections::BTreeMap<(&str, usize), (f64, f64)> = Default::default();
     for r in res
         .rows
         .iter()
         .filter(|r| r.run.solver == SolverKind::Newton && r.run.dofs >= 10_000)
     {
-        let f = floors.entry(r.run.dofs).or_insert((f64::INFINITY, 0.0));
+        let f = floors
+            .entry((r.family.label, r.run.dofs))
+            .or_insert((f64::INFINITY, 0.0));
         *f = (f.0.min(floor_of(r)), f.1.max(floor_of(r)));
     }
     let spread: Vec<String> = floors
         .iter()
-        .map(|(dofs, (lo, hi))| {
+        .map(|((family, dofs), (lo, hi))| {
             format!(
-                "{dofs} dofs {} - {} s ({:.0}%)",
+                "{family} {dofs} dofs {} - {} s ({:.0}%)",
                 seconds(*lo),
                 seconds(*hi),
                 100.0 * (hi / lo - 1.0)
@@ -409,7 +415,7 @@ fn floor_spread(res: &SpeedResult) -> String {
         })
         .collect();
     format!(
-        "Spread: the floor is the same work in every row of a mesh (the same stiffness, whatever the family and cone), timed anew beside each; its fastest time per row, smallest - largest: {}. A ratio moves with its floor by as much.",
+        "Spread: the floor is the same work in every row of a family's mesh (the same stiffness and systems, whatever the cone), timed anew beside each; its fastest time per row, smallest - largest: {}. A ratio moves with its floor by as much.",
         spread.join(", ")
     )
 }
@@ -419,8 +425,9 @@ fn floor_spread(res: &SpeedResult) -> String {
 fn machine_and_threads(doc: &mut Doc, res: &SpeedResult) {
     let l = &res.limits;
     doc.paragraph(format!(
-        "Machine: {}; measured at the start of the study (`studies::speed::measure_limits`): streaming read bandwidth {:.1} GB/s (a sum over 1 GiB), dense product peak {:.1} GFLOP/s in f64 and {:.1} GFLOP/s in f32 (faer's 2048 x 2048 product). The ratios depend on the machine: newton's runs apply their f32 factor about 24 times (each reads the whole factor from memory) against the floor's 4 substitutions (viscoplastic, double) or 5 applications (elastic, single), so a machine with less memory bandwidth per core reads higher ratios for the same code (`studies::speed::machine` gives a measured example). The bounds table divides each side's bytes by the bandwidth and its factorization's flops by the peak in its precision: how far each is from the machine's limits, not only from the other.",
+        "Machine: {}; measured at the start of the study (`studies::speed::measure_limits`): streaming read bandwidth {:.1} GB/s (a sum over 1 GiB), dense product peak {:.1} GFLOP/s in f64 and {:.1} GFLOP/s in f32 (faer's 2048 x 2048 product). The ratios depend on the machine: newton's viscoplastic runs apply their f32 factor {} times from 1e4 dofs (each reads the whole factor from memory) against the floor's one substitution per step, so a machine with less memory bandwidth per core reads higher ratios for the same code (`studies::speed::machine` gives a measured example). The bounds table divides each side's bytes by the bandwidth and its factorization's flops by the peak in its precision: how far each is from the machine's limits, not only from the other. The pattern, ordering and symbolic analysis have no such bound; the table lists them apart (newton's set-up is their counterpart).",
         res.machine,
+        applications_range(res),
         l.bandwidth / 1e9,
         l.peak_f64 / 1e9,
         l.peak_f32 / 1e9
@@ -435,6 +442,22 @@ fn machine_and_threads(doc: &mut Doc, res: &SpeedResult) {
     }
 }
 
+/// The smallest and largest number of preconditioner applications of newton's
+/// viscoplastic runs from 1e4 dofs, as text.
+fn applications_range(res: &SpeedResult) -> String {
+    let solves: Vec<usize> = [Method::Mortar, Method::Nts]
+        .into_iter()
+        .flat_map(|m| family_runs(res, &FAMILIES[0], m, SolverKind::Newton))
+        .filter(|r| r.run.dofs >= 10_000)
+        .map(|r| r.run.timings.solves)
+        .collect();
+    match (solves.iter().min(), solves.iter().max()) {
+        (Some(lo), Some(hi)) if lo < hi => format!("{lo}-{hi}"),
+        (Some(lo), _) => lo.to_string(),
+        _ => "no".to_string(),
+    }
+}
+
 /// Per family and level from 1e4 dofs (mortar's runs: the floor is the same for both
 /// cones), the floor's two ways and newton, each measured and against its bounds.
 fn bounds_table(res: &SpeedResult) -> Table {
@@ -444,8 +467,10 @@ fn bounds_table(res: &SpeedResult) -> Table {
         "dofs",
         "floor: double / single (s)",
         "floor used",
+        "of which pattern, ordering, symbolic (s)",
         "floor's bound: memory + compute (s)",
         "newton (s)",
+        "of which set-up (s)",
         "newton's bound: memory + compute (s)",
         "newton's factorization (s), its compute bound (s)",
         "applications: newton / floor's single way",
@@ -467,6 +492,7 @@ fn bounds_table(res: &SpeedResult) -> Table {
                     f.single_s.map_or("missed the tolerance".into(), seconds)
                 ),
                 way(f.precision).to_string(),
+                seconds(f.shared_s),
                 format!(
                     "{} + {} = {}",
                     seconds(b.floor_memory),
@@ -474,6 +500,7 @@ fn bounds_table(res: &SpeedResult) -> Table {
                     seconds(b.floor_memory + b.floor_compute)
                 ),
                 seconds(r.run.time_loop_s + t.setup_s),
+                seconds(t.setup_s),
                 format!(
                     "{} + {} = {}",
                     seconds(memory),
