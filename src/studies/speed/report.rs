@@ -425,12 +425,12 @@ fn floor_spread(res: &SpeedResult) -> String {
 fn machine_and_threads(doc: &mut Doc, res: &SpeedResult) {
     let l = &res.limits;
     doc.paragraph(format!(
-        "Machine: {}; measured at the start of the study (`studies::speed::measure_limits`): streaming read bandwidth {:.1} GB/s (a sum over 1 GiB), dense product peak {:.1} GFLOP/s in f64 and {:.1} GFLOP/s in f32 (faer's 2048 x 2048 product). The ratios depend on the machine: newton's viscoplastic runs apply their f32 factor {} times from 1e4 dofs (each reads the whole factor from memory) against the floor's one substitution per step, so a machine with less memory bandwidth per core reads higher ratios for the same code (`studies::speed::machine` gives a measured example). The bounds table divides each side's bytes by the bandwidth and its factorization's flops by the peak in its precision: how far each is from the machine's limits, not only from the other. The pattern, ordering and symbolic analysis have no such bound; the table lists them apart (newton's set-up is their counterpart).",
-        res.machine,
-        applications_range(res),
-        l.bandwidth / 1e9,
-        l.peak_f64 / 1e9,
-        l.peak_f32 / 1e9
+        "Machine: {machine}; measured at the start of the study (`studies::speed::measure_limits`): streaming read bandwidth {bandwidth:.1} GB/s (a sum over 1 GiB), dense product peak {f64_peak:.1} GFLOP/s in f64 and {f32_peak:.1} GFLOP/s in f32 (faer's 2048 x 2048 product). The ratios depend on the machine: newton's viscoplastic runs apply their f32 factor {applications} times from 1e4 dofs (each reads the whole factor from memory) against the floor's one substitution per step, so a machine with less memory bandwidth per core reads higher ratios for the same code (`studies::speed::machine` gives a measured example). The bounds table divides each side's bytes by the bandwidth and its factorization's flops by the peak in its precision: how far each is from the machine's limits, not only from the other. The pattern, ordering and symbolic analysis have no such bound; the table lists them apart (newton's set-up is their counterpart).",
+        machine = res.machine,
+        applications = applications_range(res),
+        bandwidth = l.bandwidth / 1e9,
+        f64_peak = l.peak_f64 / 1e9,
+        f32_peak = l.peak_f32 / 1e9
     ))
     .paragraph(format!(
         "Threads: {} (rayon's pool; `RAYON_NUM_THREADS` sets it), the same for the solver and the floor. The stiffness is block diagonal, one block per body (they meet only through the contact rows): both sides factorize the blocks apart and side by side, in the same ordering (`solve::ordering`: METIS's nested dissection of the nodes for a block of 500,000 equations or more, faer's AMD below), the floor of each whole block, newton of the block's interior with its contact-interface unknowns last; newton's substitutions run as tasks on the threads, one per subtree of the blocks' elimination trees (`solve::substitution`: split until no subtree holds more than a fifth of the work, so that the larger body does not set the time), the floor's as faer's solve of each block, side by side. Newton factorizes in single precision (faer's LDL^T in f32 of the stiffness scaled to unit diagonal; the substitutions' arithmetic in f64) and reaches the tolerance 1e-10 through its Newton and GMRES iterations. The fill is the number of entries of the factor L on and below its diagonal (both bodies; newton's includes its interface rows).",
