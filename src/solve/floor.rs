@@ -338,7 +338,7 @@ pub struct Solved {
 /// itself, `attainable(x)` (10 eps |A| |x| in the inf-norm), where that is larger: a body
 /// held only by contact leaves its shifted stiffness a rigid mode whose solution is 1e8
 /// times the rest, and no f64 answer, the double way's included, has a smaller residual
-/// (measured: `rates` level 3, 1.1-1.7 eps |A| |x| = 1.2e-10 |b|). None when
+/// (measured: `rates` level 3, 1.1-1.7e-10 |b| where eps |A| |x| = 1.2e-10 |b|). None when
 /// [`REFINEMENT_BUDGET`] applications do not reach it. Written by hand: twenty lines, and
 /// the preconditioner is faer's factorization.
 pub fn conjugate_gradients(
