@@ -114,15 +114,6 @@ pub const PEAK_SIZE: usize = 2048;
 /// Measure the machine's [`Limits`] (about 3 s).
 pub fn measure_limits() -> Limits {
     use rayon::prelude::*;
-    let fastest = |f: &mut dyn FnMut()| {
-        (0..3)
-            .map(|_| {
-                let t = std::time::Instant::now();
-                f();
-                t.elapsed().as_secs_f64()
-            })
-            .fold(f64::INFINITY, f64::min)
-    };
     let data = vec![1.0f64; STREAM_BYTES / 8];
     let sum = std::sync::atomic::AtomicU64::new(0);
     let stream = fastest(&mut || {
@@ -142,44 +133,42 @@ pub fn measure_limits() -> Limits {
         sum.fetch_add(total as u64, std::sync::atomic::Ordering::Relaxed);
     });
     drop(data);
-    let par = faer::Par::rayon(rayon::current_num_threads());
-    let flops = 2.0 * (PEAK_SIZE as f64).powi(3);
-    let peak = |single: bool| {
-        let n = PEAK_SIZE;
-        let seconds = if single {
-            let a = faer::Mat::<f32>::from_fn(n, n, |i, j| ((i + 2 * j) % 7) as f32 - 3.0);
-            let mut c = faer::Mat::<f32>::zeros(n, n);
-            fastest(&mut || {
-                faer::linalg::matmul::matmul(
-                    c.as_mut(),
-                    faer::Accum::Replace,
-                    a.as_ref(),
-                    a.as_ref(),
-                    1.0,
-                    par,
-                )
-            })
-        } else {
-            let a = faer::Mat::<f64>::from_fn(n, n, |i, j| ((i + 2 * j) % 7) as f64 - 3.0);
-            let mut c = faer::Mat::<f64>::zeros(n, n);
-            fastest(&mut || {
-                faer::linalg::matmul::matmul(
-                    c.as_mut(),
-                    faer::Accum::Replace,
-                    a.as_ref(),
-                    a.as_ref(),
-                    1.0,
-                    par,
-                )
-            })
-        };
-        flops / seconds
-    };
     Limits {
         bandwidth: STREAM_BYTES as f64 / stream,
-        peak_f64: peak(false),
-        peak_f32: peak(true),
+        peak_f64: product_rate::<f64>(),
+        peak_f32: product_rate::<f32>(),
     }
+}
+
+/// The fastest of three runs of `f` (s).
+fn fastest(f: &mut dyn FnMut()) -> f64 {
+    (0..3)
+        .map(|_| {
+            let t = std::time::Instant::now();
+            f();
+            t.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// faer's product of two [`PEAK_SIZE`]-square matrices in the precision of `T` on rayon's
+/// threads, the fastest of three (flop/s; a multiply-add is 2).
+fn product_rate<T: crate::solve::substitution::Value>() -> f64 {
+    let n = PEAK_SIZE;
+    let par = faer::Par::rayon(rayon::current_num_threads());
+    let a = faer::Mat::<T>::from_fn(n, n, |i, j| T::from_f64(((i + 2 * j) % 7) as f64 - 3.0));
+    let mut c = faer::Mat::<T>::zeros(n, n);
+    let seconds = fastest(&mut || {
+        faer::linalg::matmul::matmul(
+            c.as_mut(),
+            faer::Accum::Replace,
+            a.as_ref(),
+            a.as_ref(),
+            T::from_f64(1.0),
+            par,
+        )
+    });
+    2.0 * (n as f64).powi(3) / seconds
 }
 
 /// Levels at which newton is timed (level 7: 2,196,480 dofs).
