@@ -458,21 +458,7 @@ impl PeakMemory {
     }
 }
 
-/// Return the heap's free memory to the system (glibc's malloc_trim; nothing elsewhere):
-/// the next run pays its page faults as a fresh process would.
-pub fn release_free_heap() {
-    #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    {
-        // glibc's own function; no crate wraps it more simply than this declaration.
-        unsafe extern "C" {
-            fn malloc_trim(pad: usize) -> std::ffi::c_int;
-        }
-        // SAFETY: malloc_trim only releases free pages of the allocator's own arenas.
-        unsafe {
-            malloc_trim(0);
-        }
-    }
-}
+pub use crate::solve::floor::release_free_heap;
 
 /// Round-off bound of the checks of an exact solution, relative to the field's scale.
 const EXACT_TOL: f64 = 1e-9;

@@ -543,7 +543,7 @@ impl InterfaceFactorization {
             .sum()
     }
 
-    /// The multiply-adds of one numeric factorization of the blocks, summed
+    /// The flops of one numeric factorization of the blocks (a multiply-add counts 2), summed
     /// ([`ordering::flops`]).
     pub fn factor_flops(&self) -> f64 {
         self.blocks

@@ -272,7 +272,7 @@ impl OrderedCholesky {
         super::ordering::factor_entries(&self.symbolic)
     }
 
-    /// The multiply-adds of one numeric factorization ([`super::ordering::factor_flops`]).
+    /// The flops of one numeric factorization ([`super::ordering::factor_flops`]).
     pub fn factor_flops(&self) -> f64 {
         super::ordering::factor_flops(&self.symbolic)
     }
@@ -323,7 +323,7 @@ impl OrderedCholesky {
     /// Factorize in single precision the matrix whose values, rounded to f32, are
     /// `values`: half the bytes and twice the SIMD lanes of [`OrderedCholesky::factor`],
     /// for a preconditioner ([`OrderedCholesky::solve_single`]). A pivot below
-    /// `pivot_epsilon` (relative to the matrix's scale, as faer reads it) is replaced by
+    /// `pivot_epsilon` (absolute, as faer compares it) is replaced by
     /// `pivot_replacement`: f32's rounding (6e-8 relative) exceeds the 1e-8 shift that
     /// makes a body held only by contact definite, and leaves its rigid mode's pivot at
     /// the rounding's noise, of either sign.

@@ -191,7 +191,7 @@ pub struct Timings {
     /// 0 for a solver without one.
     #[serde(default)]
     pub factor_entries: usize,
-    /// Multiply-adds of one numeric factorization of the stiffness
+    /// Flops of one numeric factorization of the stiffness (a multiply-add counts 2)
     /// ([`ordering::flops`]); 0 for a solver without one.
     #[serde(default)]
     pub factor_flops: f64,

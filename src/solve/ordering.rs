@@ -233,9 +233,10 @@ fn supernode_shapes(
     (0..symbolic.n_supernodes()).map(move |s| (end[s] - begin[s], row_ptr[s + 1] - row_ptr[s]))
 }
 
-/// The flops (multiply-adds) of a supernodal factorization: a supernode of c columns over
-/// r rows below costs c^3/3 for its diagonal block, c^2 r for its panel and c r^2 for the
-/// update of the rows below.
+/// The flops of a supernodal factorization (a multiply-add counts 2, as in a dense
+/// Cholesky's n^3/3): a supernode of c columns over r rows below costs c^3/3 for its
+/// diagonal block, c^2 r for its panel (c^2 r / 2 multiply-adds) and c r^2 for the update
+/// of the lower triangle of the rows below (c r^2 / 2 multiply-adds).
 pub fn flops(symbolic: &SymbolicSupernodalCholesky<usize>) -> f64 {
     supernode_shapes(symbolic)
         .map(|(c, r)| {
@@ -245,7 +246,7 @@ pub fn flops(symbolic: &SymbolicSupernodalCholesky<usize>) -> f64 {
         .sum()
 }
 
-/// The multiply-adds of one numeric factorization with `symbolic`: [`flops`] for a
+/// The flops of one numeric factorization with `symbolic` (a multiply-add counts 2): [`flops`] for a
 /// supernodal factor, and for a simplicial one the same count per column (a supernode of
 /// one column).
 pub fn factor_flops(symbolic: &SymbolicCholesky<usize>) -> f64 {

@@ -70,7 +70,7 @@ pub struct SpeedRecord {
     pub floor_applications: usize,
     /// Applications of the solver's factorization (solves with it).
     pub solves: usize,
-    /// Multiply-adds of one numeric factorization: the solver's, the floor's.
+    /// Flops of one numeric factorization (a multiply-add counts 2): the solver's, the floor's.
     pub factor_flops: f64,
     pub floor_factor_flops: f64,
     /// The floor's bytes (its faster way's) over the measured bandwidth (s).
@@ -164,10 +164,11 @@ fn bounds(r: &SpeedRun, limits: &Limits) -> Bounds {
     let bytes = t.solves as f64 * (2.0 * 4.0 * t.factor_entries as f64 + 8.0 * f.stiffness_entries as f64);
     Bounds {
         floor_memory: floor_bytes / limits.bandwidth,
-        floor_compute: 2.0 * f.factor_flops / floor_peak,
+        // factor_flops counts flops (a multiply-add is 2), as the peak does.
+        floor_compute: f.factor_flops / floor_peak,
         memory: has_factor.then(|| bytes / limits.bandwidth),
         compute: has_factor
-            .then(|| 2.0 * t.factor_flops * t.factorizations as f64 / limits.peak_f32),
+            .then(|| t.factor_flops * t.factorizations as f64 / limits.peak_f32),
     }
 }
 
