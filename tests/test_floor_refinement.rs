@@ -13,12 +13,60 @@
 
 mod common;
 use contact_rates::contact::Method;
+use contact_rates::fe::Pattern;
 use contact_rates::solve::floor::{
     self, REFINEMENT_BUDGET, SINGLE_PIVOT_EPSILON, SINGLE_PIVOT_REPLACEMENT,
 };
 use contact_rates::solve::interface::Precision;
 use contact_rates::solve::linear::{OrderedCholesky, SymmetricProduct};
 use contact_rates::solve::{Settings, ordering};
+
+/// One body's block factorized both ways (f64, and f32 as the floor does), with its
+/// product and that of its absolute values: the pieces of the floor's single way.
+struct BothWays {
+    system: OrderedCholesky,
+    product: SymmetricProduct,
+    absolute: SymmetricProduct,
+}
+
+impl BothWays {
+    fn new(block: &Pattern, values: &[f64], mean: f64) -> Self {
+        let order = ordering::order(block, &vec![false; block.n], None, 0).unwrap();
+        let mut system = OrderedCholesky::new(block, &order).unwrap();
+        system.factor(values).unwrap();
+        let single: Vec<f32> = values.iter().map(|&v| v as f32).collect();
+        system
+            .factor_single(
+                &single,
+                (SINGLE_PIVOT_EPSILON * mean) as f32,
+                (SINGLE_PIVOT_REPLACEMENT * mean) as f32,
+            )
+            .unwrap();
+        BothWays {
+            system,
+            product: SymmetricProduct::new(block.clone(), values.to_vec()),
+            absolute: SymmetricProduct::new(
+                block.clone(),
+                values.iter().map(|v| v.abs()).collect(),
+            ),
+        }
+    }
+
+    /// 10 eps |A| |x|_inf: the round-off of computing A x.
+    fn attainable(&self, x: &[f64]) -> f64 {
+        let x: Vec<f64> = x.iter().map(|v| v.abs()).collect();
+        let mut y = vec![0.0; x.len()];
+        self.absolute.product(&x, &mut y);
+        10.0 * f64::EPSILON * common::amax(&y)
+    }
+
+    /// z = the f32 factor's solve of r, in f64.
+    fn precondition(&self, r: &[f64], z: &mut [f64]) {
+        let mut v: Vec<f32> = r.iter().map(|&x| x as f32).collect();
+        self.system.solve_single(&mut v);
+        z.iter_mut().zip(&v).for_each(|(z, &v)| *z = v as f64);
+    }
+}
 
 /// Goal: an elastic run under a proportional load needs one system; a viscoplastic run
 /// one per step.
@@ -58,33 +106,11 @@ fn single_precision_cholesky_with_conjugate_gradients_meets_the_tolerance() {
                 true => vec![1.0; range.len()],
                 false => load[range.clone()].to_vec(),
             };
-            let order = ordering::order(&block, &vec![false; block.n], None, 0).unwrap();
-            let mut system = OrderedCholesky::new(&block, &order).unwrap();
-            system.factor(block_values).unwrap();
+            let both = BothWays::new(&block, block_values, mean);
             let mut double = b.clone();
-            system.solve(&mut double);
-            let single: Vec<f32> = block_values.iter().map(|&v| v as f32).collect();
-            system
-                .factor_single(
-                    &single,
-                    (SINGLE_PIVOT_EPSILON * mean) as f32,
-                    (SINGLE_PIVOT_REPLACEMENT * mean) as f32,
-                )
-                .unwrap();
-            let product = SymmetricProduct::new(block.clone(), block_values.to_vec());
-            let absolute: Vec<f64> = block_values.iter().map(|v| v.abs()).collect();
-            let absolute = SymmetricProduct::new(block.clone(), absolute);
-            let attainable = |x: &[f64]| {
-                let x: Vec<f64> = x.iter().map(|v| v.abs()).collect();
-                let mut y = vec![0.0; x.len()];
-                absolute.product(&x, &mut y);
-                10.0 * f64::EPSILON * common::amax(&y)
-            };
-            let precondition = |r: &[f64], z: &mut [f64]| {
-                let mut v: Vec<f32> = r.iter().map(|&x| x as f32).collect();
-                system.solve_single(&mut v);
-                z.iter_mut().zip(&v).for_each(|(z, &v)| *z = v as f64);
-            };
+            both.system.solve(&mut double);
+            let (product, attainable) = (&both.product, |x: &[f64]| both.attainable(x));
+            let precondition = |r: &[f64], z: &mut [f64]| both.precondition(r, z);
             let solved = floor::conjugate_gradients(
                 &|x, y| product.product(x, y),
                 &attainable,
@@ -193,32 +219,9 @@ fn conjugate_gradients_stop_at_the_round_off_of_the_product() {
         let range = pattern.diagonal_blocks()[0].clone();
         let (block, entries) = pattern.block(&range);
         let block_values = &values[entries];
-        let order = ordering::order(&block, &vec![false; block.n], None, 0).unwrap();
-        let mut system = OrderedCholesky::new(&block, &order).unwrap();
-        let single: Vec<f32> = block_values.iter().map(|&v| v as f32).collect();
-        system
-            .factor_single(
-                &single,
-                (SINGLE_PIVOT_EPSILON * mean) as f32,
-                (SINGLE_PIVOT_REPLACEMENT * mean) as f32,
-            )
-            .unwrap();
-        let product = SymmetricProduct::new(block.clone(), block_values.to_vec());
-        let absolute = SymmetricProduct::new(
-            block.clone(),
-            block_values.iter().map(|v| v.abs()).collect(),
-        );
-        let attainable = |x: &[f64]| {
-            let x: Vec<f64> = x.iter().map(|v| v.abs()).collect();
-            let mut y = vec![0.0; x.len()];
-            absolute.product(&x, &mut y);
-            10.0 * f64::EPSILON * common::amax(&y)
-        };
-        let precondition = |r: &[f64], z: &mut [f64]| {
-            let mut v: Vec<f32> = r.iter().map(|&x| x as f32).collect();
-            system.solve_single(&mut v);
-            z.iter_mut().zip(&v).for_each(|(z, &v)| *z = v as f64);
-        };
+        let both = BothWays::new(&block, block_values, mean);
+        let (product, attainable) = (&both.product, |x: &[f64]| both.attainable(x));
+        let precondition = |r: &[f64], z: &mut [f64]| both.precondition(r, z);
         let b = vec![1.0; block.n];
         let solved = floor::conjugate_gradients(
             &|x, y| product.product(x, y),
