@@ -60,6 +60,18 @@ impl BothWays {
         10.0 * f64::EPSILON * common::amax(&y)
     }
 
+    /// The floor's single way for `b`: conjugate gradients to `tol` with these pieces.
+    fn single_way(&self, b: &[f64], tol: f64) -> floor::Solved {
+        floor::conjugate_gradients(
+            &|x, y| self.product.product(x, y),
+            &|x| self.attainable(x),
+            &|r, z| self.precondition(r, z),
+            b,
+            tol,
+        )
+        .expect("the single way converges")
+    }
+
     /// z = the f32 factor's solve of r, in f64.
     fn precondition(&self, r: &[f64], z: &mut [f64]) {
         let mut v: Vec<f32> = r.iter().map(|&x| x as f32).collect();
@@ -110,15 +122,7 @@ fn single_precision_cholesky_with_conjugate_gradients_meets_the_tolerance() {
             let mut double = b.clone();
             both.system.solve(&mut double);
             let (product, attainable) = (&both.product, |x: &[f64]| both.attainable(x));
-            let precondition = |r: &[f64], z: &mut [f64]| both.precondition(r, z);
-            let solved = floor::conjugate_gradients(
-                &|x, y| product.product(x, y),
-                &attainable,
-                &precondition,
-                &b,
-                tol,
-            )
-            .expect("the single way converges");
+            let solved = both.single_way(&b, tol);
             let residual = |x: &[f64]| {
                 let mut ax = vec![0.0; x.len()];
                 product.product(x, &mut ax);
@@ -223,14 +227,7 @@ fn conjugate_gradients_stop_at_the_round_off_of_the_product() {
         let (product, attainable) = (&both.product, |x: &[f64]| both.attainable(x));
         let precondition = |r: &[f64], z: &mut [f64]| both.precondition(r, z);
         let b = vec![1.0; block.n];
-        let solved = floor::conjugate_gradients(
-            &|x, y| product.product(x, y),
-            &attainable,
-            &precondition,
-            &b,
-            tol,
-        )
-        .expect("the single way converges");
+        let solved = both.single_way(&b, tol);
         // Textbook: one preconditioned CG, the true residual after each update.
         let dot = |a: &[f64], c: &[f64]| a.iter().zip(c).map(|(x, y)| x * y).sum::<f64>();
         let (mut x, mut r) = (vec![0.0; block.n], b.clone());

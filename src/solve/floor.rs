@@ -382,8 +382,17 @@ pub fn conjugate_gradients(
     let (mut x, mut r) = (vec![0.0; n], b.to_vec());
     let (mut z, mut q) = (vec![0.0; n], vec![0.0; n]);
     let (mut applications, mut products) = (0, 0);
-    // 10 eps |A| |x|_inf, once measured.
+    // 10 eps |A| |x|_inf: the last measured (at any x), and the one at the current x (set
+    // to None at each update of x; each a product with |A|, so measured at most once per x).
     let mut round_off: Option<f64> = None;
+    let mut here: Option<f64>;
+    let mut absolute_products = 0;
+    let mut measure = |x: &[f64], here: &mut Option<f64>| {
+        *here.get_or_insert_with(|| {
+            absolute_products += 1;
+            attainable(x)
+        })
+    };
     while applications < REFINEMENT_BUDGET {
         // A restart from the true residual: the recurrence's drifts by round-off.
         precondition(&r, &mut z);
@@ -395,6 +404,7 @@ pub fn conjugate_gradients(
             products += 1;
             let alpha = rz / dot(&d, &q);
             x.iter_mut().zip(&d).for_each(|(x, d)| *x += alpha * d);
+            here = None;
             r.iter_mut().zip(&q).for_each(|(r, q)| *r -= alpha * q);
             let residual = super::inf_norm(&r);
             if residual <= target || applications == REFINEMENT_BUDGET {
@@ -403,13 +413,9 @@ pub fn conjugate_gradients(
             // The recurrence's residual keeps falling below the round-off of A x while the
             // true one stays at it: stop there too (confirmed below from the true residual,
             // a restart where it misses). Measured once, then again where reached.
-            let floor = *round_off.get_or_insert_with(|| {
-                products += 1;
-                attainable(&x)
-            });
-            if residual <= floor {
-                products += 1;
-                let now = attainable(&x);
+            let threshold = *round_off.get_or_insert_with(|| measure(&x, &mut here));
+            if residual <= threshold {
+                let now = measure(&x, &mut here);
                 round_off = Some(now);
                 if residual <= now {
                     break;
@@ -429,14 +435,11 @@ pub fn conjugate_gradients(
             .zip(b.iter().zip(&q))
             .for_each(|(r, (b, q))| *r = b - q);
         let residual = super::inf_norm(&r);
-        if residual <= target || {
-            products += 1;
-            residual <= attainable(&x)
-        } {
+        if residual <= target || residual <= measure(&x, &mut here) {
             return Some(Solved {
                 x,
                 applications,
-                products,
+                products: products + absolute_products,
             });
         }
     }

@@ -350,14 +350,7 @@ impl OrderedCholesky {
 
     /// Solve with the single-precision factorization, in place.
     pub fn solve_single(&self, rhs: &mut [f32]) {
-        let n = rhs.len();
-        let mut buffer = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f32>(1, Par::Seq));
-        LltRef::new(&self.symbolic, &self.values_single).solve_in_place_with_conj(
-            Conj::No,
-            faer::MatMut::from_column_major_slice_mut(rhs, n, 1),
-            Par::Seq,
-            MemStack::new(&mut buffer),
-        );
+        substitute(&self.symbolic, &self.values_single, rhs);
     }
 
     /// Drop the double-precision factor (its memory handed back).
@@ -367,15 +360,25 @@ impl OrderedCholesky {
 
     /// Solve with the factorization, in place.
     pub fn solve(&self, rhs: &mut [f64]) {
-        let n = rhs.len();
-        let mut buffer = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
-        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
-            Conj::No,
-            faer::MatMut::from_column_major_slice_mut(rhs, n, 1),
-            Par::Seq,
-            MemStack::new(&mut buffer),
-        );
+        substitute(&self.symbolic, &self.values, rhs);
     }
+}
+
+/// faer's forward and back substitutions with the L L^T factor `values` of `symbolic`, in
+/// place, in the precision of `T`.
+fn substitute<T: super::substitution::Value>(
+    symbolic: &SymbolicCholesky<usize>,
+    values: &[T],
+    rhs: &mut [T],
+) {
+    let n = rhs.len();
+    let mut buffer = MemBuffer::new(symbolic.solve_in_place_scratch::<T>(1, Par::Seq));
+    LltRef::new(symbolic, values).solve_in_place_with_conj(
+        Conj::No,
+        faer::MatMut::from_column_major_slice_mut(rhs, n, 1),
+        Par::Seq,
+        MemStack::new(&mut buffer),
+    );
 }
 
 /// faer's numeric L L^T of `values` (pattern order, lower triangle read) into `factor`

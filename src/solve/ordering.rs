@@ -238,12 +238,13 @@ fn supernode_shapes(
 /// diagonal block, c^2 r for its panel (c^2 r / 2 multiply-adds) and c r^2 for the update
 /// of the lower triangle of the rows below (c r^2 / 2 multiply-adds).
 pub fn flops(symbolic: &SymbolicSupernodalCholesky<usize>) -> f64 {
-    supernode_shapes(symbolic)
-        .map(|(c, r)| {
-            let (c, r) = (c as f64, r as f64);
-            c * c * c / 3.0 + c * c * r + c * r * r
-        })
-        .sum()
+    supernode_shapes(symbolic).map(supernode_flops).sum()
+}
+
+/// [`flops`] of one supernode of c columns over r rows below.
+fn supernode_flops((c, r): (usize, usize)) -> f64 {
+    let (c, r) = (c as f64, r as f64);
+    c * c * c / 3.0 + c * c * r + c * r * r
 }
 
 /// The flops of one numeric factorization with `symbolic` (a multiply-add counts 2): [`flops`] for a
@@ -253,12 +254,9 @@ pub fn factor_flops(symbolic: &SymbolicCholesky<usize>) -> f64 {
     match symbolic.raw() {
         SymbolicCholeskyRaw::Simplicial(s) => {
             let col_ptr = s.col_ptr();
+            // Each column a supernode of one column over its entries below the diagonal.
             (0..s.ncols())
-                .map(|j| {
-                    // Entries below the diagonal of column j.
-                    let r = (col_ptr[j + 1] - col_ptr[j]).saturating_sub(1) as f64;
-                    1.0 / 3.0 + r + r * r
-                })
+                .map(|j| supernode_flops((1, (col_ptr[j + 1] - col_ptr[j]).saturating_sub(1))))
                 .sum()
         }
         SymbolicCholeskyRaw::Supernodal(s) => flops(s),
