@@ -25,7 +25,7 @@
 //! solves with the whole factor only, and this needs the forward and back substitutions
 //! apart, with the interface solve in between.
 
-use super::substitution::{self, Split, Structure, Value};
+use super::substitution::{self, Lift, Split, Structure, Value};
 use super::{ordering, pieces};
 use crate::error::{Error, Result};
 use crate::fe::Pattern;
@@ -714,8 +714,8 @@ impl InterfaceFactorization {
             .map(|b| b.permuted(&f[b.first..b.first + b.n]))
             .collect();
         match self.values() {
-            Values::Single(v) => self.forward(&v, &mut y),
-            Values::Double(v) => self.forward(&v, &mut y),
+            Values::Single(v) => self.forward::<f32, f32>(&v, &mut y),
+            Values::Double(v) => self.forward::<f64, f64>(&v, &mut y),
         }
         let load = (self.blocks.iter().zip(&y))
             .flat_map(|(b, yb)| b.interface_load(yb))
@@ -740,16 +740,17 @@ impl InterfaceFactorization {
         }
     }
 
-    /// y <- L^{-1} y, block by block (`y`: the blocks' vectors in elimination order).
-    fn forward<T: Value>(&self, values: &[&[T]], y: &mut [Vec<f64>]) {
+    /// y <- L^{-1} y, block by block (`y`: the blocks' vectors in elimination order), in
+    /// the arithmetic X ([`substitution::forward_blocks`]).
+    fn forward<T: Value, X: Lift<T>>(&self, values: &[&[T]], y: &mut [Vec<f64>]) {
         let structures: Vec<Structure> = self.blocks.iter().map(Block::structure).collect();
-        substitution::forward_blocks(&self.splits, &structures, values, y);
+        substitution::forward_blocks::<T, X>(&self.splits, &structures, values, y);
     }
 
     /// y <- L^{-T} y, block by block.
-    fn back<T: Value>(&self, values: &[&[T]], y: &mut [Vec<f64>]) {
+    fn back<T: Value, X: Lift<T>>(&self, values: &[&[T]], y: &mut [Vec<f64>]) {
         let structures: Vec<Structure> = self.blocks.iter().map(Block::structure).collect();
-        substitution::back_blocks(&self.splits, &structures, values, y);
+        substitution::back_blocks::<T, X>(&self.splits, &structures, values, y);
     }
 
     /// The interface part of the Newton system of `set` (see the module): the interface
@@ -802,8 +803,8 @@ impl InterfaceFactorization {
             .map(|((b, y), o)| b.before_back(y, &x_interface[o..o + b.interface.len()]))
             .collect();
         match self.values() {
-            Values::Single(v) => self.back(&v, &mut y),
-            Values::Double(v) => self.back(&v, &mut y),
+            Values::Single(v) => self.back::<f32, f32>(&v, &mut y),
+            Values::Double(v) => self.back::<f64, f64>(&v, &mut y),
         }
         let parts: Vec<Vec<f64>> = (self.blocks.par_iter().zip(&y))
             .map(|(b, yb)| b.unpermuted(yb))

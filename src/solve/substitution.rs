@@ -15,19 +15,44 @@
 //! side by side, but the blocks differ in size (at 137,472 dofs of `rates`: 45,312 and
 //! 92,160 equations), so the larger one set the time: one preconditioner solve 9.3 ms on
 //! two threads against 13.5 ms on one.
+//!
+//! Arithmetic: a subtree's vector is in the arithmetic X of [`Lift`]: f32 beside newton's
+//! f32 factor, f64 beside an f64 one; the tops (separators, and the contact interface
+//! whose dense blocks are f64) stay in f64. Why: with f32 the subtrees read half the
+//! bytes of their vector and use twice the SIMD lanes, and the preconditioner's error is
+//! the f32 factor's already. Measured with `examples/substitutions.rs` (one preconditioner
+//! solve, 2 threads, two runs alternating): at 137,472 dofs 7.23-7.26 -> 5.99-6.13 ms
+//! fastest of 50 (median 7.87-7.88 -> 6.31-6.44 ms), at 34,432 dofs 1.34-1.40 -> 1.24-1.32
+//! ms fastest of 100; newton's preconditioner applications per `rates` run stay 28 and 24.
 
 use rayon::prelude::*;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// A stored value of the factor: f64, or f32 for a preconditioner.
-pub trait Value: faer::traits::RealField + Copy + Send + Sync + 'static {
+/// A stored value of the factor: f64, or f32 for a preconditioner; also the arithmetic
+/// of a substitution ([`Lift`]).
+pub trait Value:
+    faer::traits::RealField
+    + Copy
+    + Send
+    + Sync
+    + Default
+    + std::ops::Add<Output = Self>
+    + std::ops::Mul<Output = Self>
+    + std::ops::AddAssign
+    + std::ops::SubAssign
+    + std::iter::Sum
+    + 'static
+{
+    /// Zero.
+    const ZERO: Self;
     /// The value in f64.
     fn get(self) -> f64;
     /// The value rounded from f64.
     fn from_f64(v: f64) -> Self;
 }
 impl Value for f64 {
+    const ZERO: Self = 0.0;
     fn get(self) -> f64 {
         self
     }
@@ -36,11 +61,29 @@ impl Value for f64 {
     }
 }
 impl Value for f32 {
+    const ZERO: Self = 0.0;
     fn get(self) -> f64 {
         self as f64
     }
     fn from_f64(v: f64) -> Self {
         v as f32
+    }
+}
+
+/// The arithmetic X of a substitution with a factor of precision T: f64 (any factor), or
+/// f32 beside an f32 factor (half the bytes of the vector, twice the SIMD lanes).
+pub trait Lift<T>: Value {
+    /// The value in X.
+    fn lift(t: T) -> Self;
+}
+impl<T: Value> Lift<T> for f64 {
+    fn lift(t: T) -> f64 {
+        t.get()
+    }
+}
+impl Lift<f32> for f32 {
+    fn lift(t: f32) -> f32 {
+        t
     }
 }
 
@@ -51,19 +94,19 @@ impl Value for f32 {
 /// four partial sums; sixteen were slower (0.58 ms: the columns' off-diagonal parts are
 /// short, and more of each falls to the serial remainder), and two columns at a time
 /// slower still (0.68-0.77 ms).
-fn dot<T: Value>(l: &[T], x: &[f64]) -> f64 {
+fn dot<T: Value, X: Lift<T>>(l: &[T], x: &[X]) -> X {
     const W: usize = 8;
-    let mut sums = [0.0; W];
+    let mut sums = [X::ZERO; W];
     let (l_chunks, x_chunks) = (l.chunks_exact(W), x.chunks_exact(W));
-    let rest: f64 = (l_chunks.remainder().iter().zip(x_chunks.remainder()))
-        .map(|(a, b)| a.get() * b)
+    let rest: X = (l_chunks.remainder().iter().zip(x_chunks.remainder()))
+        .map(|(&a, &b)| X::lift(a) * b)
         .sum();
     for (a, b) in l_chunks.zip(x_chunks) {
         for k in 0..W {
-            sums[k] += a[k].get() * b[k];
+            sums[k] += X::lift(a[k]) * b[k];
         }
     }
-    sums.iter().sum::<f64>() + rest
+    sums.iter().copied().sum::<X>() + rest
 }
 
 /// One supernode as the substitutions see it: (first column, width, off-diagonal row
@@ -105,9 +148,9 @@ const COLUMNS: usize = 4;
 /// its diagonal block, column by column; then the off-diagonal rows' sums
 /// `sum_j L_kj x_j` over the columns with x_j != 0, [`COLUMNS`] columns per pass,
 /// gathered once and scattered once. A solve reads the factor once.
-pub fn forward<'a, T: Value, I: Row>(
+pub fn forward<'a, T: Value, I: Row, X: Lift<T>>(
     supernodes: impl Iterator<Item = Supernode<'a, T, I>>,
-    x: &mut [f64],
+    x: &mut [X],
 ) {
     let mut below = Vec::new();
     let mut nonzero = Vec::new();
@@ -117,20 +160,20 @@ pub fn forward<'a, T: Value, I: Row>(
         nonzero.clear();
         for j in 0..width {
             let xj = x[start + j];
-            if xj == 0.0 {
+            if xj == X::ZERO {
                 continue;
             }
             nonzero.push(j);
             let column = &values[j * rows..j * rows + width];
-            for (xi, l) in x[start + j + 1..start + width]
+            for (xi, &l) in x[start + j + 1..start + width]
                 .iter_mut()
                 .zip(&column[j + 1..width])
             {
-                *xi -= l.get() * xj;
+                *xi -= X::lift(l) * xj;
             }
         }
         below.clear();
-        below.resize(p, 0.0);
+        below.resize(p, X::ZERO);
         let below = &mut below[..p];
         let off = |j: usize| &values[j * rows + width..(j + 1) * rows];
         let mut groups = nonzero.chunks_exact(COLUMNS);
@@ -145,29 +188,29 @@ pub fn forward<'a, T: Value, I: Row>(
             let (c0, c1, c2, c3) = (&c0[..p], &c1[..p], &c2[..p], &c3[..p]);
             for k in 0..p {
                 let mut t = below[k];
-                t += c0[k].get() * x0;
-                t += c1[k].get() * x1;
-                t += c2[k].get() * x2;
-                t += c3[k].get() * x3;
+                t += X::lift(c0[k]) * x0;
+                t += X::lift(c1[k]) * x1;
+                t += X::lift(c2[k]) * x2;
+                t += X::lift(c3[k]) * x3;
                 below[k] = t;
             }
         }
         for &j in groups.remainder() {
             let xj = x[start + j];
-            for (bk, l) in below.iter_mut().zip(off(j)) {
-                *bk += l.get() * xj;
+            for (bk, &l) in below.iter_mut().zip(off(j)) {
+                *bk += X::lift(l) * xj;
             }
         }
-        for (&i, bk) in pattern.iter().zip(&*below) {
+        for (&i, &bk) in pattern.iter().zip(&*below) {
             x[i.at()] -= bk;
         }
     }
 }
 
 /// x <- L^{-T} x over `supernodes` (decreasing).
-pub fn back<'a, T: Value, I: Row>(
+pub fn back<'a, T: Value, I: Row, X: Lift<T>>(
     supernodes: impl Iterator<Item = Supernode<'a, T, I>>,
-    x: &mut [f64],
+    x: &mut [X],
 ) {
     let mut below = Vec::new();
     for (start, width, pattern, values) in supernodes {
@@ -444,14 +487,14 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
 /// first; the task that finishes a block's last subtree adds their updates of the outside
 /// rows (subtree by subtree, in a fixed order) and substitutes the block's top, while the
 /// other threads go on with the next subtrees.
-pub fn forward_blocks<T: Value>(
+pub fn forward_blocks<T: Value, X: Lift<T>>(
     splits: &[Split],
     structures: &[Structure],
     values: &[&[T]],
     x: &mut [Vec<f64>],
 ) {
     let blocks: Vec<Mutex<&mut Vec<f64>>> = x.iter_mut().map(Mutex::new).collect();
-    let parts: Vec<Vec<Mutex<Vec<f64>>>> = (splits.iter())
+    let parts: Vec<Vec<Mutex<Vec<X>>>> = (splits.iter())
         .map(|s| s.subtrees.iter().map(|_| Mutex::new(Vec::new())).collect())
         .collect();
     let remaining: Vec<AtomicUsize> = (splits.iter())
@@ -463,10 +506,10 @@ pub fn forward_blocks<T: Value>(
             let z = std::mem::take(&mut *lock(part));
             let k = subtree.columns.len();
             for (&i, &v) in subtree.columns.iter().zip(&z[..k]) {
-                xb[i] = v;
+                xb[i] = v.get();
             }
             for (&i, &v) in subtree.outside.iter().zip(&z[k..]) {
-                xb[i] += v;
+                xb[i] += v.get();
             }
         }
         let (split, st, v) = (&splits[b], &structures[b], values[b]);
@@ -480,11 +523,15 @@ pub fn forward_blocks<T: Value>(
             for (t, subtree) in splits[b].subtrees.iter().enumerate() {
                 let (top, blocks, parts, remaining) = (&top, &blocks, &parts, &remaining);
                 scope.spawn_fifo(move |_| {
-                    let mut z: Vec<f64> = {
+                    let mut z: Vec<X> = {
                         let xb = lock(&blocks[b]);
-                        subtree.columns.iter().map(|&i| xb[i]).collect()
+                        subtree
+                            .columns
+                            .iter()
+                            .map(|&i| X::from_f64(xb[i]))
+                            .collect()
                     };
-                    z.resize(subtree.columns.len() + subtree.outside.len(), 0.0);
+                    z.resize(subtree.columns.len() + subtree.outside.len(), X::ZERO);
                     forward(subtree.local(&structures[b], values[b]), &mut z);
                     *lock(&parts[b][t]) = z;
                     if remaining[b].fetch_sub(1, Ordering::AcqRel) == 1 {
@@ -498,7 +545,7 @@ pub fn forward_blocks<T: Value>(
 
 /// x <- L^{-T} x for every block: each block's top, then its subtrees, as tasks on
 /// rayon's threads (the blocks with the most work first).
-pub fn back_blocks<T: Value>(
+pub fn back_blocks<T: Value, X: Lift<T>>(
     splits: &[Split],
     structures: &[Structure],
     values: &[&[T]],
@@ -506,17 +553,17 @@ pub fn back_blocks<T: Value>(
 ) {
     let blocks: Vec<Mutex<&mut Vec<f64>>> = x.iter_mut().map(Mutex::new).collect();
     let subtree = |b: usize, subtree: &Subtree| {
-        let mut z: Vec<f64> = {
+        let mut z: Vec<X> = {
             let xb = lock(&blocks[b]);
             (subtree.columns.iter())
                 .chain(&subtree.outside)
-                .map(|&i| xb[i])
+                .map(|&i| X::from_f64(xb[i]))
                 .collect()
         };
         back(subtree.local(&structures[b], values[b]).rev(), &mut z);
         let mut xb = lock(&blocks[b]);
         for (&i, &v) in subtree.columns.iter().zip(&z) {
-            xb[i] = v;
+            xb[i] = v.get();
         }
     };
     rayon::scope_fifo(|scope| {
