@@ -62,14 +62,15 @@ impl BothWays {
 
     /// The floor's single way for `b`: conjugate gradients to `tol` with these pieces.
     fn single_way(&self, b: &[f64], tol: f64) -> floor::Solved {
-        floor::conjugate_gradients(
+        let solved = floor::conjugate_gradients(
             &|x, y| self.product.product(x, y),
             &|x| self.attainable(x),
             &|r, z| self.precondition(r, z),
             b,
             tol,
-        )
-        .expect("the single way converges")
+        );
+        assert!(solved.converged, "the single way converges");
+        solved
     }
 
     /// z = the f32 factor's solve of r, in f64.
@@ -269,4 +270,28 @@ fn conjugate_gradients_stop_at_the_round_off_of_the_product() {
             solved.applications
         );
     }
+}
+
+/// Goal: where conjugate gradients cannot meet the tolerance (here a tolerance of 1e-300
+/// |b|, far below the product's round-off, with the round-off stop switched off), they
+/// give up after exactly [`REFINEMENT_BUDGET`] applications, say so, and count that work:
+/// the floor then reports the way as missed with the applications it paid.
+#[test]
+fn conjugate_gradients_that_miss_the_tolerance_count_their_applications() {
+    let case = common::case("rates-elastic", 1, Method::Mortar, &[]);
+    let (pattern, values, mean) = floor::shifted_stiffness(&case.problem.model);
+    let range = pattern.diagonal_blocks()[0].clone();
+    let (block, entries) = pattern.block(&range);
+    let both = BothWays::new(&block, &values[entries], mean);
+    let b = vec![1.0; block.n];
+    let solved = floor::conjugate_gradients(
+        &|x, y| both.product.product(x, y),
+        &|_| 0.0,
+        &|r, z| both.precondition(r, z),
+        &b,
+        1e-300,
+    );
+    assert!(!solved.converged);
+    assert_eq!(solved.applications, REFINEMENT_BUDGET);
+    assert!(solved.products >= REFINEMENT_BUDGET, "{}", solved.products);
 }

@@ -61,7 +61,8 @@ pub struct Floor {
     /// Systems solved: distinct right-hand sides ([`right_hand_sides`]).
     pub systems: usize,
     /// Applications of the f32 factor over all systems, the most of any block (the
-    /// blocks run side by side).
+    /// blocks run side by side), a block that missed the tolerance included (all its
+    /// applications).
     pub single_applications: usize,
     /// Bytes the double way must read: its factor twice per system (L, then L^T), 8 per
     /// entry, summed over the blocks (index arrays left out: a lower bound).
@@ -81,7 +82,9 @@ pub struct Floor {
 
 impl Floor {
     /// Each way at the faster of `self` and `other` (two measurements of the same floor:
-    /// the same systems, fill and iterations), and the floor as the faster way.
+    /// the same systems, fill and iterations), and the floor as the faster way. Each time
+    /// is a whole measurement's (a way's includes its own shared part), and `shared_s` the
+    /// faster of the two shared parts: the fastest of each, not one measurement's split.
     pub fn fastest(&self, other: &Floor) -> Floor {
         let double_s = self.double_s.min(other.double_s);
         let shared_s = self.shared_s.min(other.shared_s);
@@ -233,9 +236,8 @@ pub fn floor(p: &Problem, steps: usize) -> Result<Floor> {
         .par_iter_mut()
         .map(|b| solve_single(b, &values, &loads, tol, (epsilon, replacement)))
         .collect::<Result<Vec<_>>>()?;
-    let applications: Vec<Option<usize>> = outcomes.iter().map(|o| o.map(|o| o.0)).collect();
     let single_s = shared_s + t.elapsed().as_secs_f64();
-    let single_s = applications.iter().all(Option::is_some).then_some(single_s);
+    let single_s = outcomes.iter().all(|o| o.2).then_some(single_s);
 
     let (seconds, precision) = match single_s {
         Some(s) if s < double_s => (s, Precision::Single),
@@ -249,7 +251,7 @@ pub fn floor(p: &Problem, steps: usize) -> Result<Floor> {
         double_s,
         single_s,
         systems: loads.len(),
-        single_applications: applications.iter().flatten().copied().max().unwrap_or(0),
+        single_applications: outcomes.iter().map(|o| o.0).max().unwrap_or(0),
         double_bytes: blocks
             .iter()
             .map(|b| (loads.len() * 2 * b.system.factor_entries() * 8) as f64)
@@ -257,8 +259,7 @@ pub fn floor(p: &Problem, steps: usize) -> Result<Floor> {
         single_bytes: blocks
             .iter()
             .zip(&outcomes)
-            .map(|(b, o)| {
-                let (applications, products) = o.unwrap_or((0, 0));
+            .map(|(b, &(applications, products, _))| {
                 (applications * 2 * b.system.factor_entries() * 4 + products * b.pattern.nnz() * 8)
                     as f64
             })
@@ -285,15 +286,15 @@ fn solve_double(b: &mut Block, values: &[f64], loads: &[Vec<f64>]) -> Result<()>
 }
 
 /// The single way on one block: the f32 factorization, then conjugate gradients per
-/// load to `tol`. The preconditioner applications and the products, or None where a load
-/// missed `tol`.
+/// load to `tol`. The preconditioner applications and the products over all loads, and
+/// whether every load met `tol`.
 fn solve_single(
     b: &mut Block,
     values: &[f64],
     loads: &[Vec<f64>],
     tol: f64,
     (epsilon, replacement): (f32, f32),
-) -> Result<Option<(usize, usize)>> {
+) -> Result<(usize, usize, bool)> {
     let first = b.range.start;
     let t = Instant::now();
     let block_values = &values[b.entries.clone()];
@@ -318,14 +319,15 @@ fn solve_single(
         z.iter_mut().zip(&v).for_each(|(z, &v)| *z = v as f64);
     };
     Ok(pieces::time("floor.refinement", first, || {
-        let (mut applications, mut products) = (0, 0);
+        let (mut applications, mut products, mut converged) = (0, 0, true);
         for load in loads {
             let b = &load[b.range.clone()];
-            let solved = conjugate_gradients(&product, &attainable, &precondition, b, tol)?;
+            let solved = conjugate_gradients(&product, &attainable, &precondition, b, tol);
             applications += solved.applications;
             products += solved.products;
+            converged &= solved.converged;
         }
-        Some((applications, products))
+        (applications, products, converged)
     }))
 }
 
@@ -344,8 +346,10 @@ fn symmetric_product(pattern: &Pattern, values: &[f64], x: &[f64], y: &mut [f64]
 
 /// What [`conjugate_gradients`] found.
 pub struct Solved {
-    /// The solution.
+    /// The solution (the last iterate where it missed the tolerance).
     pub x: Vec<f64>,
+    /// Whether it met the tolerance within [`REFINEMENT_BUDGET`] applications.
+    pub converged: bool,
     /// Preconditioner applications.
     pub applications: usize,
     /// Products with the matrix or its absolute value (one per application, one per check
@@ -359,7 +363,7 @@ pub struct Solved {
 /// no f64 answer, the double way's included, has a smaller residual (measured: the
 /// `rates` upper body, held only by contact, at level 3: 1.1-1.7e-10 |b| where
 /// eps |A| |x| = 1.2e-10 |b|; the clamped body with ones at level 6: the f64 Cholesky's
-/// answer at 6.4e-10 |b|). None when
+/// answer at 6.4e-10 |b|). Not converged (and the work done counted) when
 /// [`REFINEMENT_BUDGET`] applications do not reach it. Written by hand: twenty lines, and
 /// the preconditioner is faer's factorization.
 pub fn conjugate_gradients(
@@ -368,16 +372,17 @@ pub fn conjugate_gradients(
     precondition: &dyn Fn(&[f64], &mut [f64]),
     b: &[f64],
     tol: f64,
-) -> Option<Solved> {
+) -> Solved {
     let n = b.len();
     let dot = |a: &[f64], c: &[f64]| a.iter().zip(c).map(|(x, y)| x * y).sum::<f64>();
     let target = tol * super::inf_norm(b);
     if target == 0.0 {
-        return Some(Solved {
+        return Solved {
             x: vec![0.0; n],
+            converged: true,
             applications: 0,
             products: 0,
-        });
+        };
     }
     let (mut x, mut r) = (vec![0.0; n], b.to_vec());
     let (mut z, mut q) = (vec![0.0; n], vec![0.0; n]);
@@ -436,12 +441,18 @@ pub fn conjugate_gradients(
             .for_each(|(r, (b, q))| *r = b - q);
         let residual = super::inf_norm(&r);
         if residual <= target || residual <= measure(&x, &mut here) {
-            return Some(Solved {
+            return Solved {
                 x,
+                converged: true,
                 applications,
                 products: products + absolute_products,
-            });
+            };
         }
     }
-    None
+    Solved {
+        x,
+        converged: false,
+        applications,
+        products: products + absolute_products,
+    }
 }
