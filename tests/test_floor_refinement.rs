@@ -274,8 +274,10 @@ fn conjugate_gradients_stop_at_the_round_off_of_the_product() {
 
 /// Goal: where conjugate gradients cannot meet the tolerance (here a tolerance of 1e-300
 /// |b|, far below the product's round-off, with the round-off stop switched off), they
-/// give up after exactly [`REFINEMENT_BUDGET`] applications, say so, and count that work:
-/// the floor then reports the way as missed with the applications it paid.
+/// give up after exactly [`REFINEMENT_BUDGET`] applications, say so, and count that work
+/// (one product per application at least), which the floor adds to the single way's
+/// applications and bytes. No committed run misses, so the floor's sum is not exercised
+/// end to end here.
 #[test]
 fn conjugate_gradients_that_miss_the_tolerance_count_their_applications() {
     let case = common::case("rates-elastic", 1, Method::Mortar, &[]);
@@ -294,4 +296,40 @@ fn conjugate_gradients_that_miss_the_tolerance_count_their_applications() {
     assert!(!solved.converged);
     assert_eq!(solved.applications, REFINEMENT_BUDGET);
     assert!(solved.products >= REFINEMENT_BUDGET, "{}", solved.products);
+}
+
+/// Goal: `Floor::fastest` of two measurements of one floor, where only the second's single
+/// way met the tolerance, keeps that way's time and the work it did (not the missed
+/// measurement's budget), and each way's fastest time.
+#[test]
+fn the_fastest_floor_takes_the_single_way_from_the_measurement_that_converged() {
+    let missed = floor::Floor {
+        seconds: 1.0,
+        precision: Precision::Double,
+        shared_s: 0.4,
+        double_s: 1.0,
+        single_s: None,
+        systems: 4,
+        single_applications: 4 * REFINEMENT_BUDGET,
+        double_bytes: 8.0,
+        single_bytes: 1000.0,
+        factor_entries: 10,
+        factor_flops: 100.0,
+        stiffness_entries: 20,
+    };
+    let converged = floor::Floor {
+        seconds: 0.9,
+        precision: Precision::Single,
+        shared_s: 0.5,
+        double_s: 1.1,
+        single_s: Some(0.9),
+        single_applications: 20,
+        single_bytes: 300.0,
+        ..missed
+    };
+    for f in [missed.fastest(&converged), converged.fastest(&missed)] {
+        assert_eq!((f.seconds, f.precision), (0.9, Precision::Single));
+        assert_eq!((f.shared_s, f.double_s, f.single_s), (0.4, 1.0, Some(0.9)));
+        assert_eq!((f.single_applications, f.single_bytes), (20, 300.0));
+    }
 }

@@ -96,12 +96,21 @@ impl Floor {
             Some(s) if s < double_s => (s, Precision::Single),
             _ => (double_s, Precision::Double),
         };
+        // The single way's work from the measurement its time comes from (the same in
+        // both unless one of them missed the tolerance).
+        let single = match (self.single_s, other.single_s) {
+            (None, Some(_)) => other,
+            (Some(a), Some(b)) if b < a => other,
+            _ => self,
+        };
         Floor {
             seconds,
             precision,
             shared_s,
             double_s,
             single_s,
+            single_applications: single.single_applications,
+            single_bytes: single.single_bytes,
             ..*self
         }
     }

@@ -87,8 +87,9 @@ impl Lift<f32> for f32 {
     }
 }
 
-/// sum_k l_k x_k, with eight partial sums (one AVX-512 register of f64, two of AVX2): one
-/// running sum is bound by the latency of the addition. Measured with
+/// sum_k l_k x_k, with eight partial sums (one AVX-512 register of f64, two of AVX2; half
+/// a register in f32, where the count was kept, not measured again): one running sum is
+/// bound by the latency of the addition. Measured in f64 with
 /// `examples/substitutions.rs` (one preconditioner solve, 2 threads, fastest of 100): back
 /// substitution 0.675 -> 0.48 ms at 34,432 dofs and 4.7 -> 3.9-4.0 ms at 137,472 against
 /// four partial sums; sixteen were slower (0.58 ms: the columns' off-diagonal parts are
