@@ -88,21 +88,15 @@ impl Floor {
     pub fn fastest(&self, other: &Floor) -> Floor {
         let double_s = self.double_s.min(other.double_s);
         let shared_s = self.shared_s.min(other.shared_s);
-        let single_s = match (self.single_s, other.single_s) {
-            (Some(a), Some(b)) => Some(a.min(b)),
-            (a, b) => a.or(b),
-        };
-        let (seconds, precision) = match single_s {
-            Some(s) if s < double_s => (s, Precision::Single),
-            _ => (double_s, Precision::Double),
-        };
-        // The single way's work from the measurement its time comes from (the same in
-        // both unless one of them missed the tolerance).
+        // The measurement with the faster single way (the one that met the tolerance, if
+        // only one did): its time and its work (the same work in both unless one missed).
         let single = match (self.single_s, other.single_s) {
             (None, Some(_)) => other,
             (Some(a), Some(b)) if b < a => other,
             _ => self,
         };
+        let single_s = single.single_s;
+        let (seconds, precision) = faster_way(double_s, single_s);
         Floor {
             seconds,
             precision,
@@ -113,6 +107,15 @@ impl Floor {
             single_bytes: single.single_bytes,
             ..*self
         }
+    }
+}
+
+/// The floor's seconds and way: the single way where it met the tolerance and is faster
+/// than the double way, else the double way.
+fn faster_way(double_s: f64, single_s: Option<f64>) -> (f64, Precision) {
+    match single_s {
+        Some(s) if s < double_s => (s, Precision::Single),
+        _ => (double_s, Precision::Double),
     }
 }
 
@@ -248,10 +251,7 @@ pub fn floor(p: &Problem, steps: usize) -> Result<Floor> {
     let single_s = shared_s + t.elapsed().as_secs_f64();
     let single_s = outcomes.iter().all(|o| o.2).then_some(single_s);
 
-    let (seconds, precision) = match single_s {
-        Some(s) if s < double_s => (s, Precision::Single),
-        _ => (double_s, Precision::Double),
-    };
+    let (seconds, precision) = faster_way(double_s, single_s);
     pieces::record("floor.total", 0, seconds);
     Ok(Floor {
         seconds,

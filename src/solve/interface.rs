@@ -611,10 +611,10 @@ impl InterfaceFactorization {
     /// In [`Precision::Single`] (newton's): the scaled stiffness is rounded to f32 and
     /// faer's LDL^T runs in f32; the interface's dense blocks stay in f64, and the
     /// substitutions run in f32 below the tops of the elimination trees and in f64 in the
-    /// tops ([`substitution`]'s arithmetic). The factorization moves half the bytes and runs twice the
-    /// SIMD lanes, a substitution reads half the bytes (measured on `rates-elastic` at
-    /// 549,376 dofs: the factorization 0.88 s against 1.37 s in f64, the run 2.64 s
-    /// against 3.06 s). A solve is then exact for a matrix within about 1e-7 cond(K) of K
+    /// tops ([`substitution`]'s arithmetic). The factorization moves half the bytes and
+    /// runs twice the SIMD lanes, a substitution reads half the bytes (measured on
+    /// `rates-elastic` at 549,376 dofs: the factorization 0.88 s against 1.37 s in f64,
+    /// the run 2.64 s against 3.06 s). A solve is then exact for a matrix within about 1e-7 cond(K) of K
     /// (8.5e-6 of the right-hand side at level 1 of `rates`), and newton's GMRES and Newton
     /// iterations take the system to its tolerance: on `rates-elastic` at 137,472 dofs, 4
     /// steps, 6 preconditioner applications and 5 iterations against 4 and 4 in f64; on
@@ -715,8 +715,8 @@ impl InterfaceFactorization {
             .map(|b| b.permuted(&f[b.first..b.first + b.n]))
             .collect();
         match self.values() {
-            Values::Single(v) => self.forward::<f32, f32>(&v, &mut y),
-            Values::Double(v) => self.forward::<f64, f64>(&v, &mut y),
+            Values::Single(v) => self.forward(&v, &mut y),
+            Values::Double(v) => self.forward(&v, &mut y),
         }
         let load = (self.blocks.iter().zip(&y))
             .flat_map(|(b, yb)| b.interface_load(yb))
@@ -741,17 +741,17 @@ impl InterfaceFactorization {
         }
     }
 
-    /// y <- L^{-1} y, block by block (`y`: the blocks' vectors in elimination order), in
-    /// the arithmetic X ([`substitution::forward_blocks`]).
-    fn forward<T: Value, X: Lift<T>>(&self, values: &[&[T]], y: &mut [Vec<f64>]) {
+    /// y <- L^{-1} y, block by block (`y`: the blocks' vectors in elimination order), the
+    /// subtrees in the factor's own precision ([`substitution::forward_blocks`]).
+    fn forward<T: Lift<T>>(&self, values: &[&[T]], y: &mut [Vec<f64>]) {
         let structures: Vec<Structure> = self.blocks.iter().map(Block::structure).collect();
-        substitution::forward_blocks::<T, X>(&self.splits, &structures, values, y);
+        substitution::forward_blocks::<T, T>(&self.splits, &structures, values, y);
     }
 
-    /// y <- L^{-T} y, block by block.
-    fn back<T: Value, X: Lift<T>>(&self, values: &[&[T]], y: &mut [Vec<f64>]) {
+    /// y <- L^{-T} y, block by block, as [`InterfaceFactorization::forward`].
+    fn back<T: Lift<T>>(&self, values: &[&[T]], y: &mut [Vec<f64>]) {
         let structures: Vec<Structure> = self.blocks.iter().map(Block::structure).collect();
-        substitution::back_blocks::<T, X>(&self.splits, &structures, values, y);
+        substitution::back_blocks::<T, T>(&self.splits, &structures, values, y);
     }
 
     /// The interface part of the Newton system of `set` (see the module): the interface
@@ -804,8 +804,8 @@ impl InterfaceFactorization {
             .map(|((b, y), o)| b.before_back(y, &x_interface[o..o + b.interface.len()]))
             .collect();
         match self.values() {
-            Values::Single(v) => self.back::<f32, f32>(&v, &mut y),
-            Values::Double(v) => self.back::<f64, f64>(&v, &mut y),
+            Values::Single(v) => self.back(&v, &mut y),
+            Values::Double(v) => self.back(&v, &mut y),
         }
         let parts: Vec<Vec<f64>> = (self.blocks.par_iter().zip(&y))
             .map(|(b, yb)| b.unpermuted(yb))
