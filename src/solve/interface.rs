@@ -745,13 +745,13 @@ impl InterfaceFactorization {
     /// subtrees in the factor's own precision ([`substitution::forward_blocks`]).
     fn forward<T: Lift<T>>(&self, values: &[&[T]], y: &mut [Vec<f64>]) {
         let structures: Vec<Structure> = self.blocks.iter().map(Block::structure).collect();
-        substitution::forward_blocks::<T, T>(&self.splits, &structures, values, y);
+        substitution::forward_blocks(&self.splits, &structures, values, y);
     }
 
     /// y <- L^{-T} y, block by block, as [`InterfaceFactorization::forward`].
     fn back<T: Lift<T>>(&self, values: &[&[T]], y: &mut [Vec<f64>]) {
         let structures: Vec<Structure> = self.blocks.iter().map(Block::structure).collect();
-        substitution::back_blocks::<T, T>(&self.splits, &structures, values, y);
+        substitution::back_blocks(&self.splits, &structures, values, y);
     }
 
     /// The interface part of the Newton system of `set` (see the module): the interface

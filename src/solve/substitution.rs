@@ -483,19 +483,20 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// x <- L^{-1} x for every block (`x`: the blocks' vectors, elimination order). The
+/// x <- L^{-1} x for every block (`x`: the blocks' vectors, elimination order), the
+/// subtrees in the factor's own arithmetic T and the tops in f64 (see the module). The
 /// subtrees of all blocks are tasks on rayon's threads, the blocks with the most work
 /// first; the task that finishes a block's last subtree adds their updates of the outside
 /// rows (subtree by subtree, in a fixed order) and substitutes the block's top, while the
 /// other threads go on with the next subtrees.
-pub fn forward_blocks<T: Value, X: Lift<T>>(
+pub fn forward_blocks<T: Lift<T>>(
     splits: &[Split],
     structures: &[Structure],
     values: &[&[T]],
     x: &mut [Vec<f64>],
 ) {
     let blocks: Vec<Mutex<&mut Vec<f64>>> = x.iter_mut().map(Mutex::new).collect();
-    let parts: Vec<Vec<Mutex<Vec<X>>>> = (splits.iter())
+    let parts: Vec<Vec<Mutex<Vec<T>>>> = (splits.iter())
         .map(|s| s.subtrees.iter().map(|_| Mutex::new(Vec::new())).collect())
         .collect();
     let remaining: Vec<AtomicUsize> = (splits.iter())
@@ -524,15 +525,15 @@ pub fn forward_blocks<T: Value, X: Lift<T>>(
             for (t, subtree) in splits[b].subtrees.iter().enumerate() {
                 let (top, blocks, parts, remaining) = (&top, &blocks, &parts, &remaining);
                 scope.spawn_fifo(move |_| {
-                    let mut z: Vec<X> = {
+                    let mut z: Vec<T> = {
                         let xb = lock(&blocks[b]);
                         subtree
                             .columns
                             .iter()
-                            .map(|&i| X::from_f64(xb[i]))
+                            .map(|&i| T::from_f64(xb[i]))
                             .collect()
                     };
-                    z.resize(subtree.columns.len() + subtree.outside.len(), X::ZERO);
+                    z.resize(subtree.columns.len() + subtree.outside.len(), T::ZERO);
                     forward(subtree.local(&structures[b], values[b]), &mut z);
                     *lock(&parts[b][t]) = z;
                     if remaining[b].fetch_sub(1, Ordering::AcqRel) == 1 {
@@ -546,7 +547,7 @@ pub fn forward_blocks<T: Value, X: Lift<T>>(
 
 /// x <- L^{-T} x for every block: each block's top, then its subtrees, as tasks on
 /// rayon's threads (the blocks with the most work first).
-pub fn back_blocks<T: Value, X: Lift<T>>(
+pub fn back_blocks<T: Lift<T>>(
     splits: &[Split],
     structures: &[Structure],
     values: &[&[T]],
@@ -554,11 +555,11 @@ pub fn back_blocks<T: Value, X: Lift<T>>(
 ) {
     let blocks: Vec<Mutex<&mut Vec<f64>>> = x.iter_mut().map(Mutex::new).collect();
     let subtree = |b: usize, subtree: &Subtree| {
-        let mut z: Vec<X> = {
+        let mut z: Vec<T> = {
             let xb = lock(&blocks[b]);
             (subtree.columns.iter())
                 .chain(&subtree.outside)
-                .map(|&i| X::from_f64(xb[i]))
+                .map(|&i| T::from_f64(xb[i]))
                 .collect()
         };
         back(subtree.local(&structures[b], values[b]).rev(), &mut z);
