@@ -433,37 +433,52 @@ fn verdict(windowed: bool, fit: Option<Fit>, fit_all: Option<Fit>, mean_last: f6
     }
 }
 
-/// The standard error sqrt(v) of a parameter of variance `v` from an inverted J^T J; a
-/// variance that is not positive comes from a J^T J singular to round-off (a term
-/// vanishing on the grid, its exponent undetermined), and is no evidence of an exact
-/// exponent: infinite, not zero (a zero read "a2 = -36.9 ± 0.0" in a two-size fit whose
-/// second term was 1e-67 of the first).
-fn standard_error(v: f64) -> f64 {
-    if v > 0.0 { v.sqrt() } else { f64::INFINITY }
-}
-
 /// Largest condition number of J^T J scaled to unit diagonal (the parameters'
-/// correlation matrix) whose inverse [`fit_power_sum`] reads standard errors from: its
-/// relative error is about the condition times f64's epsilon, so 4.5e12 keeps three
-/// digits of every variance. Beyond it the columns of J are collinear to round-off (a
-/// term alive at one level of its size only: any steeper exponent with a larger constant
-/// fits as well) and every entry of the inverse is noise, positive or not. Measured on
-/// the committed two-size grids: identified fits 1e2-3.5e3; the four degenerate ones
-/// 1.6e15 and beyond, whose standard errors read 0.017, 1.27 or 3.4e5 before this check
-/// and moved by 28 % between two runs whose errors differed by 9e-10.
+/// correlation matrix) over the directions [`exponent_standard_errors`] reads variances
+/// from: an inverse's relative error is about the condition times f64's epsilon, so
+/// 4.5e12 keeps three digits. Measured on the committed two-size grids: identified fits
+/// 1e2-3.5e3 over all four directions; the degenerate ones have one direction at
+/// 1e15-1e17 and beyond (a term alive at one level of its size only, or 1e-23 of the
+/// error everywhere: any steeper exponent with a larger constant fits as well).
 const MAX_CORRELATION_CONDITION: f64 = 1e-3 / f64::EPSILON;
 
-/// Whether the inverse of `jtj` gives the variances to three digits
-/// ([`MAX_CORRELATION_CONDITION`]).
-fn covariance_is_accurate(jtj: &nalgebra::Matrix4<f64>) -> bool {
-    let scale = jtj.diagonal().map(|v| 1.0 / v.sqrt());
-    if scale.iter().any(|s| !s.is_finite()) {
-        return false;
-    }
+/// Share of an exponent's unit vector in the undetermined directions above which the data
+/// do not determine it. Measured on the committed two-size grids: an undetermined exponent
+/// 0.5 (its term's constant and exponent move together), a determined one 3e-16 at most.
+const MAX_UNDETERMINED_SHARE: f64 = 1e-6;
+
+/// Standard errors of a1 and a2 from s^2 (J^T J)^+ (`s2`: the residual variance): the
+/// inverse over the directions the data determine ([`MAX_CORRELATION_CONDITION`]), and
+/// infinite for an exponent with a share in the others ([`MAX_UNDETERMINED_SHARE`]).
+/// Why not the plain inverse: where one term's exponent is undetermined, J^T J is
+/// singular to round-off and every entry of its inverse is noise, positive or not (the
+/// other exponent's standard error read 0.017 on a grid where the projection gives 0.072,
+/// and moved by 28 % between two runs whose errors differed by 9e-10); a determined
+/// exponent keeps its own.
+fn exponent_standard_errors(jtj: &nalgebra::Matrix4<f64>, s2: f64) -> [f64; 2] {
+    // A column of J that is zero (a term vanishing to underflow) scales to zero: its
+    // parameter then spans a zero eigenvalue's direction.
+    let scale = jtj
+        .diagonal()
+        .map(|v| if v > 0.0 { 1.0 / v.sqrt() } else { 0.0 });
     let correlation = jtj.component_mul(&(scale * scale.transpose()));
-    let eigenvalues = correlation.symmetric_eigenvalues();
-    let (smallest, largest) = (eigenvalues.min(), eigenvalues.max());
-    smallest > 0.0 && largest / smallest <= MAX_CORRELATION_CONDITION
+    let eigen = correlation.symmetric_eigen();
+    let largest = eigen.eigenvalues.max();
+    let determined = |i: usize| eigen.eigenvalues[i] * MAX_CORRELATION_CONDITION > largest;
+    [1, 3].map(|p| {
+        let (mut variance, mut undetermined) = (0.0, 0.0);
+        for i in 0..4 {
+            let v = eigen.eigenvectors[(p, i)];
+            match determined(i) {
+                true => variance += v * v / eigen.eigenvalues[i],
+                false => undetermined += v * v,
+            }
+        }
+        match undetermined <= MAX_UNDETERMINED_SHARE && scale[p] > 0.0 {
+            true => (s2 * variance).sqrt() * scale[p],
+            false => f64::INFINITY,
+        }
+    })
 }
 
 /// The fit of errors over two mesh sizes to E(h1, h2) = C1 h1^a1 + C2 h2^a2 (Lemma 3.1's
@@ -474,9 +489,9 @@ pub struct PowerSumFit {
     pub c: [f64; 2],
     /// Exponents a1 (in h1) and a2 (in h2).
     pub a: [f64; 2],
-    /// Standard errors of a1 and a2 (from s^2 (J^T J)^-1 at the optimum); infinite where
-    /// that diagonal is not positive, and both infinite where J^T J is singular to
-    /// round-off ([`MAX_CORRELATION_CONDITION`]): the data do not determine the exponents.
+    /// Standard errors of a1 and a2 (from s^2 (J^T J)^+ at the optimum, over the
+    /// directions the data determine); infinite for an exponent they do not determine
+    /// (see `exponent_standard_errors`).
     pub se: [f64; 2],
     /// Root mean square of the log residuals ln E - ln E_fit.
     pub rms_log_residual: f64,
@@ -582,15 +597,10 @@ pub fn fit_power_sum(points: &[(f64, f64, f64)]) -> Option<PowerSumFit> {
         let v = Vector4::from(*ji);
         jtj += v * v.transpose();
     }
-    let cov = jtj.try_inverse()? * (f / (n - 4) as f64);
-    let se = match covariance_is_accurate(&jtj) {
-        true => [standard_error(cov[(1, 1)]), standard_error(cov[(3, 3)])],
-        false => [f64::INFINITY; 2],
-    };
     let fit = PowerSumFit {
         c: [th[0].exp(), th[2].exp()],
         a: [th[1], th[3]],
-        se,
+        se: exponent_standard_errors(&jtj, f / (n - 4) as f64),
         rms_log_residual: (f / n as f64).sqrt(),
         points: n,
     };

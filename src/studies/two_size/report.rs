@@ -579,7 +579,7 @@ fn exponents(doc: &mut Doc, res: &TwoSizeResult) {
         ))
         .table(&table)
         .paragraph(format!(
-            "`poor fit`: the grid fit misses the errors by more than 28 % rms (rms log residual > {FIT_RMS}): the additive model does not describe them. Where an error grows when one body alone is refined (below: K_h^I's contact quantities when the master is refined past the slave, whose nodes alone carry the constraint), no sum of two positive terms C1 h1^a1 + C2 h2^a2 can fit it: the error depends on the ratio h1/h2, not on each size separately. `not identified`: a term too small on the grid for its exponent to be measured (standard error > {FIT_SE}), or one alive at a single level of its size, which any steeper exponent fits as well (J^T J singular to round-off: no standard error)."
+            "`poor fit`: the grid fit misses the errors by more than 28 % rms (rms log residual > {FIT_RMS}): the additive model does not describe them. Where an error grows when one body alone is refined (below: K_h^I's contact quantities when the master is refined past the slave, whose nodes alone carry the constraint), no sum of two positive terms C1 h1^a1 + C2 h2^a2 can fit it: the error depends on the ratio h1/h2, not on each size separately. `not identified`: a term too small on the grid for its exponent to be measured (standard error > {FIT_SE}), or one alive at a single level of its size (or negligible at every level), which any steeper exponent with a larger constant fits as well (no standard error: J^T J is singular to round-off along that term's constant and exponent; the other exponent's standard error is taken over the directions the data determine)."
         ));
 }
 
