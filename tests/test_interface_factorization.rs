@@ -17,19 +17,6 @@ use contact_rates::solve::interface::{InterfaceFactorization, Precision};
 use contact_rates::solve::linear::SparseSystem;
 use contact_rates::solve::{self, Settings};
 
-/// A fixed sequence in [-1, 1] (linear congruential; the test needs no randomness).
-fn sequence(len: usize) -> Vec<f64> {
-    let mut state: u64 = 12345;
-    (0..len)
-        .map(|_| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        })
-        .collect()
-}
-
 /// Largest residual entry of the Newton system of `active`, relative to the largest
 /// right-hand side entry.
 fn relative_residual(
@@ -88,7 +75,7 @@ fn interface_solve_is_exact_for_any_active_set() {
         let n = case.problem.model.n_free;
         let (stiffness, c, rows, pattern) = elastic_system(&case);
         let m = rows.len();
-        let b = sequence(n + m);
+        let b = common::sequence(n + m);
         // Single precision's error grows with the condition of the stiffness (h^-2): its
         // bound is the level-1 one; the split's exactness is checked in double precision.
         let precisions = match level {
@@ -132,7 +119,7 @@ fn a_solve_gives_the_same_bits_on_one_thread_and_on_two() {
     let (stiffness, c, rows, pattern) = elastic_system(&case);
     // The values alone cross into the pools (the matrix counts its solves in a Cell).
     let values = stiffness.values();
-    let b = sequence(n + rows.len());
+    let b = common::sequence(n + rows.len());
     let solve_on = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -190,7 +177,7 @@ fn the_per_triangle_tangent_change_is_the_assembled_one() {
         // A displacement of pseudo-random nodal values, strains of order 0.1 (stresses
         // about 3 sigma_Y in the triangles with large gradients, elastic elsewhere).
         let h = model.h();
-        let u: Vec<f64> = sequence(2 * model.n_nodes)
+        let u: Vec<f64> = common::sequence(2 * model.n_nodes)
             .iter()
             .map(|v| 0.05 * h * v)
             .collect();
@@ -210,7 +197,7 @@ fn the_per_triangle_tangent_change_is_the_assembled_one() {
         let (_, slots) = model.stiffness_pattern(&[], n);
         let mut assembled = SparseSystem::new(&pattern);
         model.add_tangent(&tangents, &slots, assembled.values_mut());
-        let x = sequence(n + 7)[7..].to_vec();
+        let x = common::sequence(n + 7)[7..].to_vec();
         let mut expected = vec![0.0; n];
         assembled.matvec(&x, &mut expected);
         let mut product = vec![0.0; n];

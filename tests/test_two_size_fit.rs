@@ -12,6 +12,8 @@
 //! covers a1's error (the plain inverse gave a1 +- 6.6e-9 on these data without noise).
 //! Data: levels 0-4, h1 = 0.3 / 2^l1, h2 = 0.3 / 1.4142 / 2^l2.
 
+mod common;
+
 use contact_rates::verify::rates::fit_power_sum;
 
 fn grid(noise: impl Fn(usize) -> f64) -> Vec<(f64, f64, f64)> {
@@ -34,19 +36,6 @@ fn sizes(
     out
 }
 
-/// A linear congruential sequence (fixed): uniform in [-1, 1).
-fn draws(n: usize) -> Vec<f64> {
-    let mut state = 12345u64;
-    (0..n)
-        .map(|_| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        })
-        .collect()
-}
-
 #[test]
 fn exact_data_give_the_exponents_back() {
     let f = fit_power_sum(&grid(|_| 1.0)).expect("a fit");
@@ -61,7 +50,7 @@ fn exact_data_give_the_exponents_back() {
 
 #[test]
 fn noisy_data_give_the_exponents_within_two_standard_errors() {
-    let draws = draws(25);
+    let draws = common::sequence(25);
     let f = fit_power_sum(&grid(|i| 1.0 + 0.02 * draws[i])).expect("a fit");
     println!(
         "2 % noise: a1 = {:.4} +- {:.4}, a2 = {:.4} +- {:.4}, C = {:?}, rms {:.2e}",
@@ -96,7 +85,7 @@ fn too_few_points_or_a_zero_error_give_no_fit() {
 #[test]
 fn a_part_at_one_level_only_leaves_its_exponent_undetermined_and_the_other_measured() {
     let jump = |h1: f64, _h2: f64, l2: i32| 0.1 * h1.powf(0.7) + if l2 == 0 { 0.02 } else { 0.0 };
-    let draws = draws(25);
+    let draws = common::sequence(25);
     let f = fit_power_sum(&sizes(jump, |i| 1.0 + 0.02 * draws[i])).expect("a fit");
     println!(
         "jump at h2's level 0, 2 % noise: a1 = {:.4} +- {:.4}, a2 = {:.4} +- {:.2e}, C = {:?}, rms {:.2e}",

@@ -8,6 +8,19 @@ use contact_rates::contact::Method;
 use contact_rates::scene::Scene;
 use std::process::{Command, Output};
 
+/// A fixed sequence in [-1, 1] (linear congruential; the tests need no randomness).
+pub fn sequence(len: usize) -> Vec<f64> {
+    let mut state: u64 = 12345;
+    (0..len)
+        .map(|_| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        })
+        .collect()
+}
+
 /// Run the `contact-rates` binary with `args` and extra environment `envs`.
 pub fn run(args: &[&str], envs: &[(&str, &str)]) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_contact-rates"));
