@@ -182,6 +182,9 @@ impl Report {
                     mortar,
                     nts,
                 });
+            } else if mortar.verdict == Verdict::RoundOff && nts.verdict == Verdict::RoundOff {
+                // error_ratio's 1.0 here is no measured ratio: say why they agree.
+                c.agree.push(format!("{q} (both cones exact)"));
             } else {
                 c.agree.push(q.to_string());
             }
@@ -374,7 +377,7 @@ fn near_half(report: &Report) -> Vec<String> {
         .rates
         .iter()
         .filter(|r| r.method == Method::Nts && r.quantity != Quantity::Theorem)
-        .filter(|r| matches!(r.verdict, Verdict::Fitted | Verdict::Drifting))
+        .filter(|r| r.verdict.supports_rate())
         .filter(|r| r.rate.is_some_and(|v| (v - 0.5).abs() <= NEAR_HALF))
         .map(|r| {
             format!(

@@ -11,7 +11,7 @@ use crate::solve::SolverKind;
 use crate::verify::field::P1History;
 use crate::verify::jobs::{self, Job};
 use crate::verify::quantity::Quantity;
-use crate::verify::rates::{self, LevelError, MIN_FIT_LEVELS, Verdict};
+use crate::verify::rates::{self, LevelError, MIN_FIT_LEVELS};
 use crate::verify::study_file::{LoadedStudy, needs};
 use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord};
 use crate::verify::truth::Truth;
@@ -608,7 +608,7 @@ fn judge_all(
             let required = threshold.filter(|_| method == label && quantity == key);
             // Only a rate the rules support (fitted, or drifting) can meet a threshold: a
             // pre-asymptotic fit is flagged, not a rate.
-            let supported = matches!(a.verdict, Verdict::Fitted | Verdict::Drifting);
+            let supported = a.verdict.supports_rate();
             let pass = required.map(|r| {
                 supported && a.used.len() >= MIN_FIT_LEVELS && a.fit.is_some_and(|f| f.rate >= r)
             });

@@ -136,6 +136,12 @@ impl Verdict {
         .find(|v| v.name() == name)
     }
 
+    /// Whether the verdict supports a rate: fitted, or drifting (still changing over the
+    /// levels). A pre-asymptotic fit is shown flagged, never as a rate.
+    pub fn supports_rate(self) -> bool {
+        matches!(self, Verdict::Fitted | Verdict::Drifting)
+    }
+
     /// Whether the verdict says what the errors do plainly enough to compare the cones on
     /// it: a fitted or drifting rate, exact, or not converging. Pre-asymptotic rates, tables
     /// too short to fit and quantities fixed by equilibrium are not compared.

@@ -701,22 +701,24 @@ fn families_table(res: &StudyResult) -> Table {
                     format!("{} ({})", verdict_text(r), r.assessment.successive_text())
                 })
             }));
+            // Only rates the verdicts support: a pre-asymptotic fit is no rate to compare.
             let fitted: Vec<f64> = rows
                 .iter()
                 .flatten()
+                .filter(|r| r.assessment.verdict.supports_rate())
                 .filter_map(|r| r.assessment.fit.map(|f| f.rate))
                 .collect();
-            cells.push(spread(&fitted));
+            cells.push(spread(&fitted, rows.len()));
             table.row(cells);
         }
     }
     table
 }
 
-/// "lo to hi" of at least two rates, else "n/a".
-fn spread(fitted: &[f64]) -> String {
+/// "lo to hi" of at least two rates, else "n/a" with how many of the `families` have one.
+fn spread(fitted: &[f64], families: usize) -> String {
     if fitted.len() < 2 {
-        return "n/a".into();
+        return format!("n/a ({} of {families} families fitted)", fitted.len());
     }
     let (lo, hi) = fitted
         .iter()

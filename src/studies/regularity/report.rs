@@ -75,7 +75,7 @@ pub struct RateCsv {
 
 /// The rate a row's verdict supports (fitted or drifting), with its standard error.
 fn supported(r: &RateRow) -> Option<(f64, f64)> {
-    matches!(r.assessment.verdict, Verdict::Fitted | Verdict::Drifting)
+    r.assessment.verdict.supports_rate()
         .then_some(r.assessment.fit)
         .flatten()
         .map(|f| (f.rate, f.stderr))
