@@ -93,8 +93,8 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
 /// Where D's fitted line reaches mortar's, and the local rate of the upper bound
 /// D + e_mortar of nts's error there and two levels later.
 fn crossover(res: &StudyResult, d_row: &RateRow) -> String {
-    let mortar = supported_fit(res.rate(Method::Mortar, Quantity::Theorem));
-    let (Some(fm), Some(fd)) = (mortar, supported_fit(Some(d_row))) else {
+    let mortar_row = res.rate(Method::Mortar, Quantity::Theorem);
+    let (Some(fm), Some(fd)) = (supported_fit(mortar_row), supported_fit(Some(d_row))) else {
         return "No crossover is predicted: D's or mortar's theorem-norm errors support no rate (see the rates above).".into();
     };
     if fd.rate >= fm.rate {
@@ -117,10 +117,14 @@ fn crossover(res: &StudyResult, d_row: &RateRow) -> String {
     // The local rate of D + e_mortar where D / e_mortar = ratio.
     let upper = |ratio: f64| (fm.rate + fd.rate * ratio) / (1.0 + ratio);
     let later = 4f64.powf(fm.rate - fd.rate);
+    let lines = [(mortar_row.expect("fitted above"), fm), (d_row, fd)];
+    let sd = crossover_level_sd(res, lines, h_star.ln()).map_or(String::new(), |sd| {
+        format!(" ± {sd:.1} (one standard deviation from the two rates' standard errors)")
+    });
     let place = if level <= finest as f64 {
-        format!("at level {level:.1}, within the study's levels")
+        format!("at level {level:.1}{sd}, within the study's levels")
     } else {
-        format!("near level {level:.1} (about {dofs:.1e} dofs)")
+        format!("near level {level:.1}{sd}, about {dofs:.1e} dofs")
     };
     format!(
         "From the fitted rates (D {:.3}, e_mortar {:.3}), D reaches e_mortar at h = {h_star:.3e}, {place}. There nts's error lies between 0 and 2 e_mortar, and the upper bound D + e_mortar falls at the local rate {:.2}; two levels later (D = {later:.1} e_mortar) at {:.2}, tending to D's {:.3}.",
@@ -130,6 +134,31 @@ fn crossover(res: &StudyResult, d_row: &RateRow) -> String {
         upper(later),
         fd.rate
     )
+}
+
+/// One standard deviation of the level where two fitted lines log e = intercept + rate
+/// log h (mortar's, then D's) cross at `log_h_star`, from their rates' standard errors:
+/// the delta method on each line taken at its levels' mean log h, where its value and
+/// slope are uncorrelated (value variance: the slope's times the levels' sum of squares
+/// over their count), the two fits independent. None where a level's h is missing.
+fn crossover_level_sd(res: &StudyResult, lines: [(&RateRow, Fit); 2], log_h_star: f64) -> Option<f64> {
+    let mut variance = 0.0;
+    for (row, fit) in lines {
+        let log_h: Vec<f64> = (row.assessment.used.iter())
+            .map(|&l| {
+                let e = res.errors.iter().find(|e| e.level == l && e.method == row.method)?;
+                Some(e.h.ln())
+            })
+            .collect::<Option<_>>()?;
+        let n = log_h.len() as f64;
+        let mean = log_h.iter().sum::<f64>() / n;
+        let sxx: f64 = log_h.iter().map(|x| (x - mean).powi(2)).sum();
+        let slope_variance = fit.stderr.powi(2);
+        variance += slope_variance * sxx / n + (mean - log_h_star).powi(2) * slope_variance;
+    }
+    // d(log h*) / d(value) = 1 / (rate difference); a level is a factor 2 in h.
+    let rate_difference = (lines[0].1.rate - lines[1].1.rate).abs();
+    Some(variance.sqrt() / rate_difference / std::f64::consts::LN_2)
 }
 
 /// cone_distance.png: e_mortar, e_nts and D in the theorem norm against h, with D's and
