@@ -93,8 +93,8 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
 /// Where D's fitted line reaches mortar's, and the local rate of the upper bound
 /// D + e_mortar of nts's error there and two levels later.
 fn crossover(res: &StudyResult, d_row: &RateRow) -> String {
-    let mortar_row = res.rate(Method::Mortar, Quantity::Theorem);
-    let (Some(fm), Some(fd)) = (supported_fit(mortar_row), supported_fit(Some(d_row))) else {
+    let mortar = res.rate(Method::Mortar, Quantity::Theorem);
+    let (Some(mortar), Some(fm), Some(fd)) = (mortar, supported_fit(mortar), supported_fit(Some(d_row))) else {
         return "No crossover is predicted: D's or mortar's theorem-norm errors support no rate (see the rates above).".into();
     };
     if fd.rate >= fm.rate {
@@ -117,7 +117,7 @@ fn crossover(res: &StudyResult, d_row: &RateRow) -> String {
     // The local rate of D + e_mortar where D / e_mortar = ratio.
     let upper = |ratio: f64| (fm.rate + fd.rate * ratio) / (1.0 + ratio);
     let later = 4f64.powf(fm.rate - fd.rate);
-    let lines = [(mortar_row.expect("fitted above"), fm), (d_row, fd)];
+    let lines = [(mortar, fm), (d_row, fd)];
     let sd = crossover_level_sd(res, lines, h_star.ln()).map_or(String::new(), |sd| {
         format!(" ± {sd:.1} (one standard deviation from the two rates' standard errors)")
     });
