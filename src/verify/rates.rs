@@ -480,7 +480,7 @@ fn exponent_standard_errors(jtj: &nalgebra::Matrix4<f64>, s2: f64) -> [f64; 2] {
                 false => undetermined += v * v,
             }
         }
-        match undetermined <= MAX_UNDETERMINED_SHARE && scale[p] > 0.0 {
+        match undetermined <= MAX_UNDETERMINED_SHARE {
             true => (s2 * variance).sqrt() * scale[p],
             false => f64::INFINITY,
         }
