@@ -84,30 +84,29 @@ const SEPARATES: f64 = 1.5;
 /// An nts rate within this of 1/2 attains K_h^I's h^(1/2).
 const NEAR_HALF: f64 = 0.15;
 
-/// "0.981 ± 0.005 (fitted, levels 0 1 2 3 4 5)", or the verdict where there is no rate.
+/// "0.981 ± 0.005 (fitted, levels 0 1 2 3 4 5)" where the verdict supports a rate, else
+/// the verdict with the last successive rate ("falling, last successive rate 0.557").
 fn rate_text(r: &RateRecord) -> String {
-    match (r.rate, r.stderr) {
-        (Some(rate), Some(se)) => {
+    match (r.verdict.supports_rate(), r.rate, r.stderr) {
+        (true, Some(rate), Some(se)) => {
             format!(
                 "{rate:.3} ± {se:.3} ({}, levels {})",
                 r.verdict.name(),
                 r.levels_used
             )
         }
-        _ => r.verdict.name().to_string(),
+        _ => match r.last_rate {
+            Some(last) if r.verdict != Verdict::RoundOff => {
+                format!("{}, last successive rate {last:.3}", r.verdict.name())
+            }
+            _ => r.verdict.name().to_string(),
+        },
     }
 }
 
-/// The rate in a table cell: "1.85" where fitted, "0.88 drifting" where the rate is still
-/// changing, "exact" at round-off, the verdict's name where the numbers support no rate
-/// (a pre-asymptotic fit is never printed as a rate).
+/// The rate in a table cell ([`rates::short_text`]).
 fn rate_short(r: &RateRecord) -> String {
-    match (r.verdict, r.rate) {
-        (Verdict::Fitted, Some(v)) => format!("{v:.2}"),
-        (Verdict::Drifting, Some(v)) => format!("{v:.2} drifting"),
-        (Verdict::RoundOff, _) => "exact".to_string(),
-        (v, _) => v.name().to_string(),
-    }
+    rates::short_text(r.verdict, r.rate, r.last_rate)
 }
 
 /// The items joined by `sep`, or `none` where there are none.
@@ -467,7 +466,7 @@ fn plasticity_and_time(doc: &mut Doc, dir: &Path) -> Result<()> {
     }
     let runs: Vec<TimeRun> = read(&path)?;
     let judged: Vec<(usize, f64, f64)> = runs.iter().map(|r| (r.steps, r.k, r.error)).collect();
-    let a = rates::assess_in_k(&judged)
+    let a = crate::verify::judge::assess_in_k(&judged)
         .map_err(|e| Error::input(&path, "k", format!("{e}; regenerate the report")))?;
     let steps: Vec<String> = a.used.iter().map(|&i| runs[i].steps.to_string()).collect();
     let rate = match a.fit {
@@ -513,7 +512,7 @@ pub fn headline(reports: &Path) -> Result<String> {
             let d = report.rate(Method::Nts, Quantity::ConeDistance)?;
             // Only a rate the rules support is printed here.
             let text = match d.verdict {
-                Verdict::Fitted | Verdict::Drifting => rate_text(d),
+                Verdict::Fitted => rate_text(d),
                 v => format!("no rate yet ({})", v.name()),
             };
             Some(format!("{text} in `{name}`"))
@@ -680,7 +679,7 @@ fn judged_rate(report: &Report, m: Method) -> String {
         .find(|r| r.method == m && r.threshold.is_some())
         .map_or("not measured".to_string(), |r| {
             let rate = match (r.verdict, r.rate, r.stderr) {
-                (Verdict::Fitted | Verdict::Drifting, Some(v), Some(se)) => {
+                (Verdict::Fitted, Some(v), Some(se)) => {
                     format!("{v:.3} ± {se:.3} {}", r.verdict.name())
                 }
                 (Verdict::RoundOff, _, _) => "exact (round-off)".to_string(),

@@ -11,9 +11,10 @@ use crate::solve::SolverKind;
 use crate::verify::field::P1History;
 use crate::verify::jobs::{self, Job};
 use crate::verify::quantity::Quantity;
-use crate::verify::rates::{self, LevelError, MIN_FIT_LEVELS};
+use crate::verify::judge::{RateRow, Rules, Threshold, judge_errors};
+use crate::verify::rates;
 use crate::verify::study_file::{LoadedStudy, needs};
-use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord};
+use crate::verify::table::{ErrorRecord, MethodLabel};
 use crate::verify::truth::Truth;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -79,7 +80,7 @@ pub struct Graded {
     pub label: String,
     pub levels: Vec<GradedLevel>,
     pub errors: Vec<ErrorRecord>,
-    pub rates: Vec<RateRecord>,
+    pub rates: Vec<RateRow>,
     /// The quantity the threshold applies to.
     pub key: Quantity,
     /// The time steps of the problem.
@@ -88,8 +89,10 @@ pub struct Graded {
     pub compared: bool,
     /// Sentences for the user: what was graded how.
     pub notes: Vec<String>,
-    /// Why the threshold failed (empty: passed or none given).
+    /// Why the threshold failed (empty: passed, unverified or none given).
     pub failures: Vec<String>,
+    /// Why the threshold is neither met nor missed (empty: passed, failed or none given).
+    pub unverified: Vec<String>,
     /// The command that reproduces the grade (the report folder aside).
     pub command: String,
 }
@@ -360,14 +363,20 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
         errors.extend(cones.into_iter().flatten());
     }
     let key = key_quantity(exact);
-    let (rates, failures) = judge_all(
-        &errors,
-        &label,
-        key,
-        req.threshold,
+    let threshold = |m: &MethodLabel, q: Quantity| {
+        req.threshold
+            .filter(|_| m == &label && q == key)
+            .map(Threshold::Rate)
+    };
+    let rules = Rules {
+        truth_error: &|_| 0.0,
         resultant_fixed,
-        &req.solutions,
-    )?;
+        threshold: &threshold,
+    };
+    let rates = judge_errors(&errors, &rules)
+        .map_err(|e| Error::input(&req.solutions, "levels", e.to_string()))?;
+    let failures = rates.iter().filter_map(RateRow::failure).collect();
+    let unverified = rates.iter().filter_map(RateRow::unverified).collect();
     let notes = notes(&levels, &family, pressure);
     let command = command_line(req, &files);
     Ok(Graded {
@@ -382,6 +391,7 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
         compared,
         notes,
         failures,
+        unverified,
         command,
     })
 }
@@ -494,15 +504,9 @@ fn check_label(name: &str) -> Result<MethodLabel> {
 /// Two levels with the same h cannot give a rate ([`rates::check_distinct_h`]): refused,
 /// naming both files, before anything is solved beside them.
 fn check_distinct_h(levels: &[GradedLevel], dir: &Path) -> Result<()> {
-    let as_levels: Vec<LevelError> = levels
-        .iter()
-        .map(|l| LevelError {
-            level: l.level,
-            h: l.h,
-            dofs: l.dofs as f64,
-            error: 0.0,
-        })
-        .collect();
+    let as_levels = crate::verify::judge::levels_of(
+        levels.iter().map(|l| (l.level, l.h, l.dofs as f64, 0.0)),
+    );
     rates::check_distinct_h(&as_levels).map_err(|e| {
         let of = |level: usize| levels.iter().find(|l| l.level == level);
         let file = |level: usize| of(level).map_or(String::new(), |l| l.file.display().to_string());
@@ -562,80 +566,6 @@ fn cone_rows(
         &errors,
         &family.scene.file,
     )
-}
-
-/// Every method's every quantity judged as the studies judge it; the graded code's key
-/// quantity against `threshold`. Returns the rows and the failures.
-fn judge_all(
-    errors: &[ErrorRecord],
-    label: &MethodLabel,
-    key: Quantity,
-    threshold: Option<f64>,
-    resultant_fixed: bool,
-    dir: &Path,
-) -> Result<(Vec<RateRecord>, Vec<String>)> {
-    let mut methods: Vec<MethodLabel> = Vec::new();
-    let mut quantities: Vec<Quantity> = Vec::new();
-    for r in errors {
-        if !methods.contains(&r.method) {
-            methods.push(r.method.clone());
-        }
-        if !quantities.contains(&r.quantity) {
-            quantities.push(r.quantity);
-        }
-    }
-    let (mut out, mut failures) = (Vec::new(), Vec::new());
-    for method in &methods {
-        for &quantity in &quantities {
-            let rows: Vec<&ErrorRecord> = errors
-                .iter()
-                .filter(|r| &r.method == method && r.quantity == quantity)
-                .collect();
-            if rows.is_empty() {
-                continue;
-            }
-            let levels: Vec<LevelError> = rows
-                .iter()
-                .map(|r| LevelError {
-                    level: r.level,
-                    h: r.h,
-                    dofs: r.dofs as f64,
-                    error: r.error,
-                })
-                .collect();
-            let a = rates::judge(&levels, 0.0, quantity, resultant_fixed)
-                .map_err(|e| Error::input(dir, "levels", format!("{method} {quantity}: {e}")))?;
-            let required = threshold.filter(|_| method == label && quantity == key);
-            // Only a rate the rules support (fitted, or drifting) can meet a threshold: a
-            // pre-asymptotic fit is flagged, not a rate.
-            let supported = a.verdict.supports_rate();
-            let pass = required.map(|r| {
-                supported && a.used.len() >= MIN_FIT_LEVELS && a.fit.is_some_and(|f| f.rate >= r)
-            });
-            if pass == Some(false) {
-                failures.push(match a.fit {
-                    Some(f) if supported && a.used.len() >= MIN_FIT_LEVELS => format!(
-                        "{method}'s {quantity} rate {:.3} is below the threshold {}",
-                        f.rate,
-                        required.unwrap_or(0.0)
-                    ),
-                    _ => format!(
-                        "{method}'s {quantity} errors support no rate ({}), so the threshold {} is not met",
-                        a.verdict.name(),
-                        required.unwrap_or(0.0)
-                    ),
-                });
-            }
-            out.push(RateRecord::new(
-                method.clone(),
-                quantity,
-                &a,
-                required,
-                pass,
-            ));
-        }
-    }
-    Ok((out, failures))
 }
 
 /// What the report says about how the solutions were graded.

@@ -10,6 +10,7 @@ use crate::report::markdown::{Doc, Table};
 use crate::report::plot::{self, Series};
 use crate::verify::quantity::Quantity;
 use crate::verify::rates::Verdict;
+use crate::verify::judge::RateRow;
 use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord};
 use std::path::Path;
 
@@ -25,7 +26,7 @@ impl Graded {
         out
     }
 
-    fn rate(&self, method: &MethodLabel, q: Quantity) -> Option<&RateRecord> {
+    fn rate(&self, method: &MethodLabel, q: Quantity) -> Option<&RateRow> {
         self.rates
             .iter()
             .find(|r| &r.method == method && r.quantity == q)
@@ -41,7 +42,8 @@ impl Graded {
     pub fn write(&self, dir: &Path) -> Result<()> {
         write_folder(dir, |d| {
             write(d, "errors.csv", &csv_bytes(&self.errors)?)?;
-            write(d, "rates.csv", &csv_bytes(&self.rates)?)?;
+            let rates: Vec<RateRecord> = self.rates.iter().map(RateRow::record).collect();
+            write(d, "rates.csv", &csv_bytes(&rates)?)?;
             self.plot(d)?;
             write(d, "README.md", self.readme().as_bytes())
         })
@@ -64,8 +66,8 @@ impl Graded {
                 color: i,
                 thin: false,
             });
-            if let Some(line) = self.rate(m, self.key).and_then(|r| fit_line(r, &rows, i)) {
-                series.push(line);
+            if let Some((legend, rate, intercept, hs)) = self.rate(m, self.key).and_then(|r| r.line(&rows)) {
+                series.extend(plot::fit_line(format!("{m} {legend}"), rate, intercept, &hs, i));
             }
         }
         plot::loglog(
@@ -93,6 +95,12 @@ impl Graded {
                 self.failures.join("; ")
             ));
         }
+        if !self.unverified.is_empty() {
+            doc.paragraph(format!(
+                "**Threshold unverified** (neither met nor missed: the errors support no rate, and the last successive rate is not below it): {}.",
+                self.unverified.join("; ")
+            ));
+        }
         if self.compared {
             if let Some(table) = self.contact_table() {
                 doc.paragraph(format!(
@@ -108,7 +116,7 @@ impl Graded {
         doc.heading(2, format!("{} per level", self.key));
         doc.table(&self.key_table());
         doc.heading(2, "Rates");
-        doc.paragraph("Every quantity judged as the studies judge it (docs/studies.md): a rate only over a trailing window of levels whose successive rates agree; `drifting`, `pre-asymptotic` and `too few levels` say why a rate is flagged or missing.");
+        doc.paragraph("Every quantity judged as the studies judge it (docs/studies.md): a rate only over a trailing window of levels whose successive rates agree; `falling` and `rising` (a rate in transition), `pre-asymptotic`, `too few levels` and `not converging` say why a rate is flagged or missing.");
         doc.table(&self.rate_table());
         doc.heading(2, "The graded files");
         doc.table(&self.level_table());
@@ -119,14 +127,7 @@ impl Graded {
     fn lead(&self) -> String {
         let rate = |m: &MethodLabel| {
             self.rate(m, self.key)
-                .map_or("no rate".into(), |r| match r.rate {
-                    Some(v) => format!(
-                        "{v:.3} ± {:.3} ({})",
-                        r.stderr.unwrap_or(0.0),
-                        r.verdict.name()
-                    ),
-                    None => format!("no rate ({})", r.verdict.name()),
-                })
+                .map_or("no rate".into(), |r| r.describe_with_verdict())
         };
         let label = MethodLabel::External(self.label.clone());
         let norm = match self.key {
@@ -195,7 +196,7 @@ impl Graded {
             // Its error measures the load quadrature (round-off), not the discretization.
             if self
                 .rate(&label, q)
-                .is_some_and(|r| r.verdict == Verdict::FixedByEquilibrium)
+                .is_some_and(|r| r.assessment.verdict == Verdict::FixedByEquilibrium)
             {
                 continue;
             }
@@ -259,22 +260,20 @@ impl Graded {
             "threshold",
         ]);
         for r in &self.rates {
+            let a = &r.assessment;
             table.row([
                 format!("{}", r.method),
                 format!("{}", r.quantity),
-                r.rate.map_or("-".into(), |v| {
-                    format!("{v:.3} ± {:.3}", r.stderr.unwrap_or(0.0))
-                }),
-                r.verdict.name().to_string(),
-                if r.levels_used.is_empty() {
+                a.fit.map_or("-".into(), |f| format!("{:.3} ± {:.3}", f.rate, f.stderr)),
+                a.verdict.name().to_string(),
+                if a.used.is_empty() {
                     "-".into()
                 } else {
-                    r.levels_used.clone()
+                    crate::verify::table::join(&a.used)
                 },
-                r.successive.clone(),
-                match (r.threshold, r.pass) {
-                    (Some(t), Some(true)) => format!(">= {t}: pass"),
-                    (Some(t), _) => format!(">= {t}: FAIL"),
+                a.successive_text(),
+                match (r.threshold, r.outcome) {
+                    (Some(t), Some(o)) => format!(">= {}: {}", t.value(), o.shouted()),
                     _ => "-".into(),
                 },
             ]);
@@ -337,33 +336,3 @@ impl Graded {
     }
 }
 
-/// The least-squares line of a rate over its fitted levels, drawn in `color`: the
-/// intercept is the mean of log e - rate log h over those levels (rates.csv keeps no
-/// intercept).
-fn fit_line(r: &RateRecord, rows: &[&ErrorRecord], color: usize) -> Option<Series> {
-    let rate = r.rate?;
-    let used: Vec<usize> = r
-        .levels_used
-        .split_whitespace()
-        .filter_map(|s| s.parse().ok())
-        .collect();
-    let points: Vec<(f64, f64)> = rows
-        .iter()
-        .filter(|e| used.contains(&e.level))
-        .map(|e| (e.h, e.error))
-        .collect();
-    let n = points.len().max(1) as f64;
-    let intercept = points
-        .iter()
-        .map(|p| p.1.ln() - rate * p.0.ln())
-        .sum::<f64>()
-        / n;
-    let hs: Vec<f64> = points.iter().map(|p| p.0).collect();
-    let label = format!(
-        "{} fit: slope {:.2} ± {:.2}",
-        r.method,
-        rate,
-        r.stderr.unwrap_or(0.0)
-    );
-    plot::fit_line(label, rate, intercept, &hs, color)
-}

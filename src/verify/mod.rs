@@ -11,6 +11,7 @@ pub mod exact_error;
 pub mod field;
 pub mod intersect;
 pub mod jobs;
+pub mod judge;
 pub mod kind;
 pub mod norms;
 pub mod quantity;

@@ -65,16 +65,22 @@ pub const ROUNDOFF: f64 = 1e-10;
 /// Fewest levels a fitted rate rests on; with fewer, only successive rates are given.
 pub const MIN_FIT_LEVELS: usize = 3;
 /// The fitted window: the longest trailing run of levels (at least [`MIN_FIT_LEVELS`])
-/// whose successive rates lie within this spread (max - min) of each other. Where even the
-/// last two successive rates spread more, the rate is pre-asymptotic.
-pub const WINDOW_SPREAD: f64 = 0.25;
-/// Smallest disagreement that calls a rate drifting: the window's fit against the fit over
-/// every usable level, or against the mean of the last two successive rates, by more than
-/// max(DRIFT, 2 standard errors of the window's fit).
-pub const DRIFT: f64 = 0.15;
-/// A quantity whose last two successive rates average below this does not converge: it is
-/// called that, and given no slope.
-pub const STALLED: f64 = 0.15;
+/// whose judged rates lie within this spread (max - min) of each other. Why 0.1: a fixed
+/// number small beside the 1/4 between the 3/4 and 1/2 that Theorem 3.1 distinguishes, and
+/// large enough for a 1 % level-to-level noise in the errors (each successive rate moves
+/// by 0.029, a spread of 0.058 between two neighbours).
+pub const WINDOW_SPREAD: f64 = 0.1;
+/// The trend rule: where the last three judged rates are strictly monotone and differ end to
+/// end by more than this, the rate is `falling` or `rising`, whatever the window.
+pub const TREND: f64 = 0.1;
+/// A quantity whose last two judged rates are both at most this (or whose last one is
+/// negative) has stopped converging. A steady small rate above it is judged like any other.
+pub const STALLED: f64 = 0.02;
+/// Two levels' rate is judged only where their h differ by at least this factor: halving
+/// tables (2, or within 5 % of it on unstructured meshes) use neighbours, a sqrt(2) table
+/// every second level, a 1.3 table every third, so that a 1 % noise in the errors moves a
+/// judged rate as little as in a halving table (0.029 at most).
+pub const MIN_RATE_SPAN: f64 = 1.9;
 /// Levels whose error is within this factor of the truth's own estimated error are left out.
 pub const TRUTH_MARGIN: f64 = 5.0;
 /// The safety factor of the grid convergence index with three levels (Celik et al. 2008).
@@ -84,35 +90,51 @@ pub const GCI_SAFETY: f64 = 1.25;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Verdict {
     /// A least-squares rate over a trailing window of at least [`MIN_FIT_LEVELS`] levels
-    /// whose successive rates agree (within [`WINDOW_SPREAD`]), which agrees with the fit
-    /// over every usable level and with the last successive rates (within [`DRIFT`]).
+    /// whose judged rates agree within [`WINDOW_SPREAD`], with no trend ([`TREND`]) in the
+    /// last three: the only verdict that supports a rate.
     Fitted,
-    /// The trailing window is fitted, but the fit over every usable level, or the last two
-    /// successive rates, differ from it by more than [`DRIFT`] (or 2 standard errors): the
-    /// rate is still changing; the window's rate is reported.
-    Drifting,
-    /// Even the last two successive rates differ by more than [`WINDOW_SPREAD`]: no window
-    /// of agreeing rates; the fit over every usable level is shown, flagged.
+    /// The last three judged rates fall strictly, by more than [`TREND`] end to end: the
+    /// errors are in transition to a lower rate; the last judged rate is reported.
+    Falling,
+    /// The last three judged rates rise strictly, by more than [`TREND`]: in transition to
+    /// a higher rate.
+    Rising,
+    /// No trailing window of agreeing rates and no trend: the fit over every usable level
+    /// is shown, flagged.
     PreAsymptotic,
     /// Fewer than [`MIN_FIT_LEVELS`] levels usable: successive rates only.
     TooFewLevels,
-    /// The error stops decreasing while the mesh is refined (last successive rates below
-    /// [`STALLED`]).
+    /// The error stops falling while the mesh is refined: the last two judged rates at most
+    /// [`STALLED`], or the last one negative.
     NotConverging,
     /// Every level's error is at round-off ([`ROUNDOFF`]): the discretization is exact.
     RoundOff,
     /// The quantity is fixed by equilibrium (the contact resultant of a body held normal to
-    /// Gamma_C only by the contact): it measures the load's quadrature, not the cones, and
-    /// is never fitted. Set by the study, never by [`assess`].
+    /// Gamma_C only by the contact, computed by this project's cones): it measures the
+    /// load's quadrature, not the cones, and is never fitted. Set by the study, never by
+    /// [`assess`].
     FixedByEquilibrium,
 }
 
 impl Verdict {
+    /// Every verdict, in the order of the rules.
+    pub const ALL: [Verdict; 8] = [
+        Verdict::Fitted,
+        Verdict::Falling,
+        Verdict::Rising,
+        Verdict::PreAsymptotic,
+        Verdict::TooFewLevels,
+        Verdict::NotConverging,
+        Verdict::RoundOff,
+        Verdict::FixedByEquilibrium,
+    ];
+
     /// Name in rates.csv.
     pub fn name(self) -> &'static str {
         match self {
             Verdict::Fitted => "fitted",
-            Verdict::Drifting => "drifting",
+            Verdict::Falling => "falling",
+            Verdict::Rising => "rising",
             Verdict::PreAsymptotic => "pre-asymptotic",
             Verdict::TooFewLevels => "too few levels",
             Verdict::NotConverging => "not converging",
@@ -123,33 +145,83 @@ impl Verdict {
 
     /// The verdict named `name` in rates.csv ([`Verdict::name`]).
     pub fn from_name(name: &str) -> Option<Verdict> {
-        [
-            Verdict::Fitted,
-            Verdict::Drifting,
-            Verdict::PreAsymptotic,
-            Verdict::TooFewLevels,
-            Verdict::NotConverging,
-            Verdict::RoundOff,
-            Verdict::FixedByEquilibrium,
-        ]
-        .into_iter()
-        .find(|v| v.name() == name)
+        Verdict::ALL.into_iter().find(|v| v.name() == name)
     }
 
-    /// Whether the verdict supports a rate: fitted, or drifting (still changing over the
-    /// levels). A pre-asymptotic fit is shown flagged, never as a rate.
+    /// Whether the verdict supports a rate: fitted only. A pre-asymptotic fit is shown
+    /// flagged; a falling or rising rate is in transition.
     pub fn supports_rate(self) -> bool {
-        matches!(self, Verdict::Fitted | Verdict::Drifting)
+        self == Verdict::Fitted
     }
 
-    /// Whether the verdict says what the errors do plainly enough to compare the cones on
-    /// it: a fitted or drifting rate, exact, or not converging. Pre-asymptotic rates, tables
-    /// too short to fit and quantities fixed by equilibrium are not compared.
+    /// Whether the verdict says what the errors do plainly enough to compare the cones'
+    /// finest errors on it: a fitted rate, a rate in transition, exact, or not converging.
+    /// Pre-asymptotic rates, tables too short to fit and quantities fixed by equilibrium are
+    /// not compared.
     pub fn compares_cones(self) -> bool {
         matches!(
             self,
-            Verdict::Fitted | Verdict::Drifting | Verdict::RoundOff | Verdict::NotConverging
+            Verdict::Fitted
+                | Verdict::Falling
+                | Verdict::Rising
+                | Verdict::RoundOff
+                | Verdict::NotConverging
         )
+    }
+}
+
+/// What a required rate R makes of a judged rate ([`threshold_outcome`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outcome {
+    /// The verdict supports a rate and min(fitted rate, last judged rate) >= R.
+    Pass,
+    /// The last judged rate is below R, whatever the verdict (for a falling rate, also its
+    /// extrapolation to the finest level).
+    Fail,
+    /// Anything else: no supported rate, none below R either.
+    Unverified,
+}
+
+impl Outcome {
+    /// Name in the pass column of rates.csv.
+    pub fn name(self) -> &'static str {
+        match self {
+            Outcome::Pass => "pass",
+            Outcome::Fail => "fail",
+            Outcome::Unverified => "unverified",
+        }
+    }
+    /// As consoles and tables print it: a failure in capitals.
+    pub fn shouted(self) -> &'static str {
+        match self {
+            Outcome::Fail => "FAIL",
+            o => o.name(),
+        }
+    }
+    /// The outcome named `name` ([`Outcome::name`]).
+    pub fn from_name(name: &str) -> Option<Outcome> {
+        [Outcome::Pass, Outcome::Fail, Outcome::Unverified]
+            .into_iter()
+            .find(|o| o.name() == name)
+    }
+}
+
+/// The one threshold rule for study files, `grade` and `judge`: a rate R is met (`Pass`)
+/// where the verdict supports a rate and both the fit and the last judged rate reach R;
+/// missed (`Fail`) where the last judged rate is below R, whatever the verdict, or, for a
+/// falling rate, where its extrapolation to the finest level is (the last judged rate
+/// describes the middle of the last pair of levels, half a level behind the finest one
+/// for halving h); `Unverified` otherwise.
+pub fn threshold_outcome(a: &Assessment, required: f64) -> Outcome {
+    let Some(last) = a.last_rate() else {
+        return Outcome::Unverified;
+    };
+    if last < required || a.finest_slope.is_some_and(|s| s < required) {
+        return Outcome::Fail;
+    }
+    match (a.verdict, a.fit) {
+        (Verdict::Fitted, Some(f)) if f.rate.min(last) >= required => Outcome::Pass,
+        _ => Outcome::Unverified,
     }
 }
 
@@ -241,20 +313,31 @@ pub fn celik(h: [f64; 3], phi: [f64; 3]) -> Option<Celik> {
     })
 }
 
+/// A rate between two usable levels at least [`MIN_RATE_SPAN`] apart in h: what the judge's
+/// rules read.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JudgedRate {
+    /// The coarser level and the finer one.
+    pub levels: (usize, usize),
+    /// log(e_coarse / e_fine) / log(h_coarse / h_fine).
+    pub rate: f64,
+    /// The mean of the two levels' log h: where the rate describes the errors.
+    pub log_h: f64,
+}
+
 /// What [`assess`] concluded.
 #[derive(Debug, Clone)]
 pub struct Assessment {
     /// The verdict.
     pub verdict: Verdict,
-    /// The fit in h over exactly `used` (the verdicts with a rate only).
+    /// The fit in h over exactly `used`: the window (Fitted), every usable level
+    /// (PreAsymptotic, flagged); none otherwise.
     pub fit: Option<Fit>,
     /// The fit in dofs over the same levels.
     pub fit_dofs: Option<Fit>,
-    /// The fitted levels: the trailing window (Fitted, Drifting), every usable level
-    /// (PreAsymptotic).
+    /// The fitted levels.
     pub used: Vec<usize>,
-    /// The fit over every usable level (at least [`MIN_FIT_LEVELS`]), the window's
-    /// comparison.
+    /// The fit over every usable level (at least [`MIN_FIT_LEVELS`]): reported, not judged.
     pub fit_all: Option<Fit>,
     /// Levels at round-off.
     pub roundoff: Vec<usize>,
@@ -262,6 +345,13 @@ pub struct Assessment {
     pub near_truth: Vec<usize>,
     /// Successive rates between neighbouring levels; None where either is at round-off.
     pub successive: Vec<Option<f64>>,
+    /// The rates the rules read: between usable levels at least [`MIN_RATE_SPAN`] apart in h
+    /// (the neighbours of a halving table), finest last.
+    pub judged: Vec<JudgedRate>,
+    /// For a falling rate, the last judged rate extrapolated to the finest level's log h
+    /// along the line through it and the judged rate two before (same parity: a period-2
+    /// wobble cancels).
+    pub finest_slope: Option<f64>,
     /// Celik's procedure on the last three usable levels.
     pub celik: Option<Celik>,
     /// Its asymptotic-range ratio at the reported rate ([`Celik::asymptotic_ratio`]).
@@ -291,12 +381,14 @@ fn rate_between(a: &LevelError, b: &LevelError) -> f64 {
     successive(&[a.h, b.h], &[a.error, b.error])[0]
 }
 
-/// Judge a quantity's errors over the levels (finest last) against a truth whose own
-/// estimated error is `truth_error` (0 for an exact solution): never a rate on round-off,
-/// on levels too close to the truth, on fewer than three levels, or of a stalled quantity;
-/// a rate only over a trailing window of agreeing successive rates, called drifting where it
-/// disagrees with the fit over every level or with the last successive rates. Errs on two
-/// levels with the same h.
+/// Judge a quantity's errors over the levels (coarsest first) against a truth whose own
+/// estimated error is `truth_error` (0 for an exact solution). The rules, in order
+/// (docs/studies.md#rates): every level at round-off is `round-off`; levels at round-off or
+/// within [`TRUTH_MARGIN`] of the truth are left out; errors that stop falling are `not
+/// converging`; fewer than [`MIN_FIT_LEVELS`] usable levels are `too few levels`; the last
+/// three judged rates strictly monotone by more than [`TREND`] are `falling` or `rising`;
+/// a trailing window of at least three levels whose judged rates spread by at most
+/// [`WINDOW_SPREAD`] is `fitted`; else `pre-asymptotic`. Errs on two levels with the same h.
 pub fn assess(levels: &[LevelError], truth_error: f64) -> Result<Assessment, EqualH> {
     check_distinct_h(levels)?;
     let (mut out, usable) = classify(levels, truth_error);
@@ -304,14 +396,15 @@ pub fn assess(levels: &[LevelError], truth_error: f64) -> Result<Assessment, Equ
         out.verdict = Verdict::RoundOff;
         return Ok(out);
     }
-    // Successive rates between neighbouring usable levels.
-    let rates: Vec<f64> = usable
-        .windows(2)
-        .map(|w| rate_between(w[0], w[1]))
-        .collect();
+    out.judged = judged_rates(&usable);
+    let rates: Vec<f64> = out.judged.iter().map(|r| r.rate).collect();
     let last_two = &rates[rates.len().saturating_sub(2)..];
-    let mean_last = last_two.iter().sum::<f64>() / last_two.len().max(1) as f64;
-    if !last_two.is_empty() && mean_last < STALLED {
+    let stalled = match last_two {
+        [] => false,
+        [.., last] if *last < 0.0 => true,
+        _ => last_two.len() == 2 && last_two.iter().all(|r| *r <= STALLED),
+    };
+    if stalled {
         out.verdict = Verdict::NotConverging;
         return Ok(out);
     }
@@ -328,14 +421,25 @@ pub fn assess(levels: &[LevelError], truth_error: f64) -> Result<Assessment, Equ
         ],
     );
     out.fit_all = fit_over(&usable).0;
-    let start = trailing_window(&rates, n);
-    let window: &[&LevelError] = match start {
-        Some(first) => &usable[first..],
-        None => &usable,
+    if let Some(trend) = trend(&out.judged) {
+        out.verdict = trend;
+        if trend == Verdict::Falling {
+            out.finest_slope = Some(extrapolate_to_finest(&out.judged, usable[n - 1].h));
+        }
+        return Ok(out);
+    }
+    let window: &[&LevelError] = match trailing_window(&usable, &out.judged) {
+        Some(first) => {
+            out.verdict = Verdict::Fitted;
+            &usable[first..]
+        }
+        None => {
+            out.verdict = Verdict::PreAsymptotic;
+            &usable
+        }
     };
     (out.fit, out.fit_dofs) = fit_over(window);
     out.used = window.iter().map(|e| e.level).collect();
-    out.verdict = verdict(start.is_some(), out.fit, out.fit_all, mean_last);
     out.asymptotic_ratio = match (out.celik, out.fit) {
         (Some(c), Some(f)) if f.rate > 0.0 => Some(c.asymptotic_ratio(f.rate)),
         _ => None,
@@ -343,7 +447,6 @@ pub fn assess(levels: &[LevelError], truth_error: f64) -> Result<Assessment, Equ
     Ok(out)
 }
 
-/// Errs on two levels with the same h (to 1e-12 relative).
 /// Refuse two levels with the same h (relative 1e-12): no rate between them.
 pub fn check_distinct_h(levels: &[LevelError]) -> Result<(), EqualH> {
     for (i, a) in levels.iter().enumerate() {
@@ -391,10 +494,55 @@ fn classify(levels: &[LevelError], truth_error: f64) -> (Assessment, Vec<&LevelE
         roundoff,
         near_truth,
         successive: successive_rates,
+        judged: Vec::new(),
+        finest_slope: None,
         celik: None,
         asymptotic_ratio: None,
     };
     (out, usable)
+}
+
+/// For each usable level, the rate from the finest coarser level at least
+/// [`MIN_RATE_SPAN`] times its h (none for the coarsest levels that have no such partner).
+fn judged_rates(usable: &[&LevelError]) -> Vec<JudgedRate> {
+    (0..usable.len())
+        .filter_map(|i| {
+            let fine = usable[i];
+            let coarse = usable[..i]
+                .iter()
+                .rev()
+                .find(|c| c.h >= MIN_RATE_SPAN * fine.h * (1.0 - 1e-9))?;
+            Some(JudgedRate {
+                levels: (coarse.level, fine.level),
+                rate: rate_between(coarse, fine),
+                log_h: 0.5 * (coarse.h.ln() + fine.h.ln()),
+            })
+        })
+        .collect()
+}
+
+/// `Falling` or `Rising` where the last three judged rates are strictly monotone and differ
+/// end to end by more than [`TREND`].
+fn trend(judged: &[JudgedRate]) -> Option<Verdict> {
+    let [a, b, c] = judged.get(judged.len().checked_sub(3)?..)? else {
+        return None;
+    };
+    let (a, b, c) = (a.rate, b.rate, c.rate);
+    if a > b && b > c && a - c > TREND {
+        Some(Verdict::Falling)
+    } else if a < b && b < c && c - a > TREND {
+        Some(Verdict::Rising)
+    } else {
+        None
+    }
+}
+
+/// The last judged rate carried to `finest_h` along the line through it and the judged rate
+/// two before it (at least three judged rates).
+fn extrapolate_to_finest(judged: &[JudgedRate], finest_h: f64) -> f64 {
+    let (last, before) = (judged[judged.len() - 1], judged[judged.len() - 3]);
+    let slope = (last.rate - before.rate) / (last.log_h - before.log_h);
+    last.rate + slope * (finest_h.ln() - last.log_h)
 }
 
 /// The fits in h and in dofs over `window`.
@@ -405,38 +553,28 @@ fn fit_over(window: &[&LevelError]) -> (Option<Fit>, Option<Fit>) {
     (fit(&h, &e), fit(&d, &e))
 }
 
-/// The first of `n` usable levels (successive rates `rates`) of the longest trailing window
-/// of at least [`MIN_FIT_LEVELS`] whose successive rates lie within [`WINDOW_SPREAD`]; None
-/// where even the last two spread more.
-fn trailing_window(rates: &[f64], n: usize) -> Option<usize> {
+/// The first index into `usable` of the longest trailing window of at least
+/// [`MIN_FIT_LEVELS`] levels holding at least two judged rates (both levels in the window)
+/// that spread by at most [`WINDOW_SPREAD`]; None where no such window exists.
+fn trailing_window(usable: &[&LevelError], judged: &[JudgedRate]) -> Option<usize> {
     let mut start = None;
-    for first in (0..=n - MIN_FIT_LEVELS).rev() {
-        let r = &rates[first..];
-        let spread = r.iter().copied().fold(f64::NEG_INFINITY, f64::max)
-            - r.iter().copied().fold(f64::INFINITY, f64::min);
+    for first in (0..=usable.len() - MIN_FIT_LEVELS).rev() {
+        let inside: Vec<f64> = judged
+            .iter()
+            .filter(|r| usable[first..].iter().any(|e| e.level == r.levels.0))
+            .map(|r| r.rate)
+            .collect();
+        if inside.len() < 2 {
+            continue;
+        }
+        let spread = inside.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+            - inside.iter().copied().fold(f64::INFINITY, f64::min);
         if spread > WINDOW_SPREAD {
             break;
         }
         start = Some(first);
     }
     start
-}
-
-/// The verdict on a window's fit `fit` (`windowed`: a trailing window agreed), against the
-/// fit over every usable level `fit_all` and the mean of the last two successive rates
-/// `mean_last`.
-fn verdict(windowed: bool, fit: Option<Fit>, fit_all: Option<Fit>, mean_last: f64) -> Verdict {
-    match (windowed, fit, fit_all) {
-        (true, Some(w), Some(all)) => {
-            let tolerance = DRIFT.max(2.0 * w.stderr);
-            if (all.rate - w.rate).abs() > tolerance || (mean_last - w.rate).abs() > tolerance {
-                Verdict::Drifting
-            } else {
-                Verdict::Fitted
-            }
-        }
-        _ => Verdict::PreAsymptotic,
-    }
 }
 
 /// Largest condition number of J^T J scaled to unit diagonal (the parameters'
@@ -632,17 +770,19 @@ impl Assessment {
             .join(" ")
     }
 
+    /// The last judged rate ([`Assessment::judged`]), where there is one.
+    pub fn last_rate(&self) -> Option<f64> {
+        self.judged.last().map(|r| r.rate)
+    }
+
     /// The judged rate with its standard error, or the verdict that replaces it, as reports
     /// write it.
     pub fn describe(&self) -> String {
+        let last = crate::io::fmt3(self.last_rate().unwrap_or(f64::NAN));
         match (self.verdict, self.fit) {
             (Verdict::Fitted, Some(f)) => format!("{:.3} ± {:.3}", f.rate, f.stderr),
-            (Verdict::Drifting, Some(f)) => format!(
-                "{:.3} ± {:.3} (drifting: {} over every level)",
-                f.rate,
-                f.stderr,
-                crate::io::fmt3(self.fit_all.map_or(f64::NAN, |f| f.rate))
-            ),
+            (Verdict::Falling, _) => format!("falling (last successive rate {last})"),
+            (Verdict::Rising, _) => format!("rising (last successive rate {last})"),
             (Verdict::PreAsymptotic, Some(f)) => {
                 format!("{:.3} ± {:.3} (pre-asymptotic)", f.rate, f.stderr)
             }
@@ -654,6 +794,20 @@ impl Assessment {
             }
             _ => "n/a".into(),
         }
+    }
+}
+
+/// A judged rate, or what replaces it, in a few characters (plot legends, table cells):
+/// "1.85" where fitted, "falling (last 0.56)" or "rising (last 1.20)" with the last judged
+/// rate, "exact" at round-off, else the verdict's name (a pre-asymptotic fit is never
+/// printed as a rate). `rate` is the fit's, `last` the last judged rate.
+pub fn short_text(verdict: Verdict, rate: Option<f64>, last: Option<f64>) -> String {
+    let last = crate::io::fmt3(last.unwrap_or(f64::NAN));
+    match (verdict, rate) {
+        (Verdict::Fitted, Some(v)) => format!("{v:.2}"),
+        (Verdict::Falling | Verdict::Rising, _) => format!("{} (last {last})", verdict.name()),
+        (Verdict::RoundOff, _) => "exact".into(),
+        (v, _) => v.name().into(),
     }
 }
 
@@ -672,25 +826,10 @@ pub fn judge(
         (a.fit, a.fit_dofs, a.fit_all, a.celik, a.asymptotic_ratio) =
             (None, None, None, None, None);
         a.used.clear();
+        a.judged.clear();
+        a.finest_slope = None;
     }
     Ok(a)
-}
-
-/// Judge a rate in the time step k as a rate in h is judged ([`assess`] with k in place of
-/// h, the runs in order of halving k, the truth exact in time): one rule for the time
-/// studies and for the README's reading of their `time.csv`. `runs` are (steps, k, error).
-pub fn assess_in_k(runs: &[(usize, f64, f64)]) -> Result<Assessment, EqualH> {
-    let levels: Vec<LevelError> = runs
-        .iter()
-        .enumerate()
-        .map(|(i, &(steps, k, error))| LevelError {
-            level: i,
-            h: k,
-            dofs: steps as f64,
-            error,
-        })
-        .collect();
-    assess(&levels, 0.0)
 }
 
 /// Largest standard error of an exponent of a [`PowerSumFit`] that counts as measured.

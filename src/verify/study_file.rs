@@ -87,36 +87,7 @@ fn default_threshold_quantity() -> Quantity {
     Quantity::Theorem
 }
 
-/// What a method's `theorem` error must satisfy.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Threshold {
-    /// The fitted rate in h must be at least this (Theorem 3.1's rate minus the tolerance).
-    Rate(f64),
-    /// Every level's relative error must be at most this (a method exact on the scene).
-    Exact(f64),
-}
-
-impl Threshold {
-    /// The number: the required rate or the error bound.
-    pub fn value(self) -> f64 {
-        match self {
-            Threshold::Rate(v) | Threshold::Exact(v) => v,
-        }
-    }
-
-    /// Whether errors judged as `a`, the largest `max_error`, meet it: a rate fitted on at
-    /// least [`super::rates::MIN_FIT_LEVELS`] levels at or above the required one, or every
-    /// error within the bound.
-    pub fn passes(self, a: &super::rates::Assessment, max_error: f64) -> bool {
-        match self {
-            Threshold::Exact(bound) => max_error <= bound,
-            Threshold::Rate(rate) => {
-                a.used.len() >= super::rates::MIN_FIT_LEVELS
-                    && a.fit.is_some_and(|f| f.rate >= rate)
-            }
-        }
-    }
-}
+pub use super::judge::Threshold;
 
 impl ThresholdSpec {
     /// The threshold of `method`'s `theorem` error.

@@ -9,7 +9,8 @@
 use crate::contact::Method;
 use crate::error::{Error, Result};
 use crate::verify::quantity::Quantity;
-use crate::verify::rates::{Assessment, Verdict};
+use crate::verify::judge::RateRow;
+use crate::verify::rates::{Outcome, Verdict};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::path::Path;
 
@@ -79,6 +80,20 @@ impl<'de> Deserialize<'de> for MethodLabel {
     }
 }
 
+impl Serialize for Outcome {
+    fn serialize<S: Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+impl<'de> Deserialize<'de> for Outcome {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        Outcome::from_name(&name)
+            .ok_or_else(|| serde::de::Error::custom(format!("unknown threshold outcome '{name}'")))
+    }
+}
+
 impl Serialize for Verdict {
     fn serialize<S: Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
         s.serialize_str(self.name())
@@ -132,16 +147,19 @@ pub struct RateRecord {
     pub levels_used: String,
     /// The required rate or the error bound.
     pub threshold: Option<f64>,
-    /// Whether the threshold is met.
-    pub pass: Option<bool>,
+    /// What the threshold makes of the errors: pass, fail or unverified.
+    pub pass: Option<Outcome>,
     /// The rate in dofs (error ~ dofs^-rate) over the same levels.
     pub rate_dofs: Option<f64>,
     /// Successive rates, space separated ("-" next to a level at round-off).
     pub successive: String,
     /// What the errors support ([`Verdict::name`]).
     pub verdict: Verdict,
-    /// The fit over every usable level (what the window is compared with).
+    /// The fit over every usable level: reported, not judged.
     pub rate_all_levels: Option<f64>,
+    /// The last judged rate (between the finest usable level and the finest one at least
+    /// 1.9 times its h: its neighbour in a halving table).
+    pub last_rate: Option<f64>,
     /// Celik et al. 2008 on the last three usable levels: observed order,
     pub observed_order: Option<f64>,
     /// whether the convergence oscillates (eps32 / eps21 < 0),
@@ -170,32 +188,27 @@ pub fn join(levels: &[usize]) -> String {
 }
 
 impl RateRecord {
-    /// The row of `method`'s `quantity` judged by `a`, with its threshold and whether it
-    /// passes.
-    pub fn new(
-        method: MethodLabel,
-        quantity: Quantity,
-        a: &Assessment,
-        threshold: Option<f64>,
-        pass: Option<bool>,
-    ) -> Self {
+    /// The row of a judged rate `r`.
+    pub fn new(r: &RateRow) -> Self {
+        let a = &r.assessment;
         RateRecord {
-            method,
-            quantity,
+            method: r.method.clone(),
+            quantity: r.quantity,
             rate: a.fit.and_then(|f| finite(f.rate)),
             stderr: a.fit.and_then(|f| finite(f.stderr)),
             levels_used: join(&a.used),
-            threshold,
-            pass,
+            threshold: r.threshold.map(|t| t.value()),
+            pass: r.outcome,
             rate_dofs: a.fit_dofs.map(|f| -f.rate),
             successive: a.successive_text(),
             verdict: a.verdict,
             rate_all_levels: a.fit_all.and_then(|f| finite(f.rate)),
+            last_rate: a.last_rate().and_then(finite),
             observed_order: a.celik.and_then(|c| finite(c.order)),
             oscillatory: a.celik.map(|c| c.oscillatory),
             gci_fine: a.celik.and_then(|c| finite(c.gci_fine)),
             asymptotic_ratio: a.asymptotic_ratio.and_then(finite),
-            parameter: None,
+            parameter: r.parameter,
         }
     }
 

@@ -64,8 +64,8 @@ pub fn assert_rate_passes(r: &contact_rates::studies::convergence::RateRow, leve
     );
     assert_eq!(r.assessment.used, levels);
     assert_eq!(
-        r.pass,
-        Some(true),
+        r.outcome,
+        Some(contact_rates::verify::rates::Outcome::Pass),
         "{} rate {} below {:?}",
         r.method,
         r.rate(),

@@ -53,8 +53,10 @@ use crate::verify::field::P1History;
 use crate::verify::norms;
 use crate::verify::quantity::Scale;
 use crate::verify::quantity::Quantity;
-use crate::verify::rates::{self, Assessment, LevelError};
-use crate::verify::study_file::{LoadedStudy, StudyFile, Threshold, provenance};
+use crate::verify::judge::{Rules, judge_errors};
+use crate::verify::rates::Assessment;
+use crate::verify::table::MethodLabel;
+use crate::verify::study_file::{LoadedStudy, StudyFile, provenance};
 pub use crate::verify::truth::{Reference, estimated_reference_error};
 use crate::verify::truth::{Truth, reference};
 pub use crate::verify::table::{ErrorRecord, join};
@@ -64,36 +66,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
-/// The fitted rate of one quantity of one cone.
-#[derive(Debug, Clone)]
-pub struct RateRow {
-    /// Cone.
-    pub method: Method,
-    /// Quantity.
-    pub quantity: Quantity,
-    /// What the errors support (a rate, a flagged rate, or why there is none), the fit over
-    /// exactly the levels used, and the levels left out.
-    pub assessment: Assessment,
-    /// What the error must satisfy (the `theorem` quantity only).
-    pub threshold: Option<Threshold>,
-    /// Whether it does.
-    pub pass: Option<bool>,
-}
-
-impl RateRow {
-    /// The fitted rate in h, NaN when there is none.
-    pub fn rate(&self) -> f64 {
-        self.assessment.fit.map_or(f64::NAN, |f| f.rate)
-    }
-    /// Its standard error, NaN when there is none.
-    pub fn stderr(&self) -> f64 {
-        self.assessment.fit.map_or(f64::NAN, |f| f.stderr)
-    }
-    /// Rate against dofs (error ~ dofs^-rate_dofs), over the same levels.
-    pub fn rate_dofs(&self) -> Option<f64> {
-        self.assessment.fit_dofs.map(|f| -f.rate)
-    }
-}
+pub use crate::verify::judge::RateRow;
 
 /// Per-level facts of the mesh family.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -275,31 +248,9 @@ impl StudyResult {
 
     /// The thresholds the study missed, one sentence each (empty: it passed).
     pub fn failures(&self) -> Vec<String> {
-        self.rates
-            .iter()
-            .filter(|r| r.pass == Some(false))
-            .filter_map(|r| match r.threshold? {
-                Threshold::Exact(t) => Some(format!(
-                    "{} {} error above the exactness tolerance {t:.1e}",
-                    r.method, r.quantity
-                )),
-                Threshold::Rate(t) => Some(format!(
-                    "{} {} rate {:.3} < {t:.3} (levels {})",
-                    r.method,
-                    r.quantity,
-                    r.rate(),
-                    join(&r.assessment.used)
-                )),
-            })
-            .collect()
+        self.rates.iter().filter_map(RateRow::failure).collect()
     }
 }
-
-
-
-
-
-
 
 /// The study's solves, with a named handle for each.
 struct Plan {
@@ -791,44 +742,17 @@ fn fit_rates(
     truth: &Truth,
     resultant_fixed: bool,
 ) -> Result<Vec<RateRow>> {
-    let mut out = Vec::new();
-    for &method in &sf.methods {
-        let threshold = sf.thresholds.of(method);
-        for &quantity in &sf.quantities {
-            let rows: Vec<&ErrorRecord> = errors
-                .iter()
-                .filter(|r| r.method == method && r.quantity == quantity)
-                .collect();
-            // A distance between the cones is listed under nts only.
-            if rows.is_empty() && quantity.is_distance() {
-                continue;
-            }
-            let levels: Vec<LevelError> = rows
-                .iter()
-                .map(|r| LevelError {
-                    level: r.level,
-                    h: r.h,
-                    dofs: r.dofs as f64,
-                    error: r.error,
-                })
-                .collect();
-            let a = rates::judge(&levels, truth.quantity_error(quantity), quantity, resultant_fixed)
-                .map_err(|e| {
-                    Error::input(path, "mesh.levels", format!("{method} {quantity}: {e}"))
-                })?;
-            let threshold = (quantity == sf.thresholds.quantity).then_some(threshold);
-            let max_error = rows.iter().map(|r| r.error).fold(0.0f64, f64::max);
-            let pass = threshold.map(|t| t.passes(&a, max_error));
-            out.push(RateRow {
-                method,
-                quantity,
-                assessment: a,
-                threshold,
-                pass,
-            });
-        }
-    }
-    Ok(out)
+    let threshold = |m: &MethodLabel, q: Quantity| {
+        m.cone()
+            .filter(|_| q == sf.thresholds.quantity)
+            .map(|c| sf.thresholds.of(c))
+    };
+    let rules = Rules {
+        truth_error: &|q| truth.quantity_error(q),
+        resultant_fixed,
+        threshold: &threshold,
+    };
+    judge_errors(errors, &rules).map_err(|e| Error::input(path, "mesh.levels", e.to_string()))
 }
 
 /// Step 5: the rate in time on a fixed mesh: each run against the reference in time at the
@@ -889,7 +813,7 @@ fn time_study(
         )));
     }
     let judged: Vec<(usize, f64, f64)> = runs.iter().map(|r| (r.steps, r.k, r.error)).collect();
-    let assessment = rates::assess_in_k(&judged)
+    let assessment = crate::verify::judge::assess_in_k(&judged)
         .map_err(|e| Error::input(&study.path, "time.steps", format!("time study: {e}")))?;
     Ok(Some(TimeStudy {
         scene: scene.name.clone(),

@@ -30,17 +30,6 @@ struct VariantCsv {
     error: f64,
 }
 
-/// The row of rates.csv of `r`.
-fn rate_record(r: &RateRow) -> RateRecord {
-    RateRecord::new(
-        r.method.into(),
-        r.quantity,
-        &r.assessment,
-        r.threshold.map(Threshold::value),
-        r.pass,
-    )
-}
-
 /// "rate >= 0.70" or "error <= 1e-9", with `digits` decimals for a rate.
 fn threshold_text(t: Threshold, digits: usize) -> String {
     match t {
@@ -73,7 +62,7 @@ fn fmt_order(r: &RateRow) -> String {
 pub fn write_study(res: &StudyResult, dir: &Path) -> Result<()> {
     write_folder(dir, |d| {
         write(d, "errors.csv", &csv_bytes(&res.errors)?)?;
-        let rates: Vec<RateRecord> = res.rates.iter().map(rate_record).collect();
+        let rates: Vec<RateRecord> = res.rates.iter().map(RateRow::record).collect();
         write(d, "rates.csv", &csv_bytes(&rates)?)?;
         write(d, "levels.csv", &csv_bytes(&res.levels)?)?;
         write(d, "pressure.csv", &csv_bytes(&res.pressure)?)?;
@@ -147,15 +136,9 @@ fn error_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
             color: i,
             thin: false,
         });
-        // The study's fitted line over the levels used.
-        let used: Vec<f64> = rows
-            .iter()
-            .filter(|r| rate.assessment.used.contains(&r.level))
-            .map(|r| r.h)
-            .collect();
-        if let Some(fit) = rate.assessment.fit {
-            let label = format!("{m} fit: slope {:.2} ± {:.2}", fit.rate, fit.stderr);
-            series.extend(plot::fit_line(label, fit.rate, fit.intercept, &used, i));
+        // The study's fitted line over the levels used, from the fit itself.
+        if let Some((legend, rate, intercept, hs)) = rate.line(&rows) {
+            series.extend(plot::fit_line(format!("{m} {legend}"), rate, intercept, &hs, i));
         }
     }
     for (i, &m) in res.file.methods.iter().enumerate() {
@@ -541,10 +524,10 @@ fn rates_table(doc: &mut Doc, res: &StudyResult) {
             r.threshold
                 .map(|t| threshold_text(t, 2))
                 .unwrap_or_default(),
-            r.pass
-                .map(|p| if p { "yes" } else { "**no**" })
-                .unwrap_or("")
-                .to_string(),
+            r.outcome.map_or(String::new(), |o| match o {
+                rates::Outcome::Fail => "**fail**".into(),
+                o => o.name().into(),
+            }),
         ]);
     }
     doc.heading(2, "Rates").paragraph(RATES_TEXT).table(&table);
@@ -858,7 +841,7 @@ pub fn console(res: &StudyResult, dir: &Path) -> String {
                 .map(|t| format!(
                     " threshold {}: {}",
                     threshold_text(t, 3),
-                    if r.pass == Some(true) { "pass" } else { "FAIL" }
+                    r.outcome.map_or("-", rates::Outcome::shouted)
                 ))
                 .unwrap_or_default()
         );
@@ -972,17 +955,10 @@ fn contact_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
     )
 }
 
-/// A rate or the verdict that replaces it, short.
+/// A rate or the verdict that replaces it, short ([`rates::short_text`]).
 fn verdict_text(r: &RateRow) -> String {
-    match (r.assessment.verdict, r.assessment.fit) {
-        (Verdict::Fitted, Some(f)) => format!("{:.2}", f.rate),
-        (Verdict::Drifting, Some(f)) => format!("{:.2} (drifting)", f.rate),
-        (Verdict::PreAsymptotic, Some(f)) => format!("{:.2} (pre-asymptotic)", f.rate),
-        (Verdict::RoundOff, _) => "exact".into(),
-        (Verdict::NotConverging, _) => "does not converge".into(),
-        (Verdict::FixedByEquilibrium, _) => "fixed by equilibrium".into(),
-        _ => "no fit".into(),
-    }
+    let a = &r.assessment;
+    rates::short_text(a.verdict, a.fit.map(|f| f.rate), a.last_rate())
 }
 
 /// The kind's outcome writes this report.

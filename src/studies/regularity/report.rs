@@ -10,7 +10,9 @@ use crate::report::folder::{write, write_folder};
 use crate::report::markdown::{Doc, Table};
 use crate::report::plot::{self, Series};
 use crate::studies::convergence::{RateRow, StudyResult};
-use crate::verify::kind::Outcome;
+use crate::verify::kind::Outcome as KindOutcome;
+use crate::verify::rates::Outcome;
+use crate::verify::table::MethodLabel;
 use crate::verify::quantity::Quantity;
 use crate::verify::rates::Verdict;
 use serde::{Deserialize, Serialize};
@@ -48,10 +50,10 @@ pub struct RateCsv {
     /// beta: u ~ r^beta at the transition point.
     pub beta: f64,
     /// The cone.
-    pub method: Method,
+    pub method: MethodLabel,
     /// The quantity.
     pub quantity: Quantity,
-    /// The rate in h where the verdict supports one (fitted or drifting).
+    /// The rate in h where the verdict supports one (fitted).
     pub rate: Option<f64>,
     /// Its standard error.
     pub stderr: Option<f64>,
@@ -61,6 +63,8 @@ pub struct RateCsv {
     pub levels_used: String,
     /// Successive rates between neighbouring levels, space separated.
     pub successive: String,
+    /// The last judged rate.
+    pub last_rate: Option<f64>,
     /// The best rate a uniform P1 mesh can give for this quantity at this beta.
     pub best_rate: Option<f64>,
     /// Whether the rate reaches the best rate (within the tolerance), where both exist.
@@ -69,16 +73,13 @@ pub struct RateCsv {
     pub theorem_applies: bool,
     /// The study's threshold on the theorem norm.
     pub threshold: Option<f64>,
-    /// Whether it is met.
-    pub pass: Option<bool>,
+    /// What it makes of the errors: pass, fail or unverified.
+    pub pass: Option<Outcome>,
 }
 
-/// The rate a row's verdict supports (fitted or drifting), with its standard error.
+/// The rate a row's verdict supports (fitted), with its standard error.
 fn supported(r: &RateRow) -> Option<(f64, f64)> {
-    r.assessment.verdict.supports_rate()
-        .then_some(r.assessment.fit)
-        .flatten()
-        .map(|f| (f.rate, f.stderr))
+    r.supported_fit().map(|f| (f.rate, f.stderr))
 }
 
 /// Whether a supported rate reaches `best` (within [`FOLLOW_TOLERANCE`] or 2 standard errors).
@@ -94,18 +95,19 @@ fn rate_rows(beta: f64, res: &StudyResult) -> Vec<RateCsv> {
             let best = best_rate(r.quantity, beta);
             RateCsv {
                 beta,
-                method: r.method,
+                method: r.method.clone(),
                 quantity: r.quantity,
                 rate: rate.map(|x| x.0),
                 stderr: rate.map(|x| x.1),
                 verdict: r.assessment.verdict,
                 levels_used: crate::verify::table::join(&r.assessment.used),
                 successive: r.assessment.successive_text(),
+                last_rate: r.assessment.last_rate(),
                 best_rate: best,
                 follows_best: rate.zip(best).map(|(x, b)| follows(x, b)),
                 theorem_applies: theorem_applies(beta),
                 threshold: r.threshold.map(|t| t.value()),
-                pass: r.pass,
+                pass: r.outcome,
             }
         })
         .collect()
@@ -115,11 +117,11 @@ fn rate_rows(beta: f64, res: &StudyResult) -> Vec<RateCsv> {
 fn cell(r: Option<&RateRow>) -> String {
     match r {
         Some(r) => match supported(r) {
-            Some((rate, se)) if r.assessment.verdict == Verdict::Drifting => {
-                format!("{rate:.3} ± {se:.3} (drifting)")
-            }
             Some((rate, se)) => format!("{rate:.3} ± {se:.3}"),
-            None => r.assessment.verdict.name().to_string(),
+            None => {
+                let a = &r.assessment;
+                crate::verify::rates::short_text(a.verdict, None, a.last_rate())
+            }
         },
         None => "-".into(),
     }
@@ -295,7 +297,7 @@ impl Regularity {
     }
 }
 
-impl Outcome for Regularity {
+impl KindOutcome for Regularity {
     fn write(&self, dir: &Path) -> Result<()> {
         write_folder(dir, |d| {
             let errors: Vec<ErrorRow> = self

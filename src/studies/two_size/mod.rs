@@ -48,7 +48,8 @@ use crate::verify::study_file::{LoadedStudy, provenance};
 use crate::verify::truth::{Reference, Truth, reference};
 use crate::verify::jobs::{self, Job, JobId, Mode};
 use crate::verify::quantity::Quantity;
-use crate::verify::rates::{self, Assessment, LevelError, PowerSumFit};
+use crate::verify::judge;
+use crate::verify::rates::{self, Assessment, PowerSumFit};
 use crate::verify::study_file::TwoSizeSpec;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -515,18 +516,13 @@ fn fit(
     // The sweeps: a level is left out where its error is within 5x of the floor (the
     // fixed body's own error) or of the truth's.
     let sweep = |b: usize| -> Result<Assessment> {
-        let rows: Vec<LevelError> = levels
-            .iter()
-            .filter_map(|&l| {
-                let p = at(if b == 0 { [l, fixed] } else { [fixed, l] })?;
-                Some(LevelError {
-                    level: l,
-                    h: if b == 0 { p.h1 } else { p.h2 },
-                    dofs: (if b == 0 { p.dofs1 } else { p.dofs2 }) as f64,
-                    error: p.error,
-                })
+        let rows = judge::levels_of(levels.iter().filter_map(|&l| {
+            let p = at(if b == 0 { [l, fixed] } else { [fixed, l] })?;
+            Some(match b {
+                0 => (l, p.h1, p.dofs1 as f64, p.error),
+                _ => (l, p.h2, p.dofs2 as f64, p.error),
             })
-            .collect();
+        }));
         rates::assess(&rows, floor.max(truth_error)).map_err(|e| {
             Error::input(
                 path,
