@@ -5,7 +5,7 @@ use clap::{Parser, Subcommand};
 use contact_rates::case::{Case, PeakMemory, RunSummary};
 use contact_rates::contact::Method;
 use contact_rates::external::export::{self, Source};
-use contact_rates::external::grade;
+use contact_rates::external::{grade, judge_file};
 use contact_rates::io::solution::FieldNames;
 use contact_rates::progress::Progress;
 use contact_rates::report::{self, Output, Staging};
@@ -65,6 +65,27 @@ enum Command {
     /// Grade another code's solutions of an exported problem against the exact solution:
     /// errors, rates and verdicts beside this project's mortar and nts (reports/grade-NAME).
     Grade(GradeArgs),
+    /// Judge anyone's table of errors with the studies' rules: a CSV with columns h,error and
+    /// optionally level, dofs, method, quantity (one verdict per method and quantity) and
+    /// truth_error. Exits non-zero only where a threshold fails.
+    Judge {
+        /// The CSV file.
+        file: PathBuf,
+        /// A required rate R: `pass` where the verdict supports a rate and both the fit and
+        /// the last successive rate reach R, `fail` where the last successive rate is below
+        /// R, `unverified` otherwise.
+        #[arg(long, value_name = "R")]
+        threshold: Option<f64>,
+        /// Apply the threshold to this method only (default: every group).
+        #[arg(long, value_name = "M")]
+        method: Option<String>,
+        /// Apply the threshold to this quantity only (default: every group).
+        #[arg(long, value_name = "Q")]
+        quantity: Option<String>,
+        /// Write rates.csv and error_vs_h.png into this folder.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Export a manufactured contact problem for another code: meshes (MSH 4.1 and 2.2),
     /// problem.toml, problem.py, nodal loads per level and step, README.md; all or nothing.
     Export {
@@ -228,6 +249,18 @@ fn run() -> anyhow::Result<()> {
         }
         Command::Solve(args) => solve_one(&args.request()?),
         Command::Grade(args) => grade(args),
+        Command::Judge {
+            file,
+            threshold,
+            method,
+            quantity,
+            out,
+        } => judge(judge_file::JudgeRequest {
+            file,
+            threshold,
+            method,
+            quantity,
+        }, out),
         Command::Export {
             source,
             levels,
@@ -277,6 +310,31 @@ fn study(name: &str, out: Option<PathBuf>, shard: Option<&str>, merge: bool) -> 
     let failures = outcome.failures();
     if !failures.is_empty() {
         anyhow::bail!("rate below threshold: {}", failures.join("; "));
+    }
+    Ok(())
+}
+
+/// `judge FILE.csv`: every group judged, printed, written where asked; an error only where
+/// a threshold fails (an unverified one is printed).
+fn judge(req: judge_file::JudgeRequest, out: Option<PathBuf>) -> anyhow::Result<()> {
+    if let Some(dir) = &out {
+        for n in report::check_writable(dir, Output::Report)? {
+            eprintln!("note: {n}");
+        }
+    }
+    let groups = judge_file::judge_file(&req)?;
+    print!("{}", judge_file::console(&groups));
+    if let Some(dir) = &out {
+        judge_file::write_report(&groups, &req.file, dir)?;
+        println!("wrote {}", dir.display());
+    }
+    let failed: Vec<String> = groups
+        .iter()
+        .filter(|g| g.outcome == Some(contact_rates::verify::rates::Outcome::Fail))
+        .map(judge_file::group_name)
+        .collect();
+    if !failed.is_empty() {
+        anyhow::bail!("rate below threshold: {}", failed.join(", "));
     }
     Ok(())
 }

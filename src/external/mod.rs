@@ -7,6 +7,7 @@ pub mod export;
 pub mod family;
 pub mod grade;
 pub mod grade_report;
+pub mod judge_file;
 pub mod mesh_in;
 pub mod msh_write;
 pub mod problem;

@@ -232,6 +232,26 @@ pub fn groups(errors: &[ErrorRecord]) -> Vec<Vec<&ErrorRecord>> {
         .collect()
 }
 
+/// One group's levels judged ([`rates::assess`], truth `truth_error`), and its threshold's
+/// outcome; `resultant_fixed`: the group is a cone's contact resultant fixed by
+/// equilibrium ([`rates::judge`]). The per-group step of [`judge_errors`] and of `judge`
+/// on anyone's table.
+pub fn judge_levels(
+    levels: &[LevelError],
+    truth_error: f64,
+    resultant_fixed: bool,
+    threshold: Option<Threshold>,
+) -> Result<(Assessment, Option<Outcome>), EqualH> {
+    let quantity = match resultant_fixed {
+        true => Quantity::PressureResultant,
+        false => Quantity::Theorem,
+    };
+    let assessment = rates::judge(levels, truth_error, quantity, resultant_fixed)?;
+    let max_error = levels.iter().map(|l| l.error).fold(0.0f64, f64::max);
+    let outcome = threshold.map(|t| t.outcome(&assessment, max_error));
+    Ok((assessment, outcome))
+}
+
 /// Every group of `errors` (parameter, method, quantity) judged by the rules of
 /// [`rates::assess`], with its threshold's outcome: the one judging loop.
 pub fn judge_errors(errors: &[ErrorRecord], rules: &Rules) -> Result<Vec<RateRow>, GroupEqualH> {
@@ -239,16 +259,20 @@ pub fn judge_errors(errors: &[ErrorRecord], rules: &Rules) -> Result<Vec<RateRow
         .into_iter()
         .map(|rows| {
             let (method, quantity) = (rows[0].method.clone(), rows[0].quantity);
-            let levels = levels_of_errors(&rows);
-            let fixed = rules.resultant_fixed && method.cone().is_some();
-            let assessment = rates::judge(&levels, (rules.truth_error)(quantity), quantity, fixed)
-                .map_err(|equal| GroupEqualH {
-                    group: format!("{method} {quantity}"),
-                    equal,
-                })?;
+            let fixed = rules.resultant_fixed
+                && method.cone().is_some()
+                && quantity == Quantity::PressureResultant;
             let threshold = (rules.threshold)(&method, quantity);
-            let max_error = rows.iter().map(|r| r.error).fold(0.0f64, f64::max);
-            let outcome = threshold.map(|t| t.outcome(&assessment, max_error));
+            let (assessment, outcome) = judge_levels(
+                &levels_of_errors(&rows),
+                (rules.truth_error)(quantity),
+                fixed,
+                threshold,
+            )
+            .map_err(|equal| GroupEqualH {
+                group: format!("{method} {quantity}"),
+                equal,
+            })?;
             Ok(RateRow {
                 method,
                 quantity,

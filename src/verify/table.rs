@@ -10,7 +10,7 @@ use crate::contact::Method;
 use crate::error::{Error, Result};
 use crate::verify::quantity::Quantity;
 use crate::verify::judge::RateRow;
-use crate::verify::rates::{Outcome, Verdict};
+use crate::verify::rates::{Assessment, Outcome, Verdict};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::path::Path;
 
@@ -132,13 +132,14 @@ pub struct ErrorRecord {
     pub parameter: Option<f64>,
 }
 
-/// One row of rates.csv: what one method's errors in one quantity support.
+/// One row of rates.csv: what one method's errors in one quantity support. The quantity
+/// is one of this project's ([`Quantity`]) or, for `judge` on anyone's table, its name.
 #[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct RateRecord {
+pub struct RateRecord<Q = Quantity> {
     /// The method.
     pub method: MethodLabel,
     /// Quantity.
-    pub quantity: Quantity,
+    pub quantity: Q,
     /// The rate in h over `levels_used` (empty without one).
     pub rate: Option<f64>,
     /// Its standard error.
@@ -190,15 +191,36 @@ pub fn join(levels: &[usize]) -> String {
 impl RateRecord {
     /// The row of a judged rate `r`.
     pub fn new(r: &RateRow) -> Self {
-        let a = &r.assessment;
+        RateRecord::from_parts(
+            r.method.clone(),
+            r.quantity,
+            r.parameter,
+            &r.assessment,
+            r.threshold.map(|t| t.value()),
+            r.outcome,
+        )
+    }
+}
+
+impl<Q> RateRecord<Q> {
+    /// The row of `method`'s `quantity` judged as `a`, with its threshold's value and
+    /// outcome.
+    pub fn from_parts(
+        method: MethodLabel,
+        quantity: Q,
+        parameter: Option<f64>,
+        a: &Assessment,
+        threshold: Option<f64>,
+        outcome: Option<Outcome>,
+    ) -> Self {
         RateRecord {
-            method: r.method.clone(),
-            quantity: r.quantity,
+            method,
+            quantity,
             rate: a.fit.and_then(|f| finite(f.rate)),
             stderr: a.fit.and_then(|f| finite(f.stderr)),
             levels_used: join(&a.used),
-            threshold: r.threshold.map(|t| t.value()),
-            pass: r.outcome,
+            threshold,
+            pass: outcome,
             rate_dofs: a.fit_dofs.map(|f| -f.rate),
             successive: a.successive_text(),
             verdict: a.verdict,
@@ -208,7 +230,7 @@ impl RateRecord {
             oscillatory: a.celik.map(|c| c.oscillatory),
             gci_fine: a.celik.and_then(|c| finite(c.gci_fine)),
             asymptotic_ratio: a.asymptotic_ratio.and_then(finite),
-            parameter: r.parameter,
+            parameter,
         }
     }
 
