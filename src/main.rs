@@ -115,9 +115,10 @@ struct GradeArgs {
     /// The graded code's label in the report (not mortar or nts).
     #[arg(long, default_value = "graded")]
     name: String,
-    /// Exit non-zero when the graded code's theorem-norm rate (l2_stress where the exact
-    /// solution gives no displacement) is below R, or when its errors support no rate
-    /// (only a fitted or drifting rate counts).
+    /// A required rate R for the graded code's theorem norm (l2_stress where the exact
+    /// solution gives no displacement): `pass` where its verdict supports a rate and both
+    /// the fit and the last successive rate reach R; `fail` (non-zero exit) where the last
+    /// successive rate is below R; `unverified` (printed, zero exit) otherwise.
     #[arg(long, value_name = "R")]
     threshold: Option<f64>,
     /// Report folder (default: reports/grade-NAME).
@@ -307,6 +308,9 @@ fn study(name: &str, out: Option<PathBuf>, shard: Option<&str>, merge: bool) -> 
     }
     outcome.write(&dir)?;
     print!("{}", outcome.console(&dir));
+    for u in outcome.unverified() {
+        println!("unverified: {u}");
+    }
     let failures = outcome.failures();
     if !failures.is_empty() {
         anyhow::bail!("rate below threshold: {}", failures.join("; "));
@@ -368,6 +372,9 @@ fn grade(args: GradeArgs) -> anyhow::Result<()> {
     })?;
     graded.write(&dir)?;
     print!("{}", graded.console(&dir));
+    for u in &graded.unverified {
+        println!("unverified: {u}");
+    }
     if !graded.failures.is_empty() {
         anyhow::bail!("{}", graded.failures.join("; "));
     }

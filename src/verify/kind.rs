@@ -45,8 +45,14 @@ pub trait Outcome {
     fn warnings(&self) -> &[String] {
         &[]
     }
-    /// The thresholds missed, one sentence each (empty: the study passed).
+    /// The thresholds missed (`fail`), one sentence each (empty: none failed). Only these
+    /// make `study` exit non-zero.
     fn failures(&self) -> Vec<String> {
+        Vec::new()
+    }
+    /// The thresholds neither met nor missed (`unverified`: the errors support no rate and
+    /// the last successive rate is not below it), one sentence each.
+    fn unverified(&self) -> Vec<String> {
         Vec::new()
     }
 }

@@ -250,6 +250,11 @@ impl StudyResult {
     pub fn failures(&self) -> Vec<String> {
         self.rates.iter().filter_map(RateRow::failure).collect()
     }
+
+    /// The thresholds neither met nor missed, one sentence each.
+    pub fn unverified(&self) -> Vec<String> {
+        self.rates.iter().filter_map(RateRow::unverified).collect()
+    }
 }
 
 /// The study's solves, with a named handle for each.

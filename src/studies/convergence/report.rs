@@ -975,4 +975,7 @@ impl Outcome for StudyResult {
     fn failures(&self) -> Vec<String> {
         StudyResult::failures(self)
     }
+    fn unverified(&self) -> Vec<String> {
+        StudyResult::unverified(self)
+    }
 }

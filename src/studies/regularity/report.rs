@@ -347,4 +347,11 @@ impl KindOutcome for Regularity {
             .flat_map(|(beta, res)| res.failures().into_iter().map(move |f| format!("beta = {beta}: {f}")))
             .collect()
     }
+
+    fn unverified(&self) -> Vec<String> {
+        self.members
+            .iter()
+            .flat_map(|(beta, res)| res.unverified().into_iter().map(move |f| format!("beta = {beta}: {f}")))
+            .collect()
+    }
 }
