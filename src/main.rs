@@ -45,6 +45,10 @@ enum Command {
         /// Build the report from the records of all shards.
         #[arg(long)]
         merge: bool,
+        /// Judge the written report (reports/NAME or --out) again from its CSVs and rewrite
+        /// rates.csv, the plots and README.md, without solving (von_mises.png is kept).
+        #[arg(long, conflicts_with_all = ["shard", "merge"])]
+        rejudge: bool,
     },
     /// Print the Results page docs/results.md, read from the committed reports' CSVs
     /// (reports/rates, rates-exact, rates-exact-vp, patch, crossover, two-size-exact, two-size-rates,
@@ -230,7 +234,8 @@ fn run() -> anyhow::Result<()> {
             out,
             shard,
             merge,
-        } => study(&name, out, shard.as_deref(), merge),
+            rejudge,
+        } => study(&name, out, shard.as_deref(), merge, rejudge),
         Command::Results { headline } => {
             let reports = report::reports_dir();
             if headline {
@@ -280,7 +285,13 @@ fn run() -> anyhow::Result<()> {
 
 /// `study NAME`: check the report folder, run, write the report, print its summary; an
 /// error when a threshold is missed.
-fn study(name: &str, out: Option<PathBuf>, shard: Option<&str>, merge: bool) -> anyhow::Result<()> {
+fn study(
+    name: &str,
+    out: Option<PathBuf>,
+    shard: Option<&str>,
+    merge: bool,
+    rejudge: bool,
+) -> anyhow::Result<()> {
     if name == "list" {
         for (n, d) in Study::list() {
             println!("{n:12} {d}");
@@ -300,8 +311,12 @@ fn study(name: &str, out: Option<PathBuf>, shard: Option<&str>, merge: bool) -> 
             eprintln!("note: {n}");
         }
     }
-    let Some(outcome) = kind.run(mode)? else {
-        return Ok(());
+    let outcome = match rejudge {
+        true => kind.rejudge(&dir)?,
+        false => match kind.run(mode)? {
+            Some(outcome) => outcome,
+            None => return Ok(()),
+        },
     };
     for w in outcome.warnings() {
         eprintln!("warning: {w}");

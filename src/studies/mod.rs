@@ -94,6 +94,23 @@ impl Study {
     }
 }
 
+impl Study {
+    /// Judge the written report `dir` again from its CSVs and rewrite it, without solving.
+    pub fn rejudge(&self, dir: &std::path::Path) -> Result<Box<dyn Outcome>> {
+        let Some(rejudge) = self.kind.rejudge else {
+            return Err(Error::input(
+                self.name(),
+                "--rejudge",
+                format!(
+                    "a {} study's report holds no judged rates to rejudge; run the study without --rejudge",
+                    self.kind.name
+                ),
+            ));
+        };
+        rejudge(self.file.as_deref(), dir)
+    }
+}
+
 /// The error for a study name that is neither built in nor a file.
 pub fn unknown_study(name: &str) -> Error {
     let names: Vec<String> = Study::list().into_iter().map(|(n, _)| n).collect();

@@ -32,6 +32,9 @@ pub struct Kind {
     /// Run one study: `file` is the study file for a kind found in files. A shard gives no
     /// outcome (its records are the result).
     pub run: fn(file: Option<&Path>, mode: Mode) -> Result<Option<Box<dyn Outcome>>>,
+    /// Judge a written report `dir` again from its CSVs, without solving (`study NAME
+    /// --rejudge`); None for a kind whose report holds no judged rates.
+    pub rejudge: Option<fn(file: Option<&Path>, dir: &Path) -> Result<Box<dyn Outcome>>>,
 }
 
 /// What a study measured: it writes its report folder and says what the console shows.

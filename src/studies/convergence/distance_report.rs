@@ -1,6 +1,6 @@
 //! The distance between the two cones in a convergence report: e_mortar, e_nts and D
 //! against h, the triangle-inequality bounds D - e_mortar <= e_nts <= D + e_mortar, the
-//! consistency term of each cone, and where D's fitted line would reach mortar's.
+//! consistency term of each cone, and nts read against its distance to mortar.
 
 use super::{RateRow, StudyResult};
 use crate::contact::Method;
@@ -8,22 +8,21 @@ use crate::error::Result;
 use crate::report::markdown::{Doc, Table};
 use crate::report::plot::{self, Series};
 use crate::verify::quantity::Quantity;
-use crate::verify::rates::{Fit, Verdict};
+use crate::verify::judge;
+use crate::verify::rates::Fit;
 use std::path::Path;
 
-/// The fit of a fitted rate (the rules' window of agreeing successive rates).
+/// The fit of a row whose verdict supports a rate.
 fn supported_fit(row: Option<&RateRow>) -> Option<Fit> {
-    let a = &row?.assessment;
-    // A drifting rate is still changing: no line to extrapolate.
-    (a.verdict == Verdict::Fitted).then_some(a.fit).flatten()
+    row?.supported_fit()
 }
 
 /// The section, where the study measures the cone distance in the theorem norm.
 pub fn section(doc: &mut Doc, res: &StudyResult) {
     let key = Quantity::ConeDistance;
-    let Some(d_row) = res.rate(Method::Nts, key) else {
+    if res.rate(Method::Nts, key).is_none() {
         return;
-    };
+    }
     let theorem = Quantity::Theorem;
     doc.heading(2, "The distance between the cones")
         .paragraph(
@@ -87,78 +86,64 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
         }
     }
     doc.table(&rates);
-    doc.paragraph(crossover(res, d_row));
+    decomposition(doc, res);
 }
 
-/// Where D's fitted line reaches mortar's, and the local rate of the upper bound
-/// D + e_mortar of nts's error there and two levels later.
-fn crossover(res: &StudyResult, d_row: &RateRow) -> String {
-    let mortar = res.rate(Method::Mortar, Quantity::Theorem);
-    let (Some(mortar), Some(fm), Some(fd)) = (mortar, supported_fit(mortar), supported_fit(Some(d_row))) else {
-        return "No crossover is predicted: D's or mortar's theorem-norm errors support no rate (see the rates above).".into();
-    };
-    if fd.rate >= fm.rate {
-        return format!(
-            "D falls at {:.3}, no slower than mortar's error ({:.3}): no crossover is predicted from these levels.",
-            fd.rate, fm.rate
-        );
+/// Each method read against its distance to mortar: for the theorem norm, h1_u and
+/// l2_stress, nts's observed verdict beside mortar's and D's, the largest |pythagorean|
+/// of decomposition.csv, D / e_mortar at the finest level, and what D's verdict supports
+/// of nts's asymptotic rate ([`judge::asymptote`]).
+fn decomposition(doc: &mut Doc, res: &StudyResult) {
+    let rows = judge::decomposition(&res.errors);
+    let mut table = Table::new([
+        "quantity",
+        "nts observed",
+        "mortar",
+        "D (distance to mortar)",
+        "largest abs(pythagorean)",
+        "D / e_mortar, finest level",
+        "nts's asymptotic rate",
+    ]);
+    for (q, dq) in judge::DECOMPOSED {
+        let (Some(x), Some(m), Some(d)) = (
+            res.rate(Method::Nts, q),
+            res.rate(Method::Mortar, q),
+            res.rate(Method::Nts, dq),
+        ) else {
+            continue;
+        };
+        let mine: Vec<&judge::DecompositionRow> = rows.iter().filter(|r| r.quantity == q).collect();
+        let Some(last) = mine.last() else {
+            continue;
+        };
+        let worst = mine
+            .iter()
+            .max_by(|a, b| a.pythagorean.abs().total_cmp(&b.pythagorean.abs()))
+            .map_or("-".into(), |r| format!("{:.1e} (level {})", r.pythagorean.abs(), r.level));
+        let series = |method: Method, quantity: Quantity| -> Vec<(usize, f64, f64)> {
+            res.errors
+                .iter()
+                .filter(|e| e.method == method && e.quantity == quantity)
+                .map(|e| (e.level, e.h, e.error))
+                .collect()
+        };
+        let asymptote = judge::asymptote(d, m, &series(Method::Nts, dq), &series(Method::Mortar, q));
+        table.row([
+            format!("`{q}`"),
+            x.assessment.describe(),
+            m.assessment.describe(),
+            d.assessment.describe(),
+            worst,
+            format!("{:.2}", last.distance / last.mortar_error),
+            asymptote.describe(),
+        ]);
     }
-    // e = exp(intercept) h^rate for both; equal at h*.
-    let h_star = ((fm.intercept - fd.intercept) / (fd.rate - fm.rate)).exp();
-    let finest = *res.file.mesh.levels.last().expect("levels");
-    let (h_finest, dofs_finest) = res
-        .errors
-        .iter()
-        .find(|e| e.level == finest && e.method == Method::Nts)
-        .map_or((f64::NAN, 0), |e| (e.h, e.dofs));
-    // Each level halves h and multiplies the dofs by about 4.
-    let level = finest as f64 + (h_finest / h_star).log2();
-    let dofs = dofs_finest as f64 * 4f64.powf(level - finest as f64);
-    // The local rate of D + e_mortar where D / e_mortar = ratio.
-    let upper = |ratio: f64| (fm.rate + fd.rate * ratio) / (1.0 + ratio);
-    let later = 4f64.powf(fm.rate - fd.rate);
-    let lines = [(mortar, fm), (d_row, fd)];
-    let sd = crossover_level_sd(res, lines, h_star.ln()).map_or(String::new(), |sd| {
-        format!(" ± {sd:.1} (one standard deviation from the two rates' standard errors)")
-    });
-    let place = if level <= finest as f64 {
-        format!("at level {level:.1}{sd}, within the study's levels")
-    } else {
-        format!("near level {level:.1}{sd}, about {dofs:.1e} dofs")
-    };
-    format!(
-        "From the fitted rates (D {:.3}, e_mortar {:.3}), D reaches e_mortar at h = {h_star:.3e}, {place}. There nts's error lies between 0 and 2 e_mortar, and the upper bound D + e_mortar falls at the local rate {:.2}; two levels later (D = {later:.1} e_mortar) at {:.2}, tending to D's {:.3}.",
-        fd.rate,
-        fm.rate,
-        upper(1.0),
-        upper(later),
-        fd.rate
-    )
-}
-
-/// One standard deviation of the level where two fitted lines log e = intercept + rate
-/// log h (mortar's, then D's) cross at `log_h_star`, from their rates' standard errors:
-/// the delta method on each line taken at its levels' mean log h, where its value and
-/// slope are uncorrelated (value variance: the slope's times the levels' sum of squares
-/// over their count), the two fits independent. None where a level's h is missing.
-fn crossover_level_sd(res: &StudyResult, lines: [(&RateRow, Fit); 2], log_h_star: f64) -> Option<f64> {
-    let mut variance = 0.0;
-    for (row, fit) in lines {
-        let log_h: Vec<f64> = (row.assessment.used.iter())
-            .map(|&l| {
-                let e = res.errors.iter().find(|e| e.level == l && e.method == row.method)?;
-                Some(e.h.ln())
-            })
-            .collect::<Option<_>>()?;
-        let n = log_h.len() as f64;
-        let mean = log_h.iter().sum::<f64>() / n;
-        let sxx: f64 = log_h.iter().map(|x| (x - mean).powi(2)).sum();
-        let slope_variance = fit.stderr.powi(2);
-        variance += slope_variance * sxx / n + (mean - log_h_star).powi(2) * slope_variance;
+    if table.is_empty() {
+        return;
     }
-    // d(log h*) / d(value) = 1 / (rate difference); a level is a factor 2 in h.
-    let rate_difference = (lines[0].1.rate - lines[1].1.rate).abs();
-    Some(variance.sqrt() / rate_difference / std::f64::consts::LN_2)
+    doc.heading(3, "nts read against its distance to mortar")
+        .paragraph("Since D - e_mortar <= e_nts <= D + e_mortar, nts's error tends to the rate min(r_D, r_mortar) once D's rate is supported, and its observed rate turns where D overtakes e_mortar. `pythagorean` = e_nts / sqrt(e_mortar^2 + D^2) - 1 (decomposition.csv) is descriptive: near 0 where the two parts are orthogonal. Where D's verdict supports no rate, nothing is predicted. A predicted level range takes D's rate over its own range (its fitted rate, its last successive rate, its fit over every level), D's line anchored at its finest level and mortar's at its fit.")
+        .table(&table);
 }
 
 /// cone_distance.png: e_mortar, e_nts and D in the theorem norm against h, with D's and

@@ -32,6 +32,10 @@ pub const KIND: Kind = Kind {
             .to_string();
         Ok(run_mode(&path, mode)?.map(|r| Box::new(r) as Box<dyn Outcome>))
     },
+    rejudge: Some(|file, dir| {
+        let path = file.expect("a convergence study is a file").display().to_string();
+        Ok(Box::new(rejudge(&path, dir)?) as Box<dyn Outcome>)
+    }),
 };
 
 
@@ -63,7 +67,7 @@ pub use crate::verify::table::{ErrorRecord, join};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize, Serializer};
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 pub use crate::verify::judge::RateRow;
@@ -123,8 +127,21 @@ impl Serialize for Source {
     }
 }
 
+impl<'de> Deserialize<'de> for Source {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        match name.as_str() {
+            "reference" => Ok(Source::Reference),
+            "exact" => Ok(Source::Exact),
+            _ => Method::parse(&name)
+                .map(Source::Cone)
+                .ok_or_else(|| serde::de::Error::custom(format!("unknown profile source '{name}'"))),
+        }
+    }
+}
+
 /// A point of a profile along Gamma_C at T.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ProfilePoint {
     /// Whose profile.
     pub label: Source,
@@ -230,6 +247,14 @@ pub struct StudyResult {
     pub wall_s: f64,
     /// Scene warnings (from the reference case).
     pub warnings: Vec<String>,
+    /// The truth's own estimated error per quantity (0 against an exact solution): levels
+    /// within 5x of it are left out of the rates.
+    pub truth_errors: BTreeMap<Quantity, f64>,
+    /// Whether equilibrium fixes the cones' contact resultant.
+    pub resultant_fixed: bool,
+    /// For a report rejudged from its CSVs (`--rejudge`): the folder whose plots that need
+    /// a solution (von_mises.png) are kept.
+    pub kept_from: Option<PathBuf>,
 }
 
 impl StudyResult {
@@ -636,7 +661,7 @@ fn measure_variants(
         for ((method, case, sol), e) in taken.iter().zip(&all_errors) {
             errors.extend(error_rows(sf, *method, case, sol, e)?);
         }
-        let rates = fit_rates(sf, path, &errors, truth, resultant_fixed)?;
+        let rates = fit_rates(sf, path, &errors, &|q| truth.quantity_error(q), resultant_fixed)?;
         out.push(Variant {
             coarsest: *coarsest,
             errors,
@@ -744,7 +769,7 @@ fn fit_rates(
     sf: &StudyFile,
     path: &Path,
     errors: &[ErrorRecord],
-    truth: &Truth,
+    truth_error: &dyn Fn(Quantity) -> f64,
     resultant_fixed: bool,
 ) -> Result<Vec<RateRow>> {
     let threshold = |m: &MethodLabel, q: Quantity| {
@@ -753,7 +778,7 @@ fn fit_rates(
             .map(|c| sf.thresholds.of(c))
     };
     let rules = Rules {
-        truth_error: &|q| truth.quantity_error(q),
+        truth_error,
         resultant_fixed,
         threshold: &threshold,
     };
@@ -895,6 +920,106 @@ pub fn run(name: &str) -> Result<StudyResult> {
     run_mode(name, Mode::All).map(|r| r.expect("a full run gives a result"))
 }
 
+/// The report `dir` of the convergence study `name` judged again from its CSVs (errors,
+/// levels, gap, pressure, time, variants) and run.toml, without solving: the result a full
+/// run on the same errors gives, but for the solution it no longer has (von_mises.png is
+/// kept from `dir`).
+pub fn rejudge(name: &str, dir: &Path) -> Result<StudyResult> {
+    let study = LoadedStudy::load(name)?;
+    let sf = &study.file;
+    let facts_path = dir.join("run.toml");
+    let text = std::fs::read_to_string(&facts_path).map_err(|_| {
+        Error::input(
+            &facts_path,
+            "file",
+            "no run.toml: the report predates --rejudge (or is not this study's); run the study once without --rejudge",
+        )
+    })?;
+    let facts: report::RunFacts = crate::error::parse_toml(&text, &facts_path, "run facts")?;
+    let errors: Vec<ErrorRecord> = crate::verify::table::read(&dir.join("errors.csv"))?;
+    let truth_errors: BTreeMap<Quantity, f64> = facts
+        .truth_errors
+        .iter()
+        .map(|(name, e)| {
+            Quantity::try_from(name.clone())
+                .map(|q| (q, *e))
+                .map_err(|m| Error::input(&facts_path, "truth_errors", format!("{m}; regenerate the report")))
+        })
+        .collect::<Result<_>>()?;
+    let truth_error = |q: Quantity| truth_errors.get(&q).copied().unwrap_or(0.0);
+    let rates = fit_rates(sf, &study.path, &errors, &truth_error, facts.resultant_fixed)?;
+    let variants = match dir.join("variants.csv") {
+        p if p.exists() => {
+            let rows: Vec<report::VariantCsv> = crate::verify::table::read(&p)?;
+            let mut coarsest: Vec<f64> = Vec::new();
+            for r in &rows {
+                if !coarsest.contains(&r.coarsest) {
+                    coarsest.push(r.coarsest);
+                }
+            }
+            coarsest
+                .into_iter()
+                .map(|c| {
+                    let errors: Vec<ErrorRecord> = rows
+                        .iter()
+                        .filter(|r| r.coarsest == c)
+                        .map(|r| r.record(sf.steps))
+                        .collect();
+                    let rates = fit_rates(sf, &study.path, &errors, &truth_error, facts.resultant_fixed)?;
+                    Ok(Variant {
+                        coarsest: c,
+                        errors,
+                        rates,
+                    })
+                })
+                .collect::<Result<_>>()?
+        }
+        _ => Vec::new(),
+    };
+    let time_study = match facts.time {
+        Some(t) => {
+            let runs: Vec<TimeRun> = crate::verify::table::read(&dir.join("time.csv"))?;
+            let judged: Vec<(usize, f64, f64)> = runs.iter().map(|r| (r.steps, r.k, r.error)).collect();
+            let assessment = crate::verify::judge::assess_in_k(&judged)
+                .map_err(|e| Error::input(&study.path, "time.steps", format!("time study: {e}")))?;
+            Some(TimeStudy {
+                scene: t.scene,
+                method: t.method,
+                level: t.level,
+                h: t.h,
+                dofs: t.dofs,
+                reference_steps: t.reference_steps,
+                runs,
+                assessment,
+            })
+        }
+        None => None,
+    };
+    Ok(StudyResult {
+        name: study.name,
+        description: sf.description.clone(),
+        scene: study.scene,
+        errors,
+        rates,
+        levels: crate::verify::table::read(&dir.join("levels.csv"))?,
+        reference: facts.reference,
+        exact_quadrature: facts.exact_quadrature,
+        pressure: crate::verify::table::read(&dir.join("pressure.csv"))?,
+        gap: crate::verify::table::read(&dir.join("gap.csv"))?,
+        profile_level: facts.profile_level,
+        deformed: Vec::new(),
+        time_study,
+        variants,
+        provenance: facts.provenance,
+        wall_s: facts.wall_s,
+        warnings: facts.warnings,
+        truth_errors,
+        resultant_fixed: facts.resultant_fixed,
+        kept_from: Some(dir.to_path_buf()),
+        file: study.file,
+    })
+}
+
 /// Run the convergence study `name` in `mode`: all jobs here, one shard of them (records
 /// only, no result), or a merge of the records of all shards.
 pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
@@ -913,7 +1038,7 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
     let measured = measure_levels(sf, &plan, &mut solved, &truth, profile_level)?;
     // 4. The rates and their thresholds, and the variant families'.
     let fixed = measured.resultant_fixed;
-    let rates = fit_rates(sf, &study.path, &measured.errors, &truth, fixed)?;
+    let rates = fit_rates(sf, &study.path, &measured.errors, &|q| truth.quantity_error(q), fixed)?;
     let variants = measure_variants(sf, &study.path, &plan, &mut solved, &truth, fixed)?;
     // 5. The rate in time on a fixed mesh.
     let time_study = time_study(&study, &plan, &mut solved, sf.reference.quadrature)?;
@@ -933,6 +1058,11 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
         ),
     };
     let provenance = provenance(&study, &mesh);
+    let truth_errors = measured
+        .errors
+        .iter()
+        .map(|e| (e.quantity, truth.quantity_error(e.quantity)))
+        .collect();
     Ok(Some(StudyResult {
         name: study.name,
         description: sf.description.clone(),
@@ -951,6 +1081,9 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
         provenance,
         wall_s: t0.elapsed().as_secs_f64(),
         warnings,
+        truth_errors,
+        resultant_fixed: fixed,
+        kept_from: None,
         file: study.file,
     }))
 }

@@ -18,16 +18,95 @@ use std::path::Path;
 use crate::verify::kind::Outcome;
 
 /// One row of variants.csv: a variant family's error.
-#[derive(Serialize)]
-struct VariantCsv {
+#[derive(Serialize, serde::Deserialize)]
+pub(super) struct VariantCsv {
     /// Size of body 1 at level 0 of the family.
-    coarsest: f64,
-    method: MethodLabel,
-    level: usize,
-    h: f64,
-    dofs: usize,
-    quantity: Quantity,
-    error: f64,
+    pub coarsest: f64,
+    pub method: MethodLabel,
+    pub level: usize,
+    pub h: f64,
+    pub dofs: usize,
+    pub quantity: Quantity,
+    pub error: f64,
+}
+
+impl VariantCsv {
+    /// The errors.csv row it was written from (`steps`: the study's; no wall time).
+    pub fn record(&self, steps: usize) -> ErrorRecord {
+        ErrorRecord {
+            method: self.method.clone(),
+            level: self.level,
+            h: self.h,
+            dofs: self.dofs,
+            steps,
+            quantity: self.quantity,
+            error: self.error,
+            wall_s: None,
+            parameter: None,
+        }
+    }
+}
+
+/// run.toml: what a report holds beyond its CSVs, so that `study NAME --rejudge` can judge
+/// its errors again and rewrite it without solving.
+#[derive(Serialize, serde::Deserialize)]
+pub(super) struct RunFacts {
+    /// Total wall time of the run (s).
+    pub wall_s: f64,
+    /// Level of the profiles and of von_mises.png.
+    pub profile_level: usize,
+    /// Whether equilibrium fixes the cones' contact resultant.
+    pub resultant_fixed: bool,
+    /// Gauss points per direction of the exact-error rule (none: a reference solve).
+    pub exact_quadrature: Option<usize>,
+    /// The reference solve's facts (none: the exact solution).
+    pub reference: Option<crate::verify::truth::Reference>,
+    /// The truth's own estimated error per quantity name.
+    pub truth_errors: std::collections::BTreeMap<String, f64>,
+    /// Scene warnings.
+    pub warnings: Vec<String>,
+    /// The time study's fixed facts (its runs are time.csv).
+    pub time: Option<TimeFacts>,
+    /// gmsh version, .geo hash, solver, cores, commit.
+    pub provenance: std::collections::BTreeMap<String, String>,
+}
+
+/// The time study's facts beside time.csv.
+#[derive(Serialize, serde::Deserialize)]
+pub(super) struct TimeFacts {
+    pub scene: String,
+    pub method: Method,
+    pub level: usize,
+    pub h: f64,
+    pub dofs: usize,
+    pub reference_steps: Option<usize>,
+}
+
+impl RunFacts {
+    fn of(res: &StudyResult) -> Self {
+        RunFacts {
+            wall_s: res.wall_s,
+            profile_level: res.profile_level,
+            resultant_fixed: res.resultant_fixed,
+            exact_quadrature: res.exact_quadrature,
+            reference: res.reference,
+            truth_errors: res
+                .truth_errors
+                .iter()
+                .map(|(q, e)| (q.name().to_string(), *e))
+                .collect(),
+            warnings: res.warnings.clone(),
+            time: res.time_study.as_ref().map(|t| TimeFacts {
+                scene: t.scene.clone(),
+                method: t.method,
+                level: t.level,
+                h: t.h,
+                dofs: t.dofs,
+                reference_steps: t.reference_steps,
+            }),
+            provenance: res.provenance.clone(),
+        }
+    }
 }
 
 /// "rate >= 0.70" or "error <= 1e-9", with `digits` decimals for a rate.
@@ -67,6 +146,13 @@ pub fn write_study(res: &StudyResult, dir: &Path) -> Result<()> {
         write(d, "levels.csv", &csv_bytes(&res.levels)?)?;
         write(d, "pressure.csv", &csv_bytes(&res.pressure)?)?;
         write(d, "gap.csv", &csv_bytes(&res.gap)?)?;
+        let facts = toml::to_string(&RunFacts::of(res))
+            .map_err(|e| crate::error::Error::input(d.join("run.toml"), "facts", e.to_string()))?;
+        write(d, "run.toml", facts.as_bytes())?;
+        let decomposition = crate::verify::judge::decomposition(&res.errors);
+        if !decomposition.is_empty() {
+            write(d, "decomposition.csv", &csv_bytes(&decomposition)?)?;
+        }
         if !res.variants.is_empty() {
             let rows: Vec<VariantCsv> = res
                 .variants
@@ -295,6 +381,15 @@ fn profiles(res: &StudyResult, d: &Path) -> Result<()> {
 
 /// Deformed meshes coloured by von Mises stress.
 fn von_mises(res: &StudyResult, d: &Path) -> Result<()> {
+    // Rejudged from the CSVs: no solution to draw, the plot is kept as it was.
+    if let Some(from) = &res.kept_from {
+        let old = from.join("von_mises.png");
+        if old.exists() {
+            let new = d.join("von_mises.png");
+            std::fs::copy(&old, &new).map_err(|e| crate::error::Error::io(new, e))?;
+        }
+        return Ok(());
+    }
     let panels: Vec<Panel> = res
         .deformed
         .iter()
@@ -491,7 +586,7 @@ fn cones_sentence(res: &StudyResult, q: Quantity) -> Option<String> {
 }
 
 /// How the rates are judged, above the table of rates.
-const RATES_TEXT: &str = "Least-squares slope of log(error) against log(h) over the levels used (± standard error), rate against dofs, and successive rates between neighbouring levels. A rate never overstates: errors at round-off (<= 1e-10, the solvers' tolerance) are marked and never fitted (their successive rates are `-`), levels within 5x of the truth's own error in that quantity are left out, a rate needs at least 3 levels, and a quantity whose last two successive rates average below 0.15 is called non-converging and given no slope. The levels used are the longest trailing window (at least 3 levels) whose successive rates lie within 0.25 of each other; where even the last two differ by more, the fit over every level is shown, flagged pre-asymptotic. A window's rate that differs from the fit over every level, or from the mean of the last two successive rates, by more than max(0.15, 2 standard errors) is called drifting (the rate is still changing; the all-level fit is given beside it). A contact resultant fixed by equilibrium is named so and never fitted. Beside the fit, the conventions of ASME V&V 20 (Celik et al. 2008, J. Fluids Eng. 130, 078001) on the last three levels: the observed order p (non-uniform ratio, fixed-point iteration), oscillatory convergence named, the GCI of the finest level (safety factor 1.25 at the observed order, in the units of the error) and the asymptotic ratio GCI_coarse / (r^p GCI_fine) at the rate in h printed (1 where that rate describes the last three levels; at the observed order it would be 1 by construction). The `theorem` quantity is max_n (||u - u_ref||_H1 + ||sigma - sigma_ref||_L2) over both bodies, relative to the reference's; Theorem 3.1 predicts h^(3/4) for mortar (K_h^pi) and h^(1/2) for nts (K_h^I).";
+const RATES_TEXT: &str = "Least-squares slope of log(error) against log(h) over the levels used (± standard error), rate against dofs, and successive rates between neighbouring levels, judged by the rules of docs/studies.md#rates. A rate never overstates: errors at round-off (<= 1e-10, the solvers' tolerance) are marked and never fitted (their successive rates are `-`), levels within 5x of the truth's own error in that quantity are left out, and a rate needs at least 3 levels. A quantity whose last two successive rates are both at most 0.02, or whose last is negative, does not converge. Where the last three successive rates are strictly monotone and differ by more than 0.1 end to end, the rate is `falling` or `rising` (in transition): no rate is claimed, the last successive rate is given. Otherwise the levels used are the longest trailing window (at least 3 levels) whose successive rates lie within 0.1 of each other (`fitted`); without one the fit over every level is shown, flagged `pre-asymptotic`. Only `fitted` supports a rate. A threshold passes where the rate is fitted and both the fit and the last successive rate reach it, fails where the last successive rate is below it (for a falling rate, also its extrapolation to the finest level), and is `unverified` otherwise; only a failure makes the study exit non-zero. A contact resultant fixed by equilibrium is named so and never fitted. Beside the fit, the conventions of ASME V&V 20 (Celik et al. 2008, J. Fluids Eng. 130, 078001) on the last three levels: the observed order p (non-uniform ratio, fixed-point iteration), oscillatory convergence named, the GCI of the finest level (safety factor 1.25 at the observed order, in the units of the error) and the asymptotic ratio GCI_coarse / (r^p GCI_fine) at the rate in h printed (1 where that rate describes the last three levels; at the observed order it would be 1 by construction). The `theorem` quantity is max_n (||u - u_ref||_H1 + ||sigma - sigma_ref||_L2) over both bodies, relative to the reference's; Theorem 3.1 predicts h^(3/4) for mortar (K_h^pi) and h^(1/2) for nts (K_h^I).";
 
 /// ## Rates: every cone and quantity's rate, with how it is judged.
 fn rates_table(doc: &mut Doc, res: &StudyResult) {
@@ -506,7 +601,7 @@ fn rates_table(doc: &mut Doc, res: &StudyResult) {
         "GCI fine",
         "GCI ratio",
         "threshold",
-        "pass",
+        "outcome",
     ]);
     for r in &res.rates {
         let a = &r.assessment;

@@ -28,6 +28,7 @@ pub const KIND: Kind = Kind {
     found: Found::BuiltIn,
     shards: false,
     run: |_, _| Ok(Some(Box::new(run(BETAS)?))),
+    rejudge: Some(|_, dir| Ok(Box::new(rejudge(BETAS, dir)?))),
 };
 
 /// The betas of the study.
@@ -73,6 +74,18 @@ pub fn theorem_applies(beta: f64) -> bool {
 pub struct Regularity {
     /// (beta, its convergence study), in the order of [`BETAS`].
     pub members: Vec<(f64, StudyResult)>,
+}
+
+/// The report `dir` judged again from each beta's CSVs (its `beta-BETA/` folders),
+/// without solving.
+pub fn rejudge(betas: &[f64], dir: &std::path::Path) -> Result<Regularity> {
+    let mut members = Vec::new();
+    for &beta in betas {
+        let path = study_path(beta);
+        let member = dir.join(format!("beta-{beta:.2}"));
+        members.push((beta, convergence::rejudge(&path.display().to_string(), &member)?));
+    }
+    Ok(Regularity { members })
 }
 
 /// Run the study on `betas`.

@@ -14,6 +14,7 @@ pub const KIND: Kind = Kind {
     found: Found::BuiltIn,
     shards: false,
     run: |_, _| Ok(Some(Box::new(run()?))),
+    rejudge: None,
 };
 
 

@@ -35,6 +35,7 @@ pub const KIND: Kind = Kind {
             .to_string();
         Ok(Some(Box::new(run(&path)?)))
     },
+    rejudge: None,
 };
 
 
