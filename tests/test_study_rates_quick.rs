@@ -79,15 +79,38 @@ fn quick_rates_study_meets_the_theorem_thresholds() {
                 a.rate().to_bits(),
                 a.stderr().to_bits(),
                 &a.assessment.used,
-                a.pass
+                a.outcome
             ),
             (
                 b.rate().to_bits(),
                 b.stderr().to_bits(),
                 &b.assessment.used,
-                b.pass
+                b.outcome
             )
         );
+    }
+
+    // `study rates-quick --rejudge`: the written report judged again from its CSVs and
+    // run.toml rewrites every file byte for byte (rates.csv, plots, README.md), without
+    // solving; von_mises.png is kept.
+    let dir = tempfile::tempdir().unwrap();
+    let (full, again) = (dir.path().join("full"), dir.path().join("again"));
+    convergence::report::write_study(&res, &full).unwrap();
+    convergence::report::write_study(&res, &again).unwrap();
+    let rejudged = convergence::rejudge("rates-quick", &again).unwrap();
+    convergence::report::write_study(&rejudged, &again).unwrap();
+    let mut names: Vec<_> = std::fs::read_dir(&full)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    names.sort();
+    assert!(names.iter().any(|n| n == "rates.csv") && names.iter().any(|n| n == "README.md"));
+    for name in &names {
+        let (a, b) = (
+            std::fs::read(full.join(name)).unwrap(),
+            std::fs::read(again.join(name)).unwrap(),
+        );
+        assert!(a == b, "{name:?} differs after --rejudge");
     }
 }
 
