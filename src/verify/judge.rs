@@ -6,7 +6,7 @@
 
 use crate::verify::quantity::Quantity;
 use crate::verify::rates::{self, Assessment, EqualH, LevelError, Outcome, Verdict};
-use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord, join};
+use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord};
 use serde::Serialize;
 
 /// What a method's error in the threshold quantity must satisfy.
@@ -459,37 +459,143 @@ pub fn asymptote(
     }
 }
 
-impl Asymptote {
-    /// One sentence: "tends to 0.504 ± 0.005 (D's rate) past level 3" and the like.
-    pub fn describe(&self) -> String {
-        match self {
-            Asymptote::Unsupported { distance, mortar } => format!(
-                "no asymptotic rate predicted: D's verdict is {} (mortar's {}), which supports no rate",
-                distance.name(),
-                mortar.name()
-            ),
+/// One row of asymptotes.csv: what a method X's distance to mortar says of X's error in
+/// one quantity ([`Asymptote`]), with the decomposition's largest |pythagorean| and
+/// D / e_mortar at the finest level.
+#[derive(Debug, Clone, Serialize, serde::Deserialize)]
+pub struct AsymptoteRow {
+    /// X.
+    pub method: MethodLabel,
+    /// X's error's quantity.
+    pub quantity: Quantity,
+    /// X's own verdict in that quantity.
+    pub verdict: Verdict,
+    /// X's last judged rate.
+    pub last_rate: Option<f64>,
+    /// D's verdict.
+    pub distance_verdict: Verdict,
+    /// Mortar's verdict.
+    pub mortar_verdict: Verdict,
+    /// The asymptotic rate min(r_D, r_mortar), where D's and mortar's verdicts support
+    /// rates.
+    pub asymptotic_rate: Option<f64>,
+    /// Its standard error.
+    pub asymptotic_stderr: Option<f64>,
+    /// Whether that rate is D's (D falls slower than mortar's error).
+    pub distance_sets_rate: Option<bool>,
+    /// The first level from which D >= e_mortar in the data.
+    pub overtakes_from: Option<usize>,
+    /// Otherwise the predicted crossing level, lowest and highest over D's rate range.
+    pub predicted_from: Option<f64>,
+    /// The highest.
+    pub predicted_to: Option<f64>,
+    /// Largest |pythagorean| over the levels.
+    pub largest_pythagorean: Option<f64>,
+    /// D / e_mortar at the finest level.
+    pub finest_ratio: Option<f64>,
+    /// The finest level.
+    pub finest_level: usize,
+}
+
+/// The rows of asymptotes.csv for every method other than mortar with a distance to
+/// mortar in `errors`, judged as `rates`.
+pub fn asymptotes(rates: &[RateRow], errors: &[ErrorRecord]) -> Vec<AsymptoteRow> {
+    let mortar = MethodLabel::Cone(crate::contact::Method::Mortar);
+    let decomposition = decomposition(errors);
+    let find = |m: &MethodLabel, q: Quantity| rates.iter().find(|r| &r.method == m && r.quantity == q);
+    let series = |m: &MethodLabel, q: Quantity| -> Vec<(usize, f64, f64)> {
+        errors
+            .iter()
+            .filter(|e| &e.method == m && e.quantity == q)
+            .map(|e| (e.level, e.h, e.error))
+            .collect()
+    };
+    let mut out = Vec::new();
+    for d in rates.iter().filter(|r| r.method != mortar) {
+        let Some(&(q, dq)) = DECOMPOSED.iter().find(|(_, dq)| *dq == d.quantity) else {
+            continue;
+        };
+        let (Some(x), Some(m)) = (find(&d.method, q), find(&mortar, q)) else {
+            continue;
+        };
+        let rows: Vec<&DecompositionRow> = decomposition
+            .iter()
+            .filter(|r| r.method == d.method && r.quantity == q)
+            .collect();
+        let Some(last) = rows.last() else {
+            continue;
+        };
+        let largest = rows
+            .iter()
+            .map(|r| r.pythagorean.abs())
+            .fold(None, |a: Option<f64>, v| Some(a.map_or(v, |a| a.max(v))));
+        let mut row = AsymptoteRow {
+            method: d.method.clone(),
+            quantity: q,
+            verdict: x.assessment.verdict,
+            last_rate: x.assessment.last_rate(),
+            distance_verdict: d.assessment.verdict,
+            mortar_verdict: m.assessment.verdict,
+            asymptotic_rate: None,
+            asymptotic_stderr: None,
+            distance_sets_rate: None,
+            overtakes_from: None,
+            predicted_from: None,
+            predicted_to: None,
+            largest_pythagorean: largest,
+            finest_ratio: Some(last.distance / last.mortar_error),
+            finest_level: last.level,
+        };
+        match asymptote(d, m, &series(&d.method, dq), &series(&mortar, q)) {
+            Asymptote::Unsupported { .. } => {}
             Asymptote::MortarRate { rate } => {
-                format!("D falls at least as fast as mortar's error: the method tends to mortar's rate {rate:.3}")
+                row.asymptotic_rate = Some(rate);
+                row.asymptotic_stderr = m.supported_fit().map(|f| f.stderr);
+                row.distance_sets_rate = Some(false);
             }
             Asymptote::DistanceRate {
                 rate,
                 stderr,
                 observed,
                 predicted,
-            } => match (observed, predicted) {
-                (Some(l), _) => format!(
-                    "tends to D's rate {rate:.3} ± {stderr:.3}: D exceeds mortar's error from level {l} on"
-                ),
-                (None, Some((lo, hi))) => format!(
-                    "tends to D's rate {rate:.3} ± {stderr:.3} past level {lo:.1}-{hi:.1} (where D's line, anchored at its finest level, with D's rate over its fit, its last successive rate and its fit over every level, crosses mortar's fitted line)"
-                ),
-                (None, None) => format!("tends to D's rate {rate:.3} ± {stderr:.3}"),
-            },
+            } => {
+                row.asymptotic_rate = Some(rate);
+                row.asymptotic_stderr = Some(stderr);
+                row.distance_sets_rate = Some(true);
+                row.overtakes_from = observed;
+                row.predicted_from = predicted.map(|p| p.0);
+                row.predicted_to = predicted.map(|p| p.1);
+            }
         }
+        out.push(row);
     }
+    out
 }
 
-/// Levels of a row's window, as written ("2 3 4 5").
-pub fn used_levels(r: &RateRow) -> String {
-    join(&r.assessment.used)
+impl AsymptoteRow {
+    /// What D supports of X's asymptotic rate, in a few words: "tends to D's 0.504 ± 0.005
+    /// (D >= e_mortar from level 3)", "tends to D's 0.57 ± 0.03 past level 11.9-16.0",
+    /// "tends to mortar's 0.98", or "no asymptotic rate predicted (D falling)".
+    pub fn describe(&self) -> String {
+        match (self.asymptotic_rate, self.distance_sets_rate) {
+            (Some(r), Some(true)) => {
+                let se = self.asymptotic_stderr.unwrap_or(f64::NAN);
+                match (self.overtakes_from, self.predicted_from, self.predicted_to) {
+                    (Some(l), _, _) => {
+                        format!("tends to D's rate {r:.3} ± {se:.3} (D >= e_mortar from level {l} on)")
+                    }
+                    (None, Some(a), Some(b)) => {
+                        format!("tends to D's rate {r:.3} ± {se:.3} past level {a:.1}-{b:.1}")
+                    }
+                    _ => format!("tends to D's rate {r:.3} ± {se:.3}"),
+                }
+            }
+            (Some(r), _) => format!("tends to mortar's rate {r:.3} (D falls no slower)"),
+            _ => format!(
+                "no asymptotic rate predicted (D {}, mortar {})",
+                self.distance_verdict.name(),
+                self.mortar_verdict.name()
+            ),
+        }
+    }
 }

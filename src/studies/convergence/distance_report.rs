@@ -92,9 +92,8 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
 /// Each method read against its distance to mortar: for the theorem norm, h1_u and
 /// l2_stress, nts's observed verdict beside mortar's and D's, the largest |pythagorean|
 /// of decomposition.csv, D / e_mortar at the finest level, and what D's verdict supports
-/// of nts's asymptotic rate ([`judge::asymptote`]).
+/// of nts's asymptotic rate (asymptotes.csv).
 fn decomposition(doc: &mut Doc, res: &StudyResult) {
-    let rows = judge::decomposition(&res.errors);
     let mut table = Table::new([
         "quantity",
         "nts observed",
@@ -104,45 +103,27 @@ fn decomposition(doc: &mut Doc, res: &StudyResult) {
         "D / e_mortar, finest level",
         "nts's asymptotic rate",
     ]);
-    for (q, dq) in judge::DECOMPOSED {
-        let (Some(x), Some(m), Some(d)) = (
-            res.rate(Method::Nts, q),
-            res.rate(Method::Mortar, q),
-            res.rate(Method::Nts, dq),
-        ) else {
-            continue;
-        };
-        let mine: Vec<&judge::DecompositionRow> = rows.iter().filter(|r| r.quantity == q).collect();
-        let Some(last) = mine.last() else {
-            continue;
-        };
-        let worst = mine
-            .iter()
-            .max_by(|a, b| a.pythagorean.abs().total_cmp(&b.pythagorean.abs()))
-            .map_or("-".into(), |r| format!("{:.1e} (level {})", r.pythagorean.abs(), r.level));
-        let series = |method: Method, quantity: Quantity| -> Vec<(usize, f64, f64)> {
-            res.errors
-                .iter()
-                .filter(|e| e.method == method && e.quantity == quantity)
-                .map(|e| (e.level, e.h, e.error))
-                .collect()
-        };
-        let asymptote = judge::asymptote(d, m, &series(Method::Nts, dq), &series(Method::Mortar, q));
+    for a in judge::asymptotes(&res.rates, &res.errors) {
+        let (q, dq) = judge::DECOMPOSED
+            .into_iter()
+            .find(|(q, _)| *q == a.quantity)
+            .expect("a decomposed quantity");
+        let describe = |m: Method, q: Quantity| res.rate(m, q).map_or("-".into(), |r| r.assessment.describe());
         table.row([
             format!("`{q}`"),
-            x.assessment.describe(),
-            m.assessment.describe(),
-            d.assessment.describe(),
-            worst,
-            format!("{:.2}", last.distance / last.mortar_error),
-            asymptote.describe(),
+            describe(Method::Nts, q),
+            describe(Method::Mortar, q),
+            describe(Method::Nts, dq),
+            a.largest_pythagorean.map_or("-".into(), |v| format!("{v:.1e}")),
+            a.finest_ratio.map_or("-".into(), |v| format!("{v:.2}")),
+            a.describe(),
         ]);
     }
     if table.is_empty() {
         return;
     }
     doc.heading(3, "nts read against its distance to mortar")
-        .paragraph("Since D - e_mortar <= e_nts <= D + e_mortar, nts's error tends to the rate min(r_D, r_mortar) once D's rate is supported, and its observed rate turns where D overtakes e_mortar. `pythagorean` = e_nts / sqrt(e_mortar^2 + D^2) - 1 (decomposition.csv) is descriptive: near 0 where the two parts are orthogonal. Where D's verdict supports no rate, nothing is predicted. A predicted level range takes D's rate over its own range (its fitted rate, its last successive rate, its fit over every level), D's line anchored at its finest level and mortar's at its fit.")
+        .paragraph("Since D - e_mortar <= e_nts <= D + e_mortar, nts's error tends to the rate min(r_D, r_mortar) once D's rate is supported, and its observed rate turns where D overtakes e_mortar. `pythagorean` = e_nts / sqrt(e_mortar^2 + D^2) - 1 (decomposition.csv) is descriptive: near 0 where the two parts are orthogonal. Where D's verdict supports no rate, nothing is predicted. Where D has not yet overtaken e_mortar, the predicted level range takes D's rate over its own range (its fitted rate, its last successive rate, its fit over every level), D's line anchored at its finest level and mortar's at its fit (asymptotes.csv).")
         .table(&table);
 }
 

@@ -152,6 +152,8 @@ pub fn write_study(res: &StudyResult, dir: &Path) -> Result<()> {
         let decomposition = crate::verify::judge::decomposition(&res.errors);
         if !decomposition.is_empty() {
             write(d, "decomposition.csv", &csv_bytes(&decomposition)?)?;
+            let asymptotes = crate::verify::judge::asymptotes(&res.rates, &res.errors);
+            write(d, "asymptotes.csv", &csv_bytes(&asymptotes)?)?;
         }
         if !res.variants.is_empty() {
             let rows: Vec<VariantCsv> = res

@@ -44,6 +44,28 @@ struct ErrorRow {
     wall_s: Option<f64>,
 }
 
+/// One row of the regularity study's decomposition.csv: each beta's
+/// [`crate::verify::judge::DecompositionRow`].
+#[derive(Debug, Serialize)]
+struct DecompositionCsv {
+    beta: f64,
+    method: String,
+    quantity: Quantity,
+    level: usize,
+    h: f64,
+    error: f64,
+    mortar_error: f64,
+    distance: f64,
+    pythagorean: f64,
+}
+
+/// D / e_mortar in the theorem norm at a study's finest level.
+fn finest_ratio(res: &StudyResult) -> Option<f64> {
+    let finest = res.errors.iter().map(|e| e.level).max()?;
+    let d = res.error(Method::Nts, finest, Quantity::ConeDistance)?;
+    Some(d / res.error(Method::Mortar, finest, Quantity::Theorem)?)
+}
+
 /// One row of the regularity study's rates.csv.
 #[derive(Debug, Serialize, Deserialize)]
 pub struct RateCsv {
@@ -135,32 +157,82 @@ impl Regularity {
             .and_then(|(_, res)| res.rate(m, q))
     }
 
-    /// One sentence per beta on the theorem norm: each cone's rate beside the best, and
-    /// the gap between the cones.
+    /// One sentence per beta on the theorem norm: each cone's rate (or its verdict) beside
+    /// the best, and nts's distance to mortar against mortar's error at the finest level.
     fn differences(&self) -> Vec<String> {
         self.members
             .iter()
-            .map(|(beta, _)| {
+            .map(|(beta, res)| {
                 let best = best_rate(Quantity::Theorem, *beta).expect("a best rate");
-                let [mortar, nts] = [Method::Mortar, Method::Nts]
-                    .map(|m| self.row(*beta, m, Quantity::Theorem).and_then(supported));
-                let say = |name: &str, r: Option<(f64, f64)>| match r {
-                    Some(x) if follows(x, best) => format!("{name} {:.2} (follows)", x.0),
-                    Some(x) => format!("{name} {:.2} (**{:.2} below**)", x.0, best - x.0),
-                    None => format!("{name} no rate"),
+                let say = |m: Method| match self.row(*beta, m, Quantity::Theorem) {
+                    Some(r) => match supported(r) {
+                        Some(x) if follows(x, best) => format!("{m} {:.2} (follows)", x.0),
+                        Some(x) => format!("{m} {:.2} (**{:.2} below**)", x.0, best - x.0),
+                        None => format!(
+                            "{m} {}",
+                            crate::verify::rates::short_text(r.assessment.verdict, None, r.assessment.last_rate())
+                        ),
+                    },
+                    None => format!("{m} not measured"),
                 };
                 let dagger = if theorem_applies(*beta) { "" } else { " †" };
+                let ratio = finest_ratio(res).map_or(String::new(), |r| format!("; D / e_mortar at the finest level {r:.2}"));
                 format!(
-                    "beta = {beta}{dagger}: best min(1, beta) = {best:.2}; {}, {}{}",
-                    say("mortar", mortar),
-                    say("nts", nts),
-                    match (mortar, nts) {
-                        (Some(a), Some(b)) => format!("; mortar - nts = {:+.2}", a.0 - b.0),
-                        _ => String::new(),
-                    }
+                    "beta = {beta}{dagger}: best min(1, beta) = {best:.2}; {}, {}{ratio}",
+                    say(Method::Mortar),
+                    say(Method::Nts),
                 )
             })
             .collect()
+    }
+
+    /// Whether nts's shortfall in the theorem norm follows beta or where its distance to
+    /// mortar overtakes mortar's error: the betas where nts's rate is supported and follows
+    /// its best, against those where it is not, ordered by D / e_mortar at the finest level.
+    fn deficit(&self) -> String {
+        let mut rows: Vec<(f64, f64, bool)> = self
+            .members
+            .iter()
+            .filter_map(|(beta, res)| {
+                let best = best_rate(Quantity::Theorem, *beta)?;
+                let follows_best = self
+                    .row(*beta, Method::Nts, Quantity::Theorem)
+                    .and_then(supported)
+                    .is_some_and(|x| follows(x, best));
+                Some((*beta, finest_ratio(res)?, follows_best))
+            })
+            .collect();
+        rows.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let list = |f: bool| -> String {
+            let v: Vec<String> = rows
+                .iter()
+                .filter(|r| r.2 == f)
+                .map(|r| format!("{} ({:.2})", r.0, r.1))
+                .collect();
+            if v.is_empty() { "none".into() } else { v.join(", ") }
+        };
+        // Separated by the ratio: every follower below every non-follower.
+        let separated = rows
+            .iter()
+            .filter(|r| r.2)
+            .all(|f| rows.iter().filter(|r| !r.2).all(|n| f.1 < n.1));
+        let by_beta = {
+            let mut b = rows.clone();
+            b.sort_by(|x, y| x.0.total_cmp(&y.0));
+            let flips = b.windows(2).filter(|w| w[0].2 != w[1].2).count();
+            flips <= 1
+        };
+        let verdict = match (separated, by_beta) {
+            (true, false) => "nts's shortfall follows where its distance to mortar overtakes mortar's error, not beta: every beta where nts's rate follows its best has a smaller D / e_mortar than every beta where it does not",
+            (true, true) => "the ratio D / e_mortar separates the betas where nts's rate follows its best from those where it does not, and so does beta itself: these levels cannot tell the two explanations apart",
+            (false, true) => "beta separates the betas where nts's rate follows its best from those where it does not; D / e_mortar does not",
+            (false, false) => "neither beta nor D / e_mortar separates the betas where nts's rate follows its best from those where it does not",
+        };
+        format!(
+            "nts's theorem norm, by D / e_mortar at the finest level (in brackets): follows its best at beta = {}; falls short of it, or is still in transition, at beta = {}. {verdict}.",
+            list(true),
+            list(false)
+        )
     }
 
     fn readme(&self) -> String {
@@ -171,6 +243,8 @@ impl Regularity {
         );
         doc.heading(2, "What differs between the cones (Theorem 3.1's norm)");
         doc.list(self.differences());
+        doc.paragraph(self.deficit());
+        doc.paragraph("D is the distance between the two cones' solutions on the same meshes (`cone_distance`); D - e_mortar <= e_nts <= D + e_mortar, so nts's error follows D's rate once D overtakes e_mortar. Each beta's report reads nts against D (its decomposition.csv and \"nts read against its distance to mortar\"); `decomposition.csv` here holds every beta's.");
         doc.paragraph("† Theorem 3.1 does not apply: for beta <= 1 the solution is not in H^2 and the body force ~ r^(beta-2) is not in L2 (it lies in V' only). Its rates 3/4 and 1/2 are claimed only for beta > 1; below, the study requires only convergence (rate >= 0).");
         doc.heading(2, "Rates in h, mortar / nts, beside the best uniform-mesh rate");
         let mut t = Table::new(
@@ -191,7 +265,7 @@ impl Regularity {
             })));
         }
         doc.table(&t);
-        doc.paragraph("Best rates: min(1, beta) for the H1 and theorem norms; min(beta, 3/2) for the stress in the band of triangles along Gamma_C (pointwise h on a band of area O(h), h^(beta-1) on the triangles at c); min(beta - 1/2, 2) for the pressure in L2(Gamma_C), since p ~ dist^(beta-1). `cone_distance` is the distance between the two cones' solutions on the same meshes (docs/studies.md). A rate is printed only where the verdict supports one (fitted, or drifting); otherwise the verdict.");
+        doc.paragraph("Best rates: min(1, beta) for the H1 and theorem norms; min(beta, 3/2) for the stress in the band of triangles along Gamma_C (pointwise h on a band of area O(h), h^(beta-1) on the triangles at c); min(beta - 1/2, 2) for the pressure in L2(Gamma_C), since p ~ dist^(beta-1). `cone_distance` is the distance between the two cones' solutions on the same meshes (docs/studies.md). A rate is printed only where the verdict supports one (fitted); otherwise the verdict (falling or rising: in transition, with the last successive rate).");
         let stalled: Vec<String> = self
             .members
             .iter()
@@ -323,6 +397,26 @@ impl KindOutcome for Regularity {
                 .flat_map(|(beta, res)| rate_rows(*beta, res))
                 .collect();
             write(d, "rates.csv", &csv_bytes(&rates)?)?;
+            let decomposition: Vec<DecompositionCsv> = self
+                .members
+                .iter()
+                .flat_map(|(beta, res)| {
+                    crate::verify::judge::decomposition(&res.errors)
+                        .into_iter()
+                        .map(move |r| DecompositionCsv {
+                            beta: *beta,
+                            method: r.method.to_string(),
+                            quantity: r.quantity,
+                            level: r.level,
+                            h: r.h,
+                            error: r.error,
+                            mortar_error: r.mortar_error,
+                            distance: r.distance,
+                            pythagorean: r.pythagorean,
+                        })
+                })
+                .collect();
+            write(d, "decomposition.csv", &csv_bytes(&decomposition)?)?;
             self.plots(d)?;
             for (beta, res) in &self.members {
                 crate::studies::convergence::report::write_study(res, &d.join(format!("beta-{beta:.2}")))?;
