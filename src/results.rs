@@ -16,6 +16,7 @@ use crate::studies::two_size::SizePoint;
 use crate::studies::two_size::report::FitRecord;
 use crate::verify::quantity::Quantity;
 use crate::verify::rates::{self, Verdict};
+use crate::verify::judge::AsymptoteRow;
 use crate::verify::table::{ErrorRecord, RateRecord, read};
 use std::path::Path;
 
@@ -122,6 +123,9 @@ fn listed(items: &[String], sep: &str, none: &str) -> String {
 struct Report {
     rates: Vec<RateRecord>,
     errors: Vec<ErrorRecord>,
+    /// What each method's distance to mortar supports (asymptotes.csv; empty where the
+    /// study measures no distance).
+    asymptotes: Vec<AsymptoteRow>,
     /// The finest level measured.
     finest: usize,
 }
@@ -131,9 +135,12 @@ impl Report {
         let rates: Vec<RateRecord> = read(&dir.join("rates.csv"))?;
         let errors: Vec<ErrorRecord> = read(&dir.join("errors.csv"))?;
         let finest = errors.iter().map(|e| e.level).max().unwrap_or(0);
+        let path = dir.join("asymptotes.csv");
+        let asymptotes = if path.exists() { read(&path)? } else { Vec::new() };
         Ok(Report {
             rates,
             errors,
+            asymptotes,
             finest,
         })
     }
@@ -200,6 +207,13 @@ impl Report {
             .filter(|r| r.verdict == Verdict::NotConverging && !r.quantity.is_distance())
     }
 
+    /// What nts's distance to mortar supports of nts's rate in `q`, where measured.
+    fn asymptote(&self, q: Quantity) -> Option<&AsymptoteRow> {
+        self.asymptotes
+            .iter()
+            .find(|a| a.method == Method::Nts && a.quantity == q)
+    }
+
     /// The distance between the cones and the consistency terms, as a sentence; None where
     /// the study does not measure it.
     fn distance_text(&self) -> Option<String> {
@@ -208,6 +222,15 @@ impl Report {
             "the distance D between the cones' solutions (Theorem 3.1's norm) falls at {}",
             rate_text(d)
         );
+        if let Some(a) = self.asymptote(Quantity::Theorem) {
+            out.push_str(&format!(
+                " (D / e_mortar {:.2} at level {}, largest abs(pythagorean) {:.1e}): nts's theorem norm {}",
+                a.finest_ratio.unwrap_or(f64::NAN),
+                a.finest_level,
+                a.largest_pythagorean.unwrap_or(f64::NAN),
+                a.describe()
+            ));
+        }
         let consistency: Vec<String> = CONES
             .iter()
             .filter_map(|&m| {
@@ -299,7 +322,7 @@ struct Comparison<'a> {
 pub fn section(reports: &Path) -> Result<String> {
     let mut doc = Doc::new();
     doc.heading(1, "Results").paragraph(
-        "What the committed reports measured (`cargo run --release -- results` prints this page from their CSVs; a test fails when it no longer matches them). Rates are least-squares slopes in h over the levels named, with the verdict of [the rate rules](studies.md#rates) (fitted, drifting, pre-asymptotic, not converging, round-off, fixed by equilibrium).",
+        "What the committed reports measured (`cargo run --release -- results` prints this page from their CSVs; a test fails when it no longer matches them). Rates are least-squares slopes in h over the levels named, with the verdict of [the rate rules](studies.md#rates) (fitted; falling or rising: in transition; pre-asymptotic, not converging, round-off, fixed by equilibrium). Only a fitted verdict supports a rate.",
     );
     for (name, what) in STUDIES {
         study_section(&mut doc, &reports.join(name), name, what)?;
@@ -357,10 +380,14 @@ fn study_section(doc: &mut Doc, dir: &Path, name: &str, what: &str) -> Result<()
         .filter(|r| {
             matches!(
                 r.verdict,
-                Verdict::PreAsymptotic | Verdict::FixedByEquilibrium | Verdict::TooFewLevels
+                Verdict::PreAsymptotic
+                    | Verdict::FixedByEquilibrium
+                    | Verdict::TooFewLevels
+                    | Verdict::Falling
+                    | Verdict::Rising
             )
         })
-        .map(|r| format!("{} {} ({})", r.method, r.quantity, r.verdict.name()))
+        .map(|r| format!("{} {} ({})", r.method, r.quantity, rate_short(r)))
         .collect();
     if !unfitted.is_empty() {
         doc.bullet(format!("No rate claimed: {}.", unfitted.join(", ")));
@@ -369,7 +396,7 @@ fn study_section(doc: &mut Doc, dir: &Path, name: &str, what: &str) -> Result<()
     Ok(())
 }
 
-/// The quantities other than the theorem norm where nts's fitted (or drifting) rate is
+/// The quantities other than the theorem norm where nts's fitted rate is
 /// within [`NEAR_HALF`] of 1/2.
 fn near_half(report: &Report) -> Vec<String> {
     report
@@ -503,25 +530,28 @@ pub fn headline(reports: &Path) -> Result<String> {
     ));
     let theorem: Vec<String> = CONES.iter().map(|&m| theorem_rates(&studies, m)).collect();
     doc.bullet(format!(
-        "**Theorem 3.1's norm**, fitted rates in h: {}.",
+        "**Theorem 3.1's norm**, observed rates in h with their verdicts: {}.",
         theorem.join("; ")
     ));
     let distances: Vec<String> = studies
         .iter()
         .filter_map(|(name, _, report)| {
             let d = report.rate(Method::Nts, Quantity::ConeDistance)?;
-            // Only a rate the rules support is printed here.
-            let text = match d.verdict {
-                Verdict::Fitted => rate_text(d),
-                v => format!("no rate yet ({})", v.name()),
-            };
-            Some(format!("{text} in `{name}`"))
+            let a = report.asymptote(Quantity::Theorem)?;
+            Some(format!(
+                "in `{name}` D is {} and nts's error {}",
+                match d.verdict {
+                    Verdict::Fitted => format!("fitted at {}", rate_text(d)),
+                    _ => rate_text(d),
+                },
+                a.describe()
+            ))
         })
         .collect();
     if !distances.is_empty() {
         doc.bullet(format!(
-            "**nts's h^(1/2), measured:** the distance D between the two cones' solutions on the same meshes bounds nts's error from both sides (D - e_mortar <= e_nts <= D + e_mortar); it falls at {}, while mortar's error falls at about 1: nts's error holds a part that decays like h^(1/2) and sets nts's rate once D passes e_mortar; each report predicts that level ([docs/results.md](docs/results.md)).",
-            distances.join(", ")
+            "**nts read against its distance D to mortar** (D - e_mortar <= e_nts <= D + e_mortar, on the same meshes): {}.",
+            distances.join("; ")
         ));
     }
     doc.bullet(regularity_headline(&read(
@@ -585,41 +615,41 @@ fn cones_differ(studies: &[(&str, &str, Report)]) -> String {
     }
 }
 
-/// Theorem 3.1's norm in one cone over the studies: the range of the fitted rates, how
-/// many studies measure it and how many of them fit no rate.
+/// Theorem 3.1's norm in one cone over the studies: the range of the fitted rates, and
+/// each study whose errors support no rate, with its verdict.
 fn theorem_rates(studies: &[(&str, &str, Report)], m: Method) -> String {
-    let rows: Vec<&RateRecord> = studies
+    let rows: Vec<(&str, &RateRecord)> = studies
         .iter()
-        .filter_map(|(_, _, r)| r.rate(m, Quantity::Theorem))
+        .filter_map(|(name, _, r)| Some((*name, r.rate(m, Quantity::Theorem)?)))
         .collect();
     let fitted: Vec<f64> = rows
         .iter()
-        .filter(|r| r.verdict == Verdict::Fitted)
-        .filter_map(|r| r.rate)
+        .filter(|(_, r)| r.verdict.supports_rate())
+        .filter_map(|(_, r)| r.rate)
         .collect();
     let (lo, hi) = fitted
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
             (a.min(v), b.max(v))
         });
-    let unfitted = rows.len() - fitted.len();
     let range = if fitted.is_empty() {
         "no fitted rate".to_string()
     } else if format!("{lo:.2}") == format!("{hi:.2}") {
-        format!("{lo:.2}")
+        format!("{lo:.2} fitted in {} studies", fitted.len())
     } else {
-        format!("{lo:.2}-{hi:.2}")
+        format!("{lo:.2}-{hi:.2} fitted in {} studies", fitted.len())
     };
-    let more = if unfitted > 0 {
-        format!(", {unfitted} not fitted")
-    } else {
+    let others: Vec<String> = rows
+        .iter()
+        .filter(|(_, r)| !r.verdict.supports_rate())
+        .map(|(name, r)| format!("{} in `{name}`", rate_short(r)))
+        .collect();
+    let more = if others.is_empty() {
         String::new()
+    } else {
+        format!(", {}", others.join(", "))
     };
-    format!(
-        "{m} {range} (Theorem 3.1: {}; {} studies{more})",
-        m.theorem_rate(),
-        rows.len()
-    )
+    format!("{m} {range}{more} (Theorem 3.1: {})", m.theorem_rate())
 }
 
 /// Each (method, quantity) that does not converge, with the studies where it stalls.
@@ -685,10 +715,16 @@ fn judged_rate(report: &Report, m: Method) -> String {
                 (Verdict::RoundOff, _, _) => "exact (round-off)".to_string(),
                 _ => rate_short(r),
             };
+            // What the distance to mortar supports beside what was observed.
+            let asymptote = report
+                .asymptotes
+                .iter()
+                .find(|a| a.method == m && a.quantity == r.quantity)
+                .map_or(String::new(), |a| format!("; {}", a.describe()));
             if r.quantity == Quantity::Theorem {
-                rate
+                format!("{rate}{asymptote}")
             } else {
-                format!("`{}` {rate}", r.quantity)
+                format!("`{}` {rate}{asymptote}", r.quantity)
             }
         })
 }
@@ -841,27 +877,42 @@ fn betas_where(rows: &[&RegularityRate], follows: bool) -> Vec<String> {
 }
 
 /// The headline's line on the regularity study: where each cone's theorem-norm rate follows
-/// min(1, beta), and the largest shortfall.
+/// min(1, beta), where it falls below (the largest shortfall), and where its errors support
+/// no rate (in transition, with the last successive rate).
 fn regularity_headline(rows: &[RegularityRate]) -> String {
     let cone = |m: Method| {
         let theorem = regularity_theorem(rows, m);
-        let below = betas_where(&theorem, false);
+        let mut parts = Vec::new();
+        let follows = betas_where(&theorem, true);
+        if !follows.is_empty() {
+            parts.push(format!("follows it at beta = {}", follows.join(", ")));
+        }
         let worst = theorem
             .iter()
             .filter(|r| r.follows_best == Some(false))
             .filter_map(|r| Some((r.beta, r.best_rate? - r.rate?, r.rate?)))
             .max_by(|a, b| a.1.total_cmp(&b.1));
-        match worst {
-            None => format!(
-                "{m}'s rate follows it at every beta ({})",
-                listed(&betas_where(&theorem, true), ", ", "none")
-            ),
-            Some((beta, short, rate)) => format!(
-                "{m}'s falls below it at beta = {} (by up to {short:.2}: {rate:.3} at beta = {beta}) and follows it at {}",
-                below.join(", "),
-                listed(&betas_where(&theorem, true), ", ", "no beta")
-            ),
+        if let Some((beta, short, rate)) = worst {
+            parts.push(format!(
+                "falls below it at beta = {} (by up to {short:.2}: {rate:.3} at beta = {beta})",
+                betas_where(&theorem, false).join(", ")
+            ));
         }
+        let unsupported: Vec<String> = theorem
+            .iter()
+            .filter(|r| r.follows_best.is_none())
+            .map(|r| {
+                format!(
+                    "{} at beta = {}",
+                    rates::short_text(r.verdict, r.rate, r.last_rate),
+                    r.beta
+                )
+            })
+            .collect();
+        if !unsupported.is_empty() {
+            parts.push(format!("supports no rate: {}", unsupported.join(", ")));
+        }
+        format!("{m}'s rate {}", parts.join("; "))
     };
     format!(
         "**Rates against the regularity of the contact transition** ([`regularity`](reports/regularity/README.md), u ~ r^beta where contact ends, Theorem 3.1's norm against the best uniform-mesh rate min(1, beta)): {}; {}.",

@@ -9,7 +9,8 @@
 //! Data: README.md, docs/results.md and reports/*/rates.csv, errors.csv as committed.
 
 use contact_rates::results::{HEADLINE, STUDIES, headline, section};
-use contact_rates::verify::rates::Verdict;
+use contact_rates::verify::judge::AsymptoteRow;
+use contact_rates::verify::rates::{self, Verdict};
 use contact_rates::verify::table::{RateRecord, read};
 use std::path::Path;
 
@@ -67,7 +68,9 @@ fn headline_row<'a>(text: &'a str, name: &str) -> &'a str {
 }
 
 /// Every number with a decimal point in the headline table's rows is a rate (to 2 or 3
-/// decimals) of a fitted or drifting row of that study, or its standard error: no rate a
+/// decimals) of a fitted row of that study, or its standard error, the last successive
+/// rate of a row in transition (falling or rising), or what asymptotes.csv derives from
+/// fitted rows (the asymptotic rate, its standard error, a predicted level): no rate a
 /// verdict does not support is printed.
 #[test]
 fn headline_prints_only_rates_the_verdicts_support() {
@@ -78,10 +81,7 @@ fn headline_prints_only_rates_the_verdicts_support() {
         let path = root().join("reports").join(name).join("rates.csv");
         let rows: Vec<RateRecord> = read(&path).unwrap();
         let mut allowed = Vec::new();
-        for r in rows
-            .iter()
-            .filter(|r| matches!(r.verdict, Verdict::Fitted | Verdict::Drifting))
-        {
+        for r in rows.iter().filter(|r| r.verdict == Verdict::Fitted) {
             let (rate, se) = (r.rate.unwrap(), r.stderr.unwrap());
             allowed.extend([
                 format!("{rate:.2}"),
@@ -89,13 +89,29 @@ fn headline_prints_only_rates_the_verdicts_support() {
                 format!("{se:.3}"),
             ]);
         }
+        for r in rows
+            .iter()
+            .filter(|r| matches!(r.verdict, Verdict::Falling | Verdict::Rising))
+        {
+            allowed.push(format!("{:.3}", r.last_rate.unwrap()));
+        }
+        let asymptotes = root().join("reports").join(name).join("asymptotes.csv");
+        if asymptotes.exists() {
+            let rows: Vec<AsymptoteRow> = read(&asymptotes).unwrap();
+            for a in rows {
+                allowed.extend(a.asymptotic_rate.map(|v| format!("{v:.3}")));
+                allowed.extend(a.asymptotic_stderr.map(|v| format!("{v:.3}")));
+                allowed.extend(a.predicted_from.map(|v| format!("{v:.1}")));
+                allowed.extend(a.predicted_to.map(|v| format!("{v:.1}")));
+            }
+        }
         // A ratio ends in 'x' ("63x", "3.0x") and so is not a number here.
         for token in row.split(|c: char| !(c.is_ascii_digit() || c == '.' || c == 'x')) {
             let token = token.trim_end_matches('.');
             if token.contains('.') && token.parse::<f64>().is_ok() {
                 assert!(
                     allowed.iter().any(|a| a == token),
-                    "{name}: the headline prints {token}, not the rate or standard error of a fitted or drifting row:\n{row}"
+                    "{name}: the headline prints {token}, not the rate or standard error of a fitted row:\n{row}"
                 );
                 checked += 1;
             }
@@ -179,7 +195,8 @@ fn row_claims(row: &str) -> Vec<(String, String, String)> {
 }
 
 /// Whether `text` says what the row `r` of rates.csv supports: its rate (and standard
-/// error) where the verdict is fitted or drifting, "exact" at round-off, else the verdict.
+/// error) where the verdict is fitted, "exact" at round-off, else what
+/// [`rates::short_text`] says (the verdict, with the last successive rate in transition).
 fn states(r: &RateRecord, text: &str) -> bool {
     let words: Vec<&str> = text.split_whitespace().collect();
     let rounded = |v: f64, token: &str| {
@@ -187,16 +204,15 @@ fn states(r: &RateRecord, text: &str) -> bool {
         decimals >= 2 && token == format!("{v:.decimals$}")
     };
     match (r.verdict, r.rate, r.stderr) {
-        (Verdict::Fitted | Verdict::Drifting, Some(rate), Some(se)) => match words.as_slice() {
-            [v] => r.verdict == Verdict::Fitted && rounded(rate, v),
-            [v, "drifting"] => r.verdict == Verdict::Drifting && rounded(rate, v),
+        (Verdict::Fitted, Some(rate), Some(se)) => match words.as_slice() {
+            [v] => rounded(rate, v),
             [v, "±", s, verdict] => {
                 rounded(rate, v) && rounded(se, s) && *verdict == r.verdict.name()
             }
             _ => false,
         },
         (Verdict::RoundOff, _, _) => text == "exact" || text == "exact (round-off)",
-        (v, _, _) => text == v.name(),
+        (v, rate, _) => text == rates::short_text(v, rate, r.last_rate),
     }
 }
 

@@ -8,7 +8,11 @@ use crate::contact::Method;
 use crate::error::{Error, Result};
 use crate::io::solution::{FieldNames, SolutionStep, read_msh_solution, read_pvd, read_vtu};
 use crate::solve::SolverKind;
-use crate::verify::field::P1History;
+use crate::case::Case;
+use crate::solve::Solution;
+use crate::verify::field::{P1Field, P1History};
+use crate::verify::norms::Comparison;
+use crate::verify::quantity::Scale;
 use crate::verify::jobs::{self, Job};
 use crate::verify::quantity::Quantity;
 use crate::verify::judge::{RateRow, Rules, Threshold, judge_errors};
@@ -315,11 +319,41 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
         });
     let truth = Truth::Exact(exact, points);
     let files = level_files(&req.solutions, req.levels.as_deref())?;
+    // This project's cones on the same levels, solved first (kept as records): mortar's
+    // solution is what each graded level's distance to mortar is measured against.
+    let compared = req.compare;
+    let cone_quantities: Vec<Quantity> = match &study {
+        Some(s) => s.file.quantities.clone(),
+        None => self::quantities(&family, None, true),
+    }
+    .into_iter()
+    .filter(|q| !q.is_distance())
+    .collect();
+    let jobs: Vec<(Method, usize)> = match compared {
+        true => [Method::Mortar, Method::Nts]
+            .into_iter()
+            .flat_map(|m| files.keys().map(move |&l| (m, l)))
+            .collect(),
+        false => Vec::new(),
+    };
+    let cones: Vec<(Method, usize, Case, Solution)> = jobs
+        .par_iter()
+        .map(|&(method, level)| {
+            let (case, solution) = cone_solve(&family, method, level)?;
+            Ok((method, level, case, solution))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let mortar_at = |level: usize| {
+        cones
+            .iter()
+            .find(|c| c.0 == Method::Mortar && c.1 == level)
+            .map(|c| (&c.2, &c.3))
+    };
     // The levels are independent: measured in parallel, in level order.
     let graded: Vec<(GradedLevel, BTreeMap<Quantity, f64>, bool)> = files
         .par_iter()
         .map(|(&level, (storage, path))| {
-            grade_level(level, *storage, path, &req.names, &family, &truth)
+            grade_level(level, *storage, path, &req.names, &family, &truth, mortar_at(level))
         })
         .collect::<Result<Vec<_>>>()?;
     let resultant_fixed = graded.first().is_some_and(|g| g.2);
@@ -331,6 +365,8 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
     let mut errors = Vec::new();
     for (l, e) in levels.iter().zip(&measured) {
         let steps = l.times.len();
+        let mut quantities = quantities.clone();
+        quantities.extend(DECOMPOSED_DISTANCES.iter().filter(|q| e.contains_key(q)));
         errors.extend(rows(
             &label,
             l.level,
@@ -343,24 +379,31 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
             &l.file,
         )?);
     }
-    let compared = req.compare;
-    if compared {
-        let cone_quantities: Vec<Quantity> = match &study {
-            Some(s) => s.file.quantities.clone(),
-            None => self::quantities(&family, None, true),
+    for (method, level, case, solution) in &cones {
+        let (mut errors_here, scale) = truth.measure_solved(case, solution);
+        if *method == Method::Nts
+            && let Some((mc, ms)) = mortar_at(*level)
+        {
+            let (a, b) = (P1History::of_solution(case, solution), P1History::of_solution(mc, ms));
+            errors_here.extend(
+                crate::verify::distance::cone_distance(&a, &b, &scale)
+                    .into_iter()
+                    .filter(|(q, _)| DECOMPOSED_DISTANCES.contains(q)),
+            );
         }
-        .into_iter()
-        .filter(|q| !q.is_distance())
-        .collect();
-        let jobs: Vec<(Method, usize)> = [Method::Mortar, Method::Nts]
-            .into_iter()
-            .flat_map(|m| levels.iter().map(move |l| (m, l.level)))
-            .collect();
-        let cones = jobs
-            .par_iter()
-            .map(|&(method, level)| cone_rows(&family, method, level, &truth, &cone_quantities))
-            .collect::<Result<Vec<_>>>()?;
-        errors.extend(cones.into_iter().flatten());
+        let mut quantities = cone_quantities.clone();
+        quantities.extend(DECOMPOSED_DISTANCES.iter().filter(|q| errors_here.contains_key(q)));
+        errors.extend(rows(
+            &(*method).into(),
+            *level,
+            case.h,
+            case.problem.model.n_free,
+            family.steps,
+            Some(solution.wall_s),
+            &quantities,
+            &errors_here,
+            &family.scene.file,
+        )?);
     }
     let key = key_quantity(exact);
     let threshold = |m: &MethodLabel, q: Quantity| {
@@ -443,6 +486,7 @@ fn grade_level(
     names: &FieldNames,
     family: &Family,
     truth: &Truth,
+    mortar: Option<(&Case, &Solution)>,
 ) -> Result<(GradedLevel, BTreeMap<Quantity, f64>, bool)> {
     let steps = read_level(storage, path, names, family)?;
     let (reference, raw) = family.model(level)?;
@@ -459,7 +503,10 @@ fn grade_level(
     let resultant_fixed = outside
         .interface
         .resultant_fixed_by_equilibrium(&outside.model);
-    let errors = truth.errors(&history);
+    let (mut errors, scale) = truth.measure(&history);
+    if let Some(mortar) = mortar {
+        errors.extend(distance_to_mortar(&history, mortar, &scale));
+    }
     let graded = GradedLevel {
         level,
         file: path.to_path_buf(),
@@ -534,15 +581,17 @@ pub fn key_quantity(exact: &crate::analytical::Exact) -> Quantity {
     }
 }
 
+/// The distances to mortar that each graded code and nts are read against
+/// (decomposition.csv).
+const DECOMPOSED_DISTANCES: [Quantity; 3] = [
+    Quantity::ConeDistance,
+    Quantity::ConeDistanceH1U,
+    Quantity::ConeDistanceL2Stress,
+];
+
 /// This project's `method` on the family's level `level`, solved once and kept as a
 /// record (the studies' job records, keyed by everything the solve depends on).
-fn cone_rows(
-    family: &Family,
-    method: Method,
-    level: usize,
-    truth: &Truth,
-    quantities: &[Quantity],
-) -> Result<Vec<ErrorRecord>> {
+fn cone_solve(family: &Family, method: Method, level: usize) -> Result<(Case, Solution)> {
     let job = Job {
         id: 0,
         label: format!("{method} level {level}"),
@@ -553,19 +602,47 @@ fn cone_rows(
         steps: family.steps,
         scene: 0,
     };
-    let (case, solution) = jobs::solve_cached(&job, &family.scene, SolverKind::Newton, "grade")?;
-    let errors = truth.relative_errors(&case, &solution);
-    rows(
-        &method.into(),
-        level,
-        case.h,
-        case.problem.model.n_free,
-        family.steps,
-        Some(solution.wall_s),
-        quantities,
-        &errors,
-        &family.scene.file,
-    )
+    jobs::solve_cached(&job, &family.scene, SolverKind::Newton, "grade")
+}
+
+/// The distance between a graded level's solution and mortar's on the same level
+/// (through the intersection of the two meshes), max over the graded steps, each matched
+/// with mortar's step at the same time, relative to the truth's sizes `scale`; empty where
+/// a graded time is none of mortar's steps.
+fn distance_to_mortar(
+    graded: &P1History,
+    mortar: (&Case, &Solution),
+    scale: &Scale,
+) -> BTreeMap<Quantity, f64> {
+    let m = P1History::of_solution(mortar.0, mortar.1);
+    let tolerance = 1e-9 * m.steps.last().map_or(1.0, |s| s.time.abs().max(1.0));
+    let pairs: Option<Vec<(&P1Field, &P1Field)>> = graded
+        .steps
+        .iter()
+        .map(|g| {
+            m.steps
+                .iter()
+                .find(|s| (s.time - g.time).abs() <= tolerance)
+                .map(|s| (g, s))
+        })
+        .collect();
+    let Some(pairs) = pairs else {
+        return BTreeMap::new();
+    };
+    let cmp = Comparison::new(graded.model, m.model);
+    let (mut theorem, mut h1, mut stress) = (0.0f64, 0.0f64, 0.0f64);
+    for (g, s) in pairs {
+        let d = cmp.difference(graded.model, g, m.model, s);
+        theorem = theorem.max(d.theorem());
+        h1 = h1.max(d.h1());
+        stress = stress.max(d.stress.sqrt());
+    }
+    let relative = |v: f64, s: f64| v / s.max(f64::MIN_POSITIVE);
+    BTreeMap::from([
+        (Quantity::ConeDistance, relative(theorem, scale.theorem)),
+        (Quantity::ConeDistanceH1U, relative(h1, scale.h1)),
+        (Quantity::ConeDistanceL2Stress, relative(stress, scale.stress)),
+    ])
 }
 
 /// What the report says about how the solutions were graded.

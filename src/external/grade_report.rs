@@ -44,6 +44,12 @@ impl Graded {
             write(d, "errors.csv", &csv_bytes(&self.errors)?)?;
             let rates: Vec<RateRecord> = self.rates.iter().map(RateRow::record).collect();
             write(d, "rates.csv", &csv_bytes(&rates)?)?;
+            let decomposition = crate::verify::judge::decomposition(&self.errors);
+            if !decomposition.is_empty() {
+                write(d, "decomposition.csv", &csv_bytes(&decomposition)?)?;
+                let asymptotes = crate::verify::judge::asymptotes(&self.rates, &self.errors);
+                write(d, "asymptotes.csv", &csv_bytes(&asymptotes)?)?;
+            }
             self.plot(d)?;
             write(d, "README.md", self.readme().as_bytes())
         })
@@ -109,6 +115,10 @@ impl Graded {
                 ));
                 doc.table(&table);
             }
+        }
+        if let Some(table) = self.distance_table() {
+            doc.paragraph("Each method read against its distance D to mortar's solution on the same level (through the intersection of the two meshes for the graded code): D - e_mortar <= e <= D + e_mortar, so the error tends to min(r_D, r_mortar) once D's rate is supported (decomposition.csv, asymptotes.csv; docs/studies.md#rates):");
+            doc.table(&table);
         }
         doc.list(&self.notes);
         doc.paragraph(format!("Graded with `{}`.", self.command));
@@ -215,6 +225,39 @@ impl Graded {
                 _ => "-".into(),
             }));
             table.row(row);
+        }
+        (!table.is_empty()).then_some(table)
+    }
+
+    /// Each method other than mortar read against its distance to mortar.
+    fn distance_table(&self) -> Option<Table> {
+        let mut table = Table::new([
+            "method",
+            "quantity",
+            "observed",
+            "D (distance to mortar)",
+            "largest abs(pythagorean)",
+            "D / e_mortar, finest level",
+            "asymptotic rate",
+        ]);
+        for a in crate::verify::judge::asymptotes(&self.rates, &self.errors) {
+            let dq = crate::verify::judge::DECOMPOSED
+                .into_iter()
+                .find(|(q, _)| *q == a.quantity)
+                .map(|(_, d)| d)?;
+            let describe = |q: Quantity| {
+                self.rate(&a.method, q)
+                    .map_or("-".into(), |r| r.assessment.describe().replace("**", ""))
+            };
+            table.row([
+                a.method.to_string(),
+                format!("`{}`", a.quantity),
+                describe(a.quantity),
+                describe(dq),
+                a.largest_pythagorean.map_or("-".into(), |v| format!("{v:.1e}")),
+                a.finest_ratio.map_or("-".into(), |v| format!("{v:.2}")),
+                a.describe(),
+            ]);
         }
         (!table.is_empty()).then_some(table)
     }
