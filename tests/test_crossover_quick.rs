@@ -23,7 +23,8 @@ use contact_rates::solve::SolverKind;
 use contact_rates::verify::distance::cone_distance;
 use contact_rates::verify::field::P1History;
 use contact_rates::verify::quantity::Quantity;
-use contact_rates::verify::rates::{LevelError, assess};
+use contact_rates::verify::judge::levels_of;
+use contact_rates::verify::rates::assess;
 use contact_rates::verify::solve_case;
 use contact_rates::verify::truth::Truth;
 
@@ -42,18 +43,12 @@ fn crossover_scenes_are_the_scaled_closed_form() {
 fn quick_rate(method: Method) -> f64 {
     let scene = Scene::load("crossover-quick").unwrap();
     let truth = Truth::Exact(scene.exact.as_deref().unwrap(), 4);
-    let levels: Vec<LevelError> = (0..=2)
-        .map(|level| {
-            let case = common::case("crossover-quick", level, method, &[]);
-            let (sol, _) = solve_case(&case, SolverKind::Newton, 1).unwrap();
-            LevelError {
-                level,
-                h: case.h,
-                dofs: case.problem.model.n_free as f64,
-                error: truth.relative_errors(&case, &sol)[&Quantity::Theorem],
-            }
-        })
-        .collect();
+    let levels = levels_of((0..=2).map(|level| {
+        let case = common::case("crossover-quick", level, method, &[]);
+        let (sol, _) = solve_case(&case, SolverKind::Newton, 1).unwrap();
+        let error = truth.relative_errors(&case, &sol)[&Quantity::Theorem];
+        (level, case.h, case.problem.model.n_free as f64, error)
+    }));
     let a = assess(&levels, 0.0).unwrap();
     let fit = a.fit.expect("three levels fit a rate");
     println!(

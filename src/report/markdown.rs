@@ -143,3 +143,17 @@ mod tests {
         assert_eq!(t.render(), "| a | b | c |\n|---|---|---|\n| 1 |  | 3 |\n");
     }
 }
+
+/// The items joined by `sep`, or `none` where there are none.
+pub fn listed(items: &[String], sep: &str, none: &str) -> String {
+    if items.is_empty() {
+        none.to_string()
+    } else {
+        items.join(sep)
+    }
+}
+
+/// Where docs/results.md links to the reports and to the rate rules (relative to docs/).
+pub const DOCS_REPORTS: &str = "../reports";
+/// Where README.md links to the reports (relative to the repository's root).
+pub const README_REPORTS: &str = "reports";

@@ -26,7 +26,7 @@ macro_rules! kinds {
 }
 
 // The table of study kinds: one folder under src/studies/ each.
-kinds![convergence, two_size, paper, speed, stability, regularity];
+kinds![convergence, two_size, regularity, paper, speed, stability];
 
 /// A study to run: its kind and, for a kind found in files, the study file.
 pub struct Study {

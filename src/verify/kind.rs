@@ -35,6 +35,9 @@ pub struct Kind {
     /// Judge a written report `dir` again from its CSVs, without solving (`study NAME
     /// --rejudge`); None for a kind whose report holds no judged rates.
     pub rejudge: Option<fn(file: Option<&Path>, dir: &Path) -> Result<Box<dyn Outcome>>>,
+    /// The kind's part of docs/results.md (Markdown), read from the committed reports under
+    /// `reports`; None for a kind with no part there.
+    pub results: Option<fn(reports: &Path) -> Result<String>>,
 }
 
 /// What a study measured: it writes its report folder and says what the console shows.

@@ -14,6 +14,7 @@
 
 mod distance_report;
 pub mod report;
+pub mod results;
 
 use crate::verify::kind::{Found, Kind, Outcome};
 
@@ -36,6 +37,7 @@ pub const KIND: Kind = Kind {
         let path = file.expect("a convergence study is a file").display().to_string();
         Ok(Box::new(rejudge(&path, dir)?) as Box<dyn Outcome>)
     }),
+    results: Some(results::section),
 };
 
 
@@ -762,7 +764,7 @@ fn deformed(case: &Case, sol: &Solution, method: Method, magnification: f64) -> 
 /// Step 4: every quantity of every cone judged over its levels ([`rates::assess`]: no rate
 /// on round-off, on levels within 5x of the truth's own error in that quantity, on fewer
 /// than three levels, or for a quantity that stops converging; a rate over the trailing
-/// window of agreeing successive rates, drifting where it disagrees with the others), and
+/// window of agreeing successive rates; falling or rising where the last three move), and
 /// the thresholds. Where equilibrium fixes the contact resultant (`resultant_fixed`), its
 /// error measures the load quadrature: it is named so and never fitted.
 fn fit_rates(

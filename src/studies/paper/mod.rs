@@ -2,6 +2,7 @@
 //! and every claim the paper makes there checked by a number.
 
 pub mod report;
+pub mod results;
 
 use crate::verify::kind::{Found, Kind};
 
@@ -13,6 +14,7 @@ pub const KIND: Kind = Kind {
     shards: false,
     run: |_, _| Ok(Some(Box::new(run()?))),
     rejudge: None,
+    results: Some(results::section),
 };
 
 

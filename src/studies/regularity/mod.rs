@@ -14,6 +14,7 @@
 //!    hypotheses (u in H^2, f in L2: beta > 1) fail.
 
 pub mod report;
+pub mod results;
 
 use crate::error::Result;
 use crate::studies::convergence::{self, StudyResult};
@@ -29,6 +30,7 @@ pub const KIND: Kind = Kind {
     shards: false,
     run: |_, _| Ok(Some(Box::new(run(BETAS)?))),
     rejudge: Some(|_, dir| Ok(Box::new(rejudge(BETAS, dir)?))),
+    results: Some(results::section),
 };
 
 /// The betas of the study.

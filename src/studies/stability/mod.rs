@@ -4,6 +4,7 @@
 //! of the same discrete problem, relative to the largest displacement.
 
 pub mod report;
+pub mod results;
 
 use crate::verify::kind::{Found, Kind};
 
@@ -15,6 +16,7 @@ pub const KIND: Kind = Kind {
     shards: false,
     run: |_, _| Ok(Some(Box::new(run()?))),
     rejudge: None,
+    results: Some(results::section),
 };
 
 

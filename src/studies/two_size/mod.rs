@@ -17,6 +17,7 @@
 //!    ([`rates::fit_power_sum`]).
 
 pub mod report;
+pub mod results;
 
 use crate::verify::kind::{Found, Kind};
 
@@ -36,6 +37,7 @@ pub const KIND: Kind = Kind {
         Ok(Some(Box::new(run(&path)?)))
     },
     rejudge: None,
+    results: Some(results::section),
 };
 
 

@@ -1,0 +1,467 @@
+//! The convergence studies' part of docs/results.md, read back from their reports' CSVs
+//! (rates.csv, errors.csv, asymptotes.csv, levels.csv, time.csv), and what the README's
+//! headline reads of them.
+
+use crate::contact::Method;
+use crate::studies::convergence::{LevelInfo, TimeRun};
+use crate::verify::judge::AsymptoteRow;
+use crate::verify::quantity::Quantity;
+use crate::verify::rates::{self, Verdict};
+use crate::verify::table::{ErrorRecord, RateRecord};
+use crate::error::{Error, Result};
+use crate::report::markdown::{DOCS_REPORTS, Doc, listed};
+use crate::verify::table::read;
+use std::path::Path;
+
+/// The convergence studies' sections of docs/results.md, for the reports under `reports`.
+pub fn section(reports: &Path) -> Result<String> {
+    let mut doc = Doc::new();
+    for (name, what) in STUDIES {
+        study_section(&mut doc, &reports.join(name), name, what)?;
+    }
+    Ok(doc.finish())
+}
+
+/// The convergence studies whose reports the section summarises, with a line on what each
+/// measures against.
+pub const STUDIES: [(&str, &str); 5] = [
+    (
+        "rates",
+        "the viscoplastic `rates` scene against a matching-mesh reference",
+    ),
+    (
+        "rates-exact",
+        "the manufactured `contact-mms` scene against its exact solution",
+    ),
+    (
+        "rates-exact-vp",
+        "the manufactured viscoplastic `contact-mms-vp` scene (both bodies flowing) against its exact solution, in h and in k",
+    ),
+    (
+        "patch",
+        "paper Test 2 against its exact stress diag(0, -10 t) and pressure 10 t",
+    ),
+    (
+        "crossover",
+        "stacked blocks, uniform compression plus 0.2 times an Airy mode, against the exact solution: where nts's h^(1/2) overtakes",
+    ),
+];
+
+/// The studies of the README's headline table, the exact ones first, with what each is
+/// measured against.
+pub const HEADLINE: [(&str, &str); 5] = [
+    ("rates-exact", "`contact-mms` (elastic), exact solution"),
+    (
+        "rates-exact-vp",
+        "`contact-mms-vp` (both bodies flowing), exact solution",
+    ),
+    ("patch", "paper Test 2, exact stress and pressure"),
+    (
+        "crossover",
+        "`crossover` (stacked blocks, a small Airy mode), exact solution",
+    ),
+    ("rates", "`rates` (viscoplastic), matching-mesh reference"),
+];
+
+/// The cones, in the order the pages name them.
+pub(crate) const CONES: [Method; 2] = [Method::Mortar, Method::Nts];
+
+/// A ratio of the cones' errors at the finest level beyond this (either way) separates them.
+pub(crate) const SEPARATES: f64 = 1.5;
+
+/// An nts rate within this of 1/2 attains K_h^I's h^(1/2).
+pub(crate) const NEAR_HALF: f64 = 0.15;
+
+/// "0.981 ± 0.005 (fitted, levels 0 1 2 3 4 5)" where the verdict supports a rate, else
+/// the verdict with the last successive rate ("falling, last successive rate 0.557").
+pub(crate) fn rate_text(r: &RateRecord) -> String {
+    match (r.verdict.supports_rate(), r.rate, r.stderr) {
+        (true, Some(rate), Some(se)) => {
+            format!(
+                "{rate:.3} ± {se:.3} ({}, levels {})",
+                r.verdict.name(),
+                r.levels_used
+            )
+        }
+        _ => match r.last_rate {
+            Some(last) if r.verdict != Verdict::RoundOff => {
+                format!("{}, last successive rate {last:.3}", r.verdict.name())
+            }
+            _ => r.verdict.name().to_string(),
+        },
+    }
+}
+
+/// The rate in a table cell ([`rates::short_text`]).
+pub(crate) fn rate_short(r: &RateRecord) -> String {
+    rates::short_text(r.verdict, r.rate, r.last_rate)
+}
+
+/// One convergence report read back: its rates and its errors at the finest level.
+pub(crate) struct Report {
+    pub(crate) rates: Vec<RateRecord>,
+    pub(crate) errors: Vec<ErrorRecord>,
+    /// What each method's distance to mortar supports (asymptotes.csv; empty where the
+    /// study measures no distance).
+    pub(crate) asymptotes: Vec<AsymptoteRow>,
+    /// The finest level measured.
+    pub(crate) finest: usize,
+}
+
+impl Report {
+    pub(crate) fn read(dir: &Path) -> Result<Report> {
+        let rates: Vec<RateRecord> = read(&dir.join("rates.csv"))?;
+        let errors: Vec<ErrorRecord> = read(&dir.join("errors.csv"))?;
+        let finest = errors.iter().map(|e| e.level).max().unwrap_or(0);
+        let path = dir.join("asymptotes.csv");
+        let asymptotes = if path.exists() { read(&path)? } else { Vec::new() };
+        Ok(Report {
+            rates,
+            errors,
+            asymptotes,
+            finest,
+        })
+    }
+
+    pub(crate) fn rate(&self, method: Method, quantity: Quantity) -> Option<&RateRecord> {
+        self.rates
+            .iter()
+            .find(|r| r.method == method && r.quantity == quantity)
+    }
+
+    /// The error of a method in a quantity at the finest level.
+    pub(crate) fn error(&self, r: &RateRecord) -> Option<f64> {
+        self.errors
+            .iter()
+            .find(|e| e.method == r.method && e.quantity == r.quantity && e.level == self.finest)
+            .map(|e| e.error)
+    }
+
+    /// The contact quantities compared between the cones at the finest level.
+    pub(crate) fn compare_cones(&self) -> Comparison<'_> {
+        let mut c = Comparison::default();
+        for mortar in self
+            .rates
+            .iter()
+            .filter(|r| r.method == Method::Mortar && r.quantity.is_contact())
+        {
+            let q = mortar.quantity;
+            let Some(nts) = self.rate(Method::Nts, q) else {
+                continue;
+            };
+            if !mortar.verdict.compares_cones() || !nts.verdict.compares_cones() {
+                c.not_compared.push(q.to_string());
+                continue;
+            }
+            let (Some(a), Some(b)) = (self.error(mortar), self.error(nts)) else {
+                continue;
+            };
+            let ratio = error_ratio(mortar.verdict, nts.verdict, a, b);
+            if !(1.0 / SEPARATES..=SEPARATES).contains(&ratio) {
+                c.separate.push(Separation {
+                    quantity: q,
+                    ratio,
+                    mortar_error: a,
+                    nts_error: b,
+                    mortar,
+                    nts,
+                });
+            } else if mortar.verdict == Verdict::RoundOff && nts.verdict == Verdict::RoundOff {
+                // error_ratio's 1.0 here is no measured ratio: say why they agree.
+                c.agree.push(format!("{q} (both cones exact)"));
+            } else {
+                c.agree.push(q.to_string());
+            }
+        }
+        c
+    }
+
+    /// The rows whose errors stop decreasing.
+    /// The errors that stop decreasing (a distance between the cones is no error: it is
+    /// reported with the distance).
+    pub(crate) fn stalled(&self) -> impl Iterator<Item = &RateRecord> {
+        self.rates
+            .iter()
+            .filter(|r| r.verdict == Verdict::NotConverging && !r.quantity.is_distance())
+    }
+
+    /// What nts's distance to mortar supports of nts's rate in `q`, where measured.
+    pub(crate) fn asymptote(&self, q: Quantity) -> Option<&AsymptoteRow> {
+        self.asymptotes
+            .iter()
+            .find(|a| a.method == Method::Nts && a.quantity == q)
+    }
+
+    /// The distance between the cones and the consistency terms, as a sentence; None where
+    /// the study does not measure it.
+    pub(crate) fn distance_text(&self) -> Option<String> {
+        let d = self.rate(Method::Nts, Quantity::ConeDistance)?;
+        let mut out = format!(
+            "the distance D between the cones' solutions (Theorem 3.1's norm) falls at {}",
+            rate_text(d)
+        );
+        if let Some(a) = self.asymptote(Quantity::Theorem) {
+            out.push_str(&format!(
+                " (D / e_mortar {:.2} at level {}, largest abs(pythagorean) {:.1e}): nts's theorem norm {}",
+                a.finest_ratio.unwrap_or(f64::NAN),
+                a.finest_level,
+                a.largest_pythagorean.unwrap_or(f64::NAN),
+                a.describe()
+            ));
+        }
+        let consistency: Vec<String> = CONES
+            .iter()
+            .filter_map(|&m| {
+                self.rate(m, Quantity::Consistency)
+                    .map(|r| format!("{m} {}", rate_text(r)))
+            })
+            .collect();
+        if !consistency.is_empty() {
+            out.push_str(&format!(
+                "; Proposition 3.1's consistency term: {}",
+                consistency.join("; ")
+            ));
+        }
+        Some(out)
+    }
+}
+
+/// nts's error over mortar's; a cone at round-off is exact: infinite where mortar is, 0
+/// where nts is, 1 where both are (rather than a ratio of round-off).
+pub(crate) fn error_ratio(mortar: Verdict, nts: Verdict, mortar_error: f64, nts_error: f64) -> f64 {
+    let exact = |v: Verdict| v == Verdict::RoundOff;
+    match (exact(mortar), exact(nts)) {
+        (true, true) => 1.0,
+        (true, false) => f64::INFINITY,
+        (false, true) => 0.0,
+        (false, false) => nts_error / mortar_error,
+    }
+}
+
+/// A contact quantity whose errors differ between the cones by more than [`SEPARATES`].
+pub(crate) struct Separation<'a> {
+    pub(crate) quantity: Quantity,
+    /// nts's error over mortar's at the finest level ([`error_ratio`]).
+    pub(crate) ratio: f64,
+    pub(crate) mortar_error: f64,
+    pub(crate) nts_error: f64,
+    pub(crate) mortar: &'a RateRecord,
+    pub(crate) nts: &'a RateRecord,
+}
+
+impl Separation<'_> {
+    /// "nts/mortar = 63", "nts/mortar = 2.99", "mortar exact" or "nts exact".
+    pub(crate) fn ratio_text(&self) -> String {
+        if self.ratio.is_infinite() {
+            "mortar exact".to_string()
+        } else if self.ratio == 0.0 {
+            "nts exact".to_string()
+        } else if self.ratio >= 10.0 {
+            format!("nts/mortar = {:.0}", self.ratio)
+        } else {
+            format!("nts/mortar = {:.2}", self.ratio)
+        }
+    }
+
+    /// The gap between the cones either way (infinite where one is exact).
+    pub(crate) fn gap(&self) -> f64 {
+        self.ratio.max(1.0 / self.ratio)
+    }
+
+    /// The headline's cell: "`l2_pressure` 63x (mortar 1.85, nts not converging)".
+    pub(crate) fn headline_text(&self) -> String {
+        let q = self.quantity;
+        let (mortar, nts) = (rate_short(self.mortar), rate_short(self.nts));
+        if self.ratio.is_infinite() {
+            format!("`{q}` mortar exact (nts {nts})")
+        } else if self.ratio == 0.0 {
+            format!("`{q}` nts exact (mortar {mortar})")
+        } else if self.ratio >= 10.0 {
+            format!("`{q}` {:.0}x (mortar {mortar}, nts {nts})", self.ratio)
+        } else {
+            format!("`{q}` {:.1}x (mortar {mortar}, nts {nts})", self.ratio)
+        }
+    }
+}
+
+/// The contact quantities of a report, by what the cones' errors say.
+#[derive(Default)]
+pub(crate) struct Comparison<'a> {
+    /// Error ratio beyond [`SEPARATES`], in rates.csv's order.
+    pub(crate) separate: Vec<Separation<'a>>,
+    /// Within [`SEPARATES`].
+    pub(crate) agree: Vec<String>,
+    /// No rate the numbers support in some cone, or fixed by equilibrium.
+    pub(crate) not_compared: Vec<String>,
+}
+
+/// One convergence report's section: the theorem norm, plasticity and time, where nts
+/// reaches h^(1/2), what separates the cones, what does not converge, what has no rate.
+pub(crate) fn study_section(doc: &mut Doc, dir: &Path, name: &str, what: &str) -> Result<()> {
+    let report = Report::read(dir)?;
+    doc.heading(
+        2,
+        format!("[`{name}`]({DOCS_REPORTS}/{name}/README.md): {what}"),
+    );
+    let theorem: Vec<String> = CONES
+        .iter()
+        .filter_map(|&m| {
+            report
+                .rate(m, Quantity::Theorem)
+                .map(|r| format!("{m} {}, Theorem 3.1: {}", rate_text(r), m.theorem_rate()))
+        })
+        .collect();
+    if !theorem.is_empty() {
+        doc.bullet(format!("Theorem 3.1 norm: {}.", theorem.join("; ")));
+    }
+    plasticity_and_time(doc, dir)?;
+    doc.bullet(format!(
+        "nts at h^(1/2) (a rate within {NEAR_HALF} of 0.5): {}.",
+        listed(&near_half(&report), "; ", "no quantity")
+    ));
+    separation_bullets(doc, &report);
+    if let Some(text) = report.distance_text() {
+        doc.bullet(format!("Between the cones: {text}."));
+    }
+    doc.bullet(format!(
+        "Does not converge: {}.",
+        listed(&stalled_texts(&report), "; ", "nothing")
+    ));
+    let unfitted: Vec<String> = report
+        .rates
+        .iter()
+        .filter(|r| {
+            matches!(
+                r.verdict,
+                Verdict::PreAsymptotic
+                    | Verdict::FixedByEquilibrium
+                    | Verdict::TooFewLevels
+                    | Verdict::Falling
+                    | Verdict::Rising
+            )
+        })
+        .map(|r| format!("{} {} ({})", r.method, r.quantity, rate_short(r)))
+        .collect();
+    if !unfitted.is_empty() {
+        doc.bullet(format!("No rate claimed: {}.", unfitted.join(", ")));
+    }
+    doc.blank();
+    Ok(())
+}
+
+/// The quantities other than the theorem norm where nts's fitted rate is
+/// within [`NEAR_HALF`] of 1/2.
+pub(crate) fn near_half(report: &Report) -> Vec<String> {
+    report
+        .rates
+        .iter()
+        .filter(|r| r.method == Method::Nts && r.quantity != Quantity::Theorem)
+        .filter(|r| r.verdict.supports_rate())
+        .filter(|r| r.rate.is_some_and(|v| (v - 0.5).abs() <= NEAR_HALF))
+        .map(|r| {
+            format!(
+                "{} {}, last successive rates {}",
+                r.quantity,
+                rate_text(r),
+                r.last_successive()
+            )
+        })
+        .collect()
+}
+
+/// The contact quantities that separate the cones at the finest level, those within
+/// [`SEPARATES`], and those not compared.
+pub(crate) fn separation_bullets(doc: &mut Doc, report: &Report) {
+    let comparison = report.compare_cones();
+    let separate: Vec<String> = comparison
+        .separate
+        .iter()
+        .map(|c| {
+            format!(
+                "{} {} (mortar {:.2e}, {}; nts {:.2e}, {})",
+                c.quantity,
+                c.ratio_text(),
+                c.mortar_error,
+                rate_text(c.mortar),
+                c.nts_error,
+                rate_text(c.nts)
+            )
+        })
+        .collect();
+    let agree = if comparison.agree.is_empty() {
+        String::new()
+    } else {
+        format!(" Within {SEPARATES}x: {}.", comparison.agree.join(", "))
+    };
+    doc.bullet(format!(
+        "Contact quantities that separate the cones at level {} (error ratio beyond {SEPARATES}): {}.{agree}",
+        report.finest,
+        listed(&separate, "; ", "none"),
+    ));
+    if !comparison.not_compared.is_empty() {
+        doc.bullet(format!(
+            "Not compared (no rate the numbers support in some cone, or fixed by equilibrium): {}.",
+            comparison.not_compared.join(", ")
+        ));
+    }
+}
+
+/// Each quantity that does not converge, with its error at the finest level and its
+/// successive rates.
+pub(crate) fn stalled_texts(report: &Report) -> Vec<String> {
+    report
+        .stalled()
+        .map(|r| {
+            let e = report.error(r).map_or(String::new(), |e| {
+                format!(
+                    " (at {e:.2e} at level {}; successive {})",
+                    report.finest, r.successive
+                )
+            });
+            format!("{} {}{e}", r.method, r.quantity)
+        })
+        .collect()
+}
+
+/// The plastic fraction at T of the finest level (where the bodies flow), and the rate in
+/// k of the time study (where there is one), judged again from time.csv by the rule that
+/// judged it ([`rates::assess`]).
+pub(crate) fn plasticity_and_time(doc: &mut Doc, dir: &Path) -> Result<()> {
+    let levels: Vec<LevelInfo> = read(&dir.join("levels.csv"))?;
+    let finest = levels.iter().map(|l| l.level).max().unwrap_or(0);
+    let plastic: Vec<String> = levels
+        .iter()
+        .filter(|l| l.level == finest && l.plastic_fraction > 0.0)
+        .map(|l| format!("{} {:.3}", l.method, l.plastic_fraction))
+        .collect();
+    if !plastic.is_empty() {
+        doc.bullet(format!(
+            "Plastic fraction at T, level {finest}: {}.",
+            plastic.join(", ")
+        ));
+    }
+    let path = dir.join("time.csv");
+    if !path.exists() {
+        return Ok(());
+    }
+    let runs: Vec<TimeRun> = read(&path)?;
+    let judged: Vec<(usize, f64, f64)> = runs.iter().map(|r| (r.steps, r.k, r.error)).collect();
+    let a = crate::verify::judge::assess_in_k(&judged)
+        .map_err(|e| Error::input(&path, "k", format!("{e}; regenerate the report")))?;
+    let steps: Vec<String> = a.used.iter().map(|&i| runs[i].steps.to_string()).collect();
+    let rate = match a.fit {
+        Some(f) => format!(
+            "{:.3} ± {:.3} ({}, steps {})",
+            f.rate,
+            f.stderr,
+            a.verdict.name(),
+            steps.join(" ")
+        ),
+        None => a.verdict.name().to_string(),
+    };
+    doc.bullet(format!(
+        "Rate in k (time study, backward Euler's k term: 1): {rate}."
+    ));
+    Ok(())
+}
+
