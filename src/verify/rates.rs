@@ -73,8 +73,9 @@ pub const WINDOW_SPREAD: f64 = 0.1;
 /// The trend rule: where the last three judged rates are strictly monotone and differ end to
 /// end by more than this, the rate is `falling` or `rising`, whatever the window.
 pub const TREND: f64 = 0.1;
-/// A quantity whose last two judged rates are both at most this (or whose last one is
-/// negative) has stopped converging. A steady small rate above it is judged like any other.
+/// A quantity whose last two judged rates average at most this (the rate across the last
+/// three levels of a halving table), or whose last one is negative, has stopped converging.
+/// A steady small rate above it is judged like any other.
 pub const STALLED: f64 = 0.02;
 /// Two levels' rate is judged only where their h differ by at least this factor: halving
 /// tables (2, or within 5 % of it on unstructured meshes) use neighbours, a sqrt(2) table
@@ -104,8 +105,8 @@ pub enum Verdict {
     PreAsymptotic,
     /// Fewer than [`MIN_FIT_LEVELS`] levels usable: successive rates only.
     TooFewLevels,
-    /// The error stops falling while the mesh is refined: the last two judged rates at most
-    /// [`STALLED`], or the last one negative.
+    /// The error stops falling while the mesh is refined: the last two judged rates average
+    /// at most [`STALLED`], or the last one is negative.
     NotConverging,
     /// Every level's error is at round-off ([`ROUNDOFF`]): the discretization is exact.
     RoundOff,
@@ -384,8 +385,8 @@ fn rate_between(a: &LevelError, b: &LevelError) -> f64 {
 /// Judge a quantity's errors over the levels (coarsest first) against a truth whose own
 /// estimated error is `truth_error` (0 for an exact solution). The rules, in order
 /// (docs/studies.md#rates): every level at round-off is `round-off`; levels at round-off or
-/// within [`TRUTH_MARGIN`] of the truth are left out; errors that stop falling are `not
-/// converging`; fewer than [`MIN_FIT_LEVELS`] usable levels are `too few levels`; the last
+/// within [`TRUTH_MARGIN`] of the truth are left out; errors that stop falling ([`STALLED`])
+/// are `not converging`; fewer than [`MIN_FIT_LEVELS`] usable levels are `too few levels`; the last
 /// three judged rates strictly monotone by more than [`TREND`] are `falling` or `rising`;
 /// a trailing window of at least three levels whose judged rates spread by at most
 /// [`WINDOW_SPREAD`] is `fitted`; else `pre-asymptotic`. Errs on two levels with the same h.
@@ -399,10 +400,13 @@ pub fn assess(levels: &[LevelError], truth_error: f64) -> Result<Assessment, Equ
     out.judged = judged_rates(&usable);
     let rates: Vec<f64> = out.judged.iter().map(|r| r.rate).collect();
     let last_two = &rates[rates.len().saturating_sub(2)..];
+    // The last two judged rates together (their mean: the rate across the last three
+    // levels of a halving table) at most STALLED, or the last one negative.
     let stalled = match last_two {
         [] => false,
         [.., last] if *last < 0.0 => true,
-        _ => last_two.len() == 2 && last_two.iter().all(|r| *r <= STALLED),
+        [a, b] => 0.5 * (a + b) <= STALLED,
+        _ => false,
     };
     if stalled {
         out.verdict = Verdict::NotConverging;
