@@ -218,3 +218,34 @@ fn a_table_refined_by_sqrt_2_is_judged_on_levels_a_factor_2_apart() {
     assert!(a.judged.iter().all(|r| r.levels.1 - r.levels.0 == 2));
     assert!((a.fit.unwrap().rate - 0.75).abs() < 0.01);
 }
+
+#[test]
+fn the_crossing_of_the_distance_with_mortars_error_is_predicted_where_the_lines_meet() {
+    // e_mortar = h, D = 0.01 h^(1/2) (no noise): D < e_mortar on levels 0-5, both fitted;
+    // the lines meet where h = 0.01 h^(1/2), h = 1e-4, level log2(1e4) = 13.2877 (h = 2^-L).
+    let mut errors = Vec::new();
+    for l in 0..6 {
+        let h = 2f64.powi(-l);
+        let (m, d) = (h, 0.01 * h.sqrt());
+        errors.push(record("mortar", Quantity::Theorem, l as usize, h, m));
+        errors.push(record("nts", Quantity::Theorem, l as usize, h, m.hypot(d)));
+        errors.push(record("nts", Quantity::ConeDistance, l as usize, h, d));
+    }
+    let rules = Rules {
+        truth_error: &|_| 0.0,
+        resultant_fixed: false,
+        threshold: &|_, _| None,
+    };
+    let rows = judge_errors(&errors, &rules).unwrap();
+    let a = contact_rates::verify::judge::asymptotes(&rows, &errors);
+    let theorem = a.iter().find(|r| r.quantity == Quantity::Theorem).unwrap();
+    println!("{}", theorem.describe());
+    assert_eq!(theorem.distance_sets_rate, Some(true));
+    assert!((theorem.asymptotic_rate.unwrap() - 0.5).abs() < 1e-12);
+    assert_eq!(theorem.overtakes_from, None);
+    let exact = 1e4f64.log2();
+    assert!((theorem.predicted_from.unwrap() - exact).abs() < 1e-9);
+    assert!((theorem.predicted_to.unwrap() - exact).abs() < 1e-9);
+    // The pythagorean column is 0 by construction here.
+    assert!(theorem.largest_pythagorean.unwrap() < 1e-14);
+}

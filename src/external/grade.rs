@@ -606,9 +606,10 @@ fn cone_solve(family: &Family, method: Method, level: usize) -> Result<(Case, So
 }
 
 /// The distance between a graded level's solution and mortar's on the same level
-/// (through the intersection of the two meshes), max over the graded steps, each matched
-/// with mortar's step at the same time, relative to the truth's sizes `scale`; empty where
-/// a graded time is none of mortar's steps.
+/// (through the intersection of the two meshes), max over the steps, each matched with
+/// mortar's step at the same time, relative to the truth's sizes `scale`. Empty unless the
+/// graded steps are all of mortar's: D is read against errors that are maxima over every
+/// step, and a distance at T alone would mix two norms in time.
 fn distance_to_mortar(
     graded: &P1History,
     mortar: (&Case, &Solution),
@@ -626,7 +627,7 @@ fn distance_to_mortar(
                 .map(|s| (g, s))
         })
         .collect();
-    let Some(pairs) = pairs else {
+    let Some(pairs) = pairs.filter(|p| p.len() == m.steps.len()) else {
         return BTreeMap::new();
     };
     let cmp = Comparison::new(graded.model, m.model);
@@ -650,7 +651,7 @@ fn notes(levels: &[GradedLevel], family: &Family, pressure: bool) -> Vec<String>
     let mut out = Vec::new();
     if levels.iter().any(|l| l.storage == Storage::Vtu) {
         out.push(format!(
-            "Levels given as one .vtu are graded at t = T only: their theorem norm is the error at T, not the maximum over the {} steps.",
+            "Levels given as one .vtu are graded at t = T only: their theorem norm is the error at T, not the maximum over the {} steps, and their distance to mortar (a maximum over the steps like mortar's error) is not measured.",
             family.steps
         ));
     }

@@ -390,8 +390,9 @@ pub enum Asymptote {
         /// Otherwise the levels where D's line crosses mortar's, with D's rate taken over
         /// its range (the window's fit, the last successive rate, the fit over every level)
         /// and D's line anchored at D's finest level, mortar's at its fit (fractional
-        /// levels, lowest and highest).
-        predicted: Option<(f64, f64)>,
+        /// levels, lowest and highest; no highest where a rate in D's range is at or above
+        /// mortar's: the lines may never cross).
+        predicted: Option<(f64, Option<f64>)>,
     },
 }
 
@@ -432,9 +433,11 @@ pub fn asymptote(
                 distance.assessment.last_rate(),
                 distance.assessment.fit_all.map(|f| f.rate),
             ];
-            let crossings: Vec<f64> = candidates
+            let rates: Vec<f64> = candidates.into_iter().flatten().collect();
+            // A rate in D's range at or above mortar's never crosses: no upper end.
+            let never = rates.iter().any(|r| *r >= fm.rate);
+            let crossings: Vec<f64> = rates
                 .into_iter()
-                .flatten()
                 .filter(|r| *r < fm.rate)
                 .map(|rd| {
                     // ln D(h) = ln d + rd (ln h - ln h_f); ln e_m(h) = c_m + rm ln h.
@@ -445,7 +448,7 @@ pub fn asymptote(
             (!crossings.is_empty()).then(|| {
                 (
                     crossings.iter().copied().fold(f64::INFINITY, f64::min),
-                    crossings.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                    (!never).then(|| crossings.iter().copied().fold(f64::NEG_INFINITY, f64::max)),
                 )
             })
         }
@@ -487,7 +490,8 @@ pub struct AsymptoteRow {
     pub overtakes_from: Option<usize>,
     /// Otherwise the predicted crossing level, lowest and highest over D's rate range.
     pub predicted_from: Option<f64>,
-    /// The highest.
+    /// The highest; empty beside a lowest where a rate in D's range reaches mortar's (the
+    /// lines may never cross).
     pub predicted_to: Option<f64>,
     /// Largest |pythagorean| over the levels.
     pub largest_pythagorean: Option<f64>,
@@ -564,7 +568,7 @@ pub fn asymptotes(rates: &[RateRow], errors: &[ErrorRecord]) -> Vec<AsymptoteRow
                 row.distance_sets_rate = Some(true);
                 row.overtakes_from = observed;
                 row.predicted_from = predicted.map(|p| p.0);
-                row.predicted_to = predicted.map(|p| p.1);
+                row.predicted_to = predicted.and_then(|p| p.1);
             }
         }
         out.push(row);
@@ -587,6 +591,9 @@ impl AsymptoteRow {
                     (None, Some(a), Some(b)) => {
                         format!("tends to D's rate {r:.3} ± {se:.3} past level {a:.1}-{b:.1}")
                     }
+                    (None, Some(a), None) => format!(
+                        "tends to D's rate {r:.3} ± {se:.3} past level {a:.1}, or never (D's rate over its range reaches mortar's)"
+                    ),
                     _ => format!("tends to D's rate {r:.3} ± {se:.3}"),
                 }
             }
