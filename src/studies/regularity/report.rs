@@ -223,10 +223,10 @@ impl Regularity {
             flips <= 1
         };
         let verdict = match (separated, by_beta) {
-            (true, false) => "nts's shortfall follows where its distance to mortar overtakes mortar's error, not beta: every beta where nts's rate follows its best has a smaller D / e_mortar than every beta where it does not",
-            (true, true) => "the ratio D / e_mortar separates the betas where nts's rate follows its best from those where it does not, and so does beta itself: these levels cannot tell the two explanations apart",
-            (false, true) => "beta separates the betas where nts's rate follows its best from those where it does not; D / e_mortar does not",
-            (false, false) => "neither beta nor D / e_mortar separates the betas where nts's rate follows its best from those where it does not",
+            (true, false) => "The shortfall follows where its distance to mortar overtakes mortar's error, not beta: every beta where nts's rate follows its best has a smaller D / e_mortar than every beta where it does not",
+            (true, true) => "The ratio D / e_mortar separates the betas where nts's rate follows its best from those where it does not, and so does beta itself: these levels cannot tell the two explanations apart",
+            (false, true) => "Beta separates the betas where nts's rate follows its best from those where it does not; D / e_mortar does not",
+            (false, false) => "Neither beta nor D / e_mortar separates the betas where nts's rate follows its best from those where it does not",
         };
         format!(
             "nts's theorem norm, by D / e_mortar at the finest level (in brackets): follows its best at beta = {}; falls short of it, or is still in transition, at beta = {}. {verdict}.",
