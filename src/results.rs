@@ -10,8 +10,9 @@ use crate::error::Result;
 use crate::report::markdown::{Doc, README_REPORTS, Table, listed};
 use crate::studies::KINDS;
 use crate::studies::convergence::results::{
-    CONES, HEADLINE, Report, SEPARATES, Separation, rate_short, rate_text,
+    CONES, Report, SEPARATES, Separation, rate_short, rate_text,
 };
+pub use crate::studies::convergence::results::{HEADLINE, STUDIES};
 use crate::verify::quantity::Quantity;
 use crate::verify::rates::Verdict;
 use crate::verify::table::RateRecord;
@@ -59,14 +60,17 @@ pub fn headline(reports: &Path) -> Result<String> {
         .filter_map(|(name, _, report)| {
             let d = report.rate(Method::Nts, Quantity::ConeDistance)?;
             let a = report.asymptote(Quantity::Theorem)?;
-            Some(format!(
-                "in `{name}` D is {} and nts's error {}",
-                match d.verdict {
-                    Verdict::Fitted => format!("fitted at {}", rate_text(d)),
-                    _ => rate_text(d),
-                },
-                a.describe()
-            ))
+            Some(match (d.verdict, a.asymptotic_rate) {
+                (Verdict::Fitted, Some(_)) => format!(
+                    "in `{name}` D falls at {}, and nts's error {}",
+                    rate_text(d),
+                    a.describe()
+                ),
+                _ => format!(
+                    "in `{name}` D supports no rate ({}): no asymptotic rate is predicted",
+                    rate_text(d)
+                ),
+            })
         })
         .collect();
     if !distances.is_empty() {

@@ -132,10 +132,18 @@ fn round_trip_of_this_projects_solves_gives_the_study_errors() {
             .as_path(),
     )
     .unwrap();
-    let mine = errors_of(&g, "outside");
-    // A distance between the cones is no property of one solution: not graded.
+    let (distances, mine): (Vec<&ErrorRecord>, Vec<&ErrorRecord>) = errors_of(&g, "outside")
+        .into_iter()
+        .partition(|r| r.quantity.is_distance());
     let graded: Vec<Quantity> = study.file.solution_quantities().collect();
     assert_eq!(mine.len(), 3 * graded.len());
+    // Its distance to grade's own mortar, measured through the intersection of the two
+    // meshes (here the same mesh): the graded solution is mortar's, so D is round-off, in
+    // the theorem norm, h1_u and l2_stress at each of the 3 levels.
+    assert_eq!(distances.len(), 9);
+    let largest = distances.iter().map(|r| r.error).fold(0.0f64, f64::max);
+    println!("distance of the written mortar solution to grade's mortar: {largest:.2e}");
+    assert!(largest <= 1e-10, "{largest}");
     let mut worst = 0.0f64;
     for r in &mine {
         let s = committed
@@ -162,6 +170,13 @@ fn round_trip_of_this_projects_solves_gives_the_study_errors() {
     };
     for &q in &graded {
         let (a, b) = (rate("outside", q), rate("mortar", q));
+        if q == Quantity::PressureResultant {
+            // Fixed by equilibrium in this project's cones; measured for a graded code,
+            // whose resultant equilibrium does not guarantee: here at round-off.
+            assert_eq!(b.assessment.verdict, Verdict::FixedByEquilibrium);
+            assert_eq!(a.assessment.verdict, Verdict::RoundOff);
+            continue;
+        }
         assert_eq!(a.assessment.verdict, b.assessment.verdict, "{q}");
         assert_eq!(a.assessment.used, b.assessment.used, "{q}");
         match (a.assessment.fit.map(|f| f.rate), b.assessment.fit.map(|f| f.rate)) {

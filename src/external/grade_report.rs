@@ -64,8 +64,15 @@ impl Graded {
                 .iter()
                 .filter(|r| &r.method == m && r.quantity == self.key)
                 .collect();
+            let verdict = match self.rate(m, self.key) {
+                Some(r) if r.supported_fit().is_none() => {
+                    let a = &r.assessment;
+                    format!(": {}", crate::verify::rates::short_text(a.verdict, None, a.last_rate()))
+                }
+                _ => String::new(),
+            };
             series.push(Series {
-                label: format!("{m}"),
+                label: format!("{m}{verdict}"),
                 points: rows.iter().map(|r| (r.h, r.error)).collect(),
                 markers: true,
                 line: false,

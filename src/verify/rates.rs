@@ -802,14 +802,14 @@ impl Assessment {
 }
 
 /// A judged rate, or what replaces it, in a few characters (plot legends, table cells):
-/// "1.85" where fitted, "falling (last 0.56)" or "rising (last 1.20)" with the last judged
-/// rate, "exact" at round-off, else the verdict's name (a pre-asymptotic fit is never
+/// "1.85" where fitted, "falling to 0.557" or "rising to 1.117" with the last judged rate
+/// (no brackets or commas: table cells list several), "exact" at round-off, else the verdict's name (a pre-asymptotic fit is never
 /// printed as a rate). `rate` is the fit's, `last` the last judged rate.
 pub fn short_text(verdict: Verdict, rate: Option<f64>, last: Option<f64>) -> String {
     let last = crate::io::fmt3(last.unwrap_or(f64::NAN));
     match (verdict, rate) {
         (Verdict::Fitted, Some(v)) => format!("{v:.2}"),
-        (Verdict::Falling | Verdict::Rising, _) => format!("{} (last {last})", verdict.name()),
+        (Verdict::Falling | Verdict::Rising, _) => format!("{} to {last}", verdict.name()),
         (Verdict::RoundOff, _) => "exact".into(),
         (v, _) => v.name().into(),
     }

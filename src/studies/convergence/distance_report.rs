@@ -115,7 +115,11 @@ fn decomposition(doc: &mut Doc, res: &StudyResult) {
             describe(Method::Mortar, q),
             describe(Method::Nts, dq),
             a.largest_pythagorean.map_or("-".into(), |v| format!("{v:.1e}")),
-            a.finest_ratio.map_or("-".into(), |v| format!("{v:.2}")),
+            match a.mortar_verdict {
+                // A ratio to round-off measures nothing.
+                crate::verify::rates::Verdict::RoundOff => "mortar exact (round-off)".into(),
+                _ => a.finest_ratio.map_or("-".into(), |v| format!("{v:.2}")),
+            },
             a.describe(),
         ]);
     }

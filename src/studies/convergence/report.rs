@@ -216,8 +216,13 @@ fn error_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
             .iter()
             .find(|r| r.method == m && r.quantity == key)
             .unwrap();
+        // Without a supported rate, the legend says what the errors do instead.
+        let verdict = match rate.supported_fit() {
+            Some(_) => String::new(),
+            None => format!(": {}", verdict_text(rate)),
+        };
         series.push(Series {
-            label: format!("{m} ({})", quantity_label(key)),
+            label: format!("{m} ({}){verdict}", quantity_label(key)),
             points: rows.iter().map(|r| (r.h, r.error)).collect(),
             markers: true,
             line: false,
