@@ -136,7 +136,14 @@ impl RateRow {
     }
     /// The row of rates.csv.
     pub fn record(&self) -> RateRecord {
-        RateRecord::new(self)
+        RateRecord::from_parts(
+            self.method.clone(),
+            self.quantity,
+            self.parameter,
+            &self.assessment,
+            self.threshold.map(Threshold::value),
+            self.outcome,
+        )
     }
     /// The sentence of a threshold this row failed (None: it did not fail).
     pub fn failure(&self) -> Option<String> {

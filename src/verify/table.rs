@@ -9,7 +9,6 @@
 use crate::contact::Method;
 use crate::error::{Error, Result};
 use crate::verify::quantity::Quantity;
-use crate::verify::judge::RateRow;
 use crate::verify::rates::{Assessment, Outcome, Verdict};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::path::Path;
@@ -186,20 +185,6 @@ pub fn join(levels: &[usize]) -> String {
         .map(|l| l.to_string())
         .collect::<Vec<_>>()
         .join(" ")
-}
-
-impl RateRecord {
-    /// The row of a judged rate `r`.
-    pub fn new(r: &RateRow) -> Self {
-        RateRecord::from_parts(
-            r.method.clone(),
-            r.quantity,
-            r.parameter,
-            &r.assessment,
-            r.threshold.map(|t| t.value()),
-            r.outcome,
-        )
-    }
 }
 
 impl<Q> RateRecord<Q> {
