@@ -261,12 +261,15 @@ fn run() -> anyhow::Result<()> {
             method,
             quantity,
             out,
-        } => judge(judge_file::JudgeRequest {
-            file,
-            threshold,
-            method,
-            quantity,
-        }, out),
+        } => judge(
+            judge_file::JudgeRequest {
+                file,
+                threshold,
+                method,
+                quantity,
+            },
+            out,
+        ),
         Command::Export {
             source,
             levels,

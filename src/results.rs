@@ -251,11 +251,3 @@ fn judged_rate(report: &Report, m: Method) -> String {
             }
         })
 }
-
-
-
-
-
-
-
-

@@ -27,11 +27,11 @@ use contact_rates::scene::Scene;
 use contact_rates::solve::{Solution as Solved, SolverKind, State};
 use contact_rates::verify::exact_error::ExactComparison;
 use contact_rates::verify::field::P1Field;
+use contact_rates::verify::judge::RateRow;
 use contact_rates::verify::quantity::Quantity;
+use contact_rates::verify::rates::Verdict;
 use contact_rates::verify::solve_case;
 use contact_rates::verify::study_file::LoadedStudy;
-use contact_rates::verify::judge::RateRow;
-use contact_rates::verify::rates::Verdict;
 use contact_rates::verify::table::{ErrorRecord, read};
 use solution_files::{Encoding, Options, Solution};
 use std::path::Path;
@@ -179,7 +179,10 @@ fn round_trip_of_this_projects_solves_gives_the_study_errors() {
         }
         assert_eq!(a.assessment.verdict, b.assessment.verdict, "{q}");
         assert_eq!(a.assessment.used, b.assessment.used, "{q}");
-        match (a.assessment.fit.map(|f| f.rate), b.assessment.fit.map(|f| f.rate)) {
+        match (
+            a.assessment.fit.map(|f| f.rate),
+            b.assessment.fit.map(|f| f.rate),
+        ) {
             (Some(x), Some(y)) => assert!((x - y).abs() <= 1e-9 * y.abs(), "{q}: {x} vs {y}"),
             (x, y) => assert_eq!(x, y, "{q}"),
         }
@@ -409,7 +412,11 @@ fn the_threshold_is_met_and_missed() {
     );
     assert_eq!(theorem.assessment.verdict, Verdict::PreAsymptotic);
     assert_eq!(g.failures.len(), 1, "{:?}", g.failures);
-    assert!(g.failures[0].contains("last successive rate"), "{:?}", g.failures);
+    assert!(
+        g.failures[0].contains("last successive rate"),
+        "{:?}",
+        g.failures
+    );
     // Below the last successive rate, a pre-asymptotic fit neither passes nor fails.
     req.threshold = Some(0.5);
     let g = grade(&req).unwrap();

@@ -44,25 +44,41 @@ fn judge_passes_fails_and_leaves_a_transition_unverified() {
     assert!(text.contains("0.600 ± 0.000"), "{text}");
     // The crossover study's nts theorem norm, falling 0.709 -> 0.557: R = 0.5 is neither
     // met nor missed (exit 0), and rates.csv says so in its pass column.
-    let committed = format!("{}/reports/crossover/errors.csv", env!("CARGO_MANIFEST_DIR"));
+    let committed = format!(
+        "{}/reports/crossover/errors.csv",
+        env!("CARGO_MANIFEST_DIR")
+    );
     let mut rdr = csv::Reader::from_path(committed).unwrap();
     let mut s = String::from("method,quantity,level,h,dofs,error\n");
     for r in rdr.records().map(Result::unwrap) {
         if &r[0] == "nts" && &r[5] == "theorem" {
-            s.push_str(&format!("nts,theorem,{},{},{},{}\n", &r[1], &r[2], &r[3], &r[6]));
+            s.push_str(&format!(
+                "nts,theorem,{},{},{},{}\n",
+                &r[1], &r[2], &r[3], &r[6]
+            ));
         }
     }
     let f = table(dir.path(), "crossover.csv", &s);
     let report = dir.path().join("report");
     let out = common::run(
-        &["judge", f.to_str().unwrap(), "--threshold", "0.5", "--out", report.to_str().unwrap()],
+        &[
+            "judge",
+            f.to_str().unwrap(),
+            "--threshold",
+            "0.5",
+            "--out",
+            report.to_str().unwrap(),
+        ],
         &[],
     );
     let text = String::from_utf8_lossy(&out.stdout);
     println!("{text}");
     assert!(out.status.success(), "{text}");
     let rates = std::fs::read_to_string(report.join("rates.csv")).unwrap();
-    assert!(rates.contains(",unverified,") && rates.contains(",falling,"), "{rates}");
+    assert!(
+        rates.contains(",unverified,") && rates.contains(",falling,"),
+        "{rates}"
+    );
     assert!(report.join("error_vs_h.png").exists());
 }
 
@@ -71,10 +87,21 @@ fn a_bad_cell_is_one_error_naming_file_row_and_column() {
     let dir = tempfile::tempdir().unwrap();
     let f = table(dir.path(), "bad.csv", "h,error\n0.5,0.1\n0.25,abc\n");
     let report = dir.path().join("report");
-    let out = common::run(&["judge", f.to_str().unwrap(), "--out", report.to_str().unwrap()], &[]);
+    let out = common::run(
+        &[
+            "judge",
+            f.to_str().unwrap(),
+            "--out",
+            report.to_str().unwrap(),
+        ],
+        &[],
+    );
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success());
-    assert!(err.contains("bad.csv") && err.contains("row 2, column error"), "{err}");
+    assert!(
+        err.contains("bad.csv") && err.contains("row 2, column error"),
+        "{err}"
+    );
     assert!(!report.exists(), "nothing half-written");
     let f = table(dir.path(), "nocol.csv", "h,err\n0.5,0.1\n");
     let out = common::run(&["judge", f.to_str().unwrap()], &[]);

@@ -31,9 +31,16 @@ fn pure_powers_are_fitted_at_their_exponent() {
     for p in [0.5, 0.75, 1.0, 2.0] {
         let a = assess(&table(6, |h| 0.3 * h.powf(p)), 0.0).unwrap();
         let f = a.fit.expect("a fit");
-        println!("p = {p}: {:?} {:.4} ± {:.4} over {:?}", a.verdict, f.rate, f.stderr, a.used);
+        println!(
+            "p = {p}: {:?} {:.4} ± {:.4} over {:?}",
+            a.verdict, f.rate, f.stderr, a.used
+        );
         assert_eq!(a.verdict, Verdict::Fitted, "p = {p}");
-        assert!((f.rate - p).abs() <= 0.03f64.max(2.0 * f.stderr), "p = {p}: {}", f.rate);
+        assert!(
+            (f.rate - p).abs() <= 0.03f64.max(2.0 * f.stderr),
+            "p = {p}: {}",
+            f.rate
+        );
         assert_eq!(threshold_outcome(&a, p - 0.05), Outcome::Pass, "p = {p}");
     }
 }
@@ -89,7 +96,9 @@ fn two_term_transitions_are_never_fitted_beyond_what_their_levels_show() {
                 }
             }
             let s: Vec<f64> = a.judged.iter().map(|r| r.rate).collect();
-            let [x, y, z] = s[s.len() - 3..] else { unreachable!() };
+            let [x, y, z] = s[s.len() - 3..] else {
+                unreachable!()
+            };
             if x > y && y > z && x - z > 0.1 {
                 assert_eq!(a.verdict, Verdict::Falling, "{what}: {s:?}");
                 falling += 1;
@@ -163,18 +172,33 @@ fn judged(errors: &[ErrorRecord], threshold: Option<Threshold>) -> RateRow {
 fn committed_reports_read_as_their_errors_say() {
     // crossover: nts's theorem norm falls 0.709, 0.666, 0.597, 0.557 over levels 3-7 (it
     // was "0.632 ± 0.018 fitted"): in transition to the distance's h^(1/2).
-    let nts = judged(&committed("crossover", "nts", Quantity::Theorem, None), Some(Threshold::Rate(0.45)));
+    let nts = judged(
+        &committed("crossover", "nts", Quantity::Theorem, None),
+        Some(Threshold::Rate(0.45)),
+    );
     println!("crossover nts theorem: {}", nts.assessment.describe());
     assert_eq!(nts.assessment.verdict, Verdict::Falling);
     // rates-exact: mortar's theorem norm at about 1 over every level.
-    let mortar = judged(&committed("rates-exact", "mortar", Quantity::Theorem, None), Some(Threshold::Rate(0.7)));
-    println!("rates-exact mortar theorem: {}", mortar.assessment.describe());
+    let mortar = judged(
+        &committed("rates-exact", "mortar", Quantity::Theorem, None),
+        Some(Threshold::Rate(0.7)),
+    );
+    println!(
+        "rates-exact mortar theorem: {}",
+        mortar.assessment.describe()
+    );
     assert_eq!(mortar.assessment.verdict, Verdict::Fitted);
     assert_eq!(mortar.outcome, Some(Outcome::Pass));
     // regularity, beta = 0.6: mortar's l2_pressure falls at 0.100 at every level, exactly
     // its best rate beta - 1/2: a steady small rate, not a stall.
-    let p = judged(&committed("regularity", "mortar", Quantity::L2Pressure, Some(0.6)), None);
-    println!("regularity 0.6 mortar l2_pressure: {}", p.assessment.describe());
+    let p = judged(
+        &committed("regularity", "mortar", Quantity::L2Pressure, Some(0.6)),
+        None,
+    );
+    println!(
+        "regularity 0.6 mortar l2_pressure: {}",
+        p.assessment.describe()
+    );
     assert_eq!(p.assessment.verdict, Verdict::Fitted);
     assert!((p.rate() - 0.1).abs() < 5e-4, "{}", p.rate());
 }
@@ -202,7 +226,10 @@ fn a_pre_asymptotic_fit_above_the_threshold_is_unverified() {
         Outcome::Unverified
     );
     // Below R at the last rate: a failure whatever the verdict.
-    assert_eq!(Threshold::Rate(1.15).outcome(&row.assessment, 1.0), Outcome::Fail);
+    assert_eq!(
+        Threshold::Rate(1.15).outcome(&row.assessment, 1.0),
+        Outcome::Fail
+    );
 }
 
 #[test]

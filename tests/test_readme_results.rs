@@ -252,11 +252,22 @@ fn headline_cells_state_their_own_rows_rates() {
         checked += row_claims(row).len();
         // The asymptote after a rate cell's "; " is asymptotes.csv's own sentence.
         let path = root().join("reports").join(name).join("asymptotes.csv");
-        let asymptotes: Vec<AsymptoteRow> = if path.exists() { read(&path).unwrap() } else { Vec::new() };
-        let cells: Vec<&str> = row.trim().trim_matches('|').split('|').map(str::trim).collect();
+        let asymptotes: Vec<AsymptoteRow> = if path.exists() {
+            read(&path).unwrap()
+        } else {
+            Vec::new()
+        };
+        let cells: Vec<&str> = row
+            .trim()
+            .trim_matches('|')
+            .split('|')
+            .map(str::trim)
+            .collect();
         for (method, cell) in [("mortar", cells[3]), ("nts", cells[4])] {
             if let Some((_, said)) = cell.split_once("; ") {
-                let q = cell.strip_prefix('`').map_or("theorem", |r| r.split_once('`').unwrap().0);
+                let q = cell
+                    .strip_prefix('`')
+                    .map_or("theorem", |r| r.split_once('`').unwrap().0);
                 let a = asymptotes
                     .iter()
                     .find(|a| a.method.name() == method && a.quantity.name() == q)

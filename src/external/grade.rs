@@ -4,18 +4,18 @@
 
 use super::family::{Family, Source};
 use super::mesh_in::OutsideModel;
+use crate::case::Case;
 use crate::contact::Method;
 use crate::error::{Error, Result};
 use crate::io::solution::{FieldNames, SolutionStep, read_msh_solution, read_pvd, read_vtu};
-use crate::solve::SolverKind;
-use crate::case::Case;
 use crate::solve::Solution;
+use crate::solve::SolverKind;
 use crate::verify::field::{P1Field, P1History};
-use crate::verify::norms::Comparison;
-use crate::verify::quantity::Scale;
 use crate::verify::jobs::{self, Job};
-use crate::verify::quantity::Quantity;
 use crate::verify::judge::{RateRow, Rules, Threshold, judge_errors};
+use crate::verify::norms::Comparison;
+use crate::verify::quantity::Quantity;
+use crate::verify::quantity::Scale;
 use crate::verify::rates;
 use crate::verify::study_file::{LoadedStudy, needs};
 use crate::verify::table::{ErrorRecord, MethodLabel};
@@ -353,7 +353,15 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
     let graded: Vec<(GradedLevel, BTreeMap<Quantity, f64>, bool)> = files
         .par_iter()
         .map(|(&level, (storage, path))| {
-            grade_level(level, *storage, path, &req.names, &family, &truth, mortar_at(level))
+            grade_level(
+                level,
+                *storage,
+                path,
+                &req.names,
+                &family,
+                &truth,
+                mortar_at(level),
+            )
         })
         .collect::<Result<Vec<_>>>()?;
     let resultant_fixed = graded.first().is_some_and(|g| g.2);
@@ -384,7 +392,10 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
         if *method == Method::Nts
             && let Some((mc, ms)) = mortar_at(*level)
         {
-            let (a, b) = (P1History::of_solution(case, solution), P1History::of_solution(mc, ms));
+            let (a, b) = (
+                P1History::of_solution(case, solution),
+                P1History::of_solution(mc, ms),
+            );
             errors_here.extend(
                 crate::verify::distance::cone_distance(&a, &b, &scale)
                     .into_iter()
@@ -392,7 +403,11 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
             );
         }
         let mut quantities = cone_quantities.clone();
-        quantities.extend(DECOMPOSED_DISTANCES.iter().filter(|q| errors_here.contains_key(q)));
+        quantities.extend(
+            DECOMPOSED_DISTANCES
+                .iter()
+                .filter(|q| errors_here.contains_key(q)),
+        );
         errors.extend(rows(
             &(*method).into(),
             *level,
@@ -551,9 +566,8 @@ fn check_label(name: &str) -> Result<MethodLabel> {
 /// Two levels with the same h cannot give a rate ([`rates::check_distinct_h`]): refused,
 /// naming both files, before anything is solved beside them.
 fn check_distinct_h(levels: &[GradedLevel], dir: &Path) -> Result<()> {
-    let as_levels = crate::verify::judge::levels_of(
-        levels.iter().map(|l| (l.level, l.h, l.dofs as f64, 0.0)),
-    );
+    let as_levels =
+        crate::verify::judge::levels_of(levels.iter().map(|l| (l.level, l.h, l.dofs as f64, 0.0)));
     rates::check_distinct_h(&as_levels).map_err(|e| {
         let of = |level: usize| levels.iter().find(|l| l.level == level);
         let file = |level: usize| of(level).map_or(String::new(), |l| l.file.display().to_string());
@@ -642,7 +656,10 @@ fn distance_to_mortar(
     BTreeMap::from([
         (Quantity::ConeDistance, relative(theorem, scale.theorem)),
         (Quantity::ConeDistanceH1U, relative(h1, scale.h1)),
-        (Quantity::ConeDistanceL2Stress, relative(stress, scale.stress)),
+        (
+            Quantity::ConeDistanceL2Stress,
+            relative(stress, scale.stress),
+        ),
     ])
 }
 

@@ -8,9 +8,9 @@ use crate::io::csv_bytes;
 use crate::report::folder::{write, write_folder};
 use crate::report::markdown::{Doc, Table};
 use crate::report::plot::{self, Series};
+use crate::verify::judge::RateRow;
 use crate::verify::quantity::Quantity;
 use crate::verify::rates::Verdict;
-use crate::verify::judge::RateRow;
 use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord};
 use std::path::Path;
 
@@ -67,7 +67,10 @@ impl Graded {
             let verdict = match self.rate(m, self.key) {
                 Some(r) if r.supported_fit().is_none() => {
                     let a = &r.assessment;
-                    format!(": {}", crate::verify::rates::short_text(a.verdict, None, a.last_rate()))
+                    format!(
+                        ": {}",
+                        crate::verify::rates::short_text(a.verdict, None, a.last_rate())
+                    )
                 }
                 _ => String::new(),
             };
@@ -79,8 +82,16 @@ impl Graded {
                 color: i,
                 thin: false,
             });
-            if let Some((legend, rate, intercept, hs)) = self.rate(m, self.key).and_then(|r| r.line(&rows)) {
-                series.extend(plot::fit_line(format!("{m} {legend}"), rate, intercept, &hs, i));
+            if let Some((legend, rate, intercept, hs)) =
+                self.rate(m, self.key).and_then(|r| r.line(&rows))
+            {
+                series.extend(plot::fit_line(
+                    format!("{m} {legend}"),
+                    rate,
+                    intercept,
+                    &hs,
+                    i,
+                ));
             }
         }
         plot::loglog(
@@ -261,7 +272,8 @@ impl Graded {
                 format!("`{}`", a.quantity),
                 describe(a.quantity),
                 describe(dq),
-                a.largest_pythagorean.map_or("-".into(), |v| format!("{v:.1e}")),
+                a.largest_pythagorean
+                    .map_or("-".into(), |v| format!("{v:.1e}")),
                 a.finest_ratio.map_or("-".into(), |v| format!("{v:.2}")),
                 a.describe(),
             ]);
@@ -314,7 +326,8 @@ impl Graded {
             table.row([
                 format!("{}", r.method),
                 format!("{}", r.quantity),
-                a.fit.map_or("-".into(), |f| format!("{:.3} ± {:.3}", f.rate, f.stderr)),
+                a.fit
+                    .map_or("-".into(), |f| format!("{:.3} ± {:.3}", f.rate, f.stderr)),
                 a.verdict.name().to_string(),
                 if a.used.is_empty() {
                     "-".into()
@@ -385,4 +398,3 @@ impl Graded {
         out
     }
 }
-

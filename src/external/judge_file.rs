@@ -75,7 +75,10 @@ pub fn judge_file(req: &JudgeRequest) -> Result<Vec<JudgedGroup>> {
                 return Err(Error::input(
                     &req.file,
                     name.trim_start_matches("--"),
-                    format!("no row has {} '{v}'; give one the table has, or leave {name} out", name.trim_start_matches("--")),
+                    format!(
+                        "no row has {} '{v}'; give one the table has, or leave {name} out",
+                        name.trim_start_matches("--")
+                    ),
                 ));
             }
         }
@@ -125,7 +128,13 @@ fn read_rows(path: &Path) -> Result<Vec<Row>> {
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .from_path(path)
-        .map_err(|e| Error::input(path, "file", format!("cannot read ({e}); give a CSV file with a header row")))?;
+        .map_err(|e| {
+            Error::input(
+                path,
+                "file",
+                format!("cannot read ({e}); give a CSV file with a header row"),
+            )
+        })?;
     let headers = reader
         .headers()
         .map_err(|e| Error::input(path, "header", format!("{e}")))?
@@ -147,17 +156,30 @@ fn read_rows(path: &Path) -> Result<Vec<Row>> {
     let mut rows = Vec::new();
     for (i, record) in reader.records().enumerate() {
         let row = i + 1;
-        let record = record.map_err(|e| Error::input(path, format!("row {row}"), format!("{e}")))?;
+        let record =
+            record.map_err(|e| Error::input(path, format!("row {row}"), format!("{e}")))?;
         let cell = |c: usize| record.get(c).unwrap_or("");
         let number = |name: &str, c: usize, positive: bool| -> Result<f64> {
             let text = cell(c);
             let v: f64 = text.parse().map_err(|_| {
-                Error::input(path, format!("row {row}, column {name}"), format!("'{text}' is not a number"))
+                Error::input(
+                    path,
+                    format!("row {row}, column {name}"),
+                    format!("'{text}' is not a number"),
+                )
             })?;
             let ok = v.is_finite() && if positive { v > 0.0 } else { v >= 0.0 };
             if !ok {
-                let want = if positive { "a positive number" } else { "a number >= 0" };
-                return Err(Error::input(path, format!("row {row}, column {name}"), format!("{text}: give {want}")));
+                let want = if positive {
+                    "a positive number"
+                } else {
+                    "a number >= 0"
+                };
+                return Err(Error::input(
+                    path,
+                    format!("row {row}, column {name}"),
+                    format!("{text}: give {want}"),
+                ));
             }
             Ok(v)
         };
@@ -166,7 +188,11 @@ fn read_rows(path: &Path) -> Result<Vec<Row>> {
             quantity: col("quantity").map_or("error".into(), |c| cell(c).to_string()),
             level: match col("level") {
                 Some(c) => Some(cell(c).parse().map_err(|_| {
-                    Error::input(path, format!("row {row}, column level"), format!("'{}' is not a level (0, 1, 2, ...)", cell(c)))
+                    Error::input(
+                        path,
+                        format!("row {row}, column level"),
+                        format!("'{}' is not a level (0, 1, 2, ...)", cell(c)),
+                    )
                 })?),
                 None => None,
             },
@@ -183,7 +209,11 @@ fn read_rows(path: &Path) -> Result<Vec<Row>> {
         });
     }
     if rows.is_empty() {
-        return Err(Error::input(path, "rows", "no rows after the header; give one row per level"));
+        return Err(Error::input(
+            path,
+            "rows",
+            "no rows after the header; give one row per level",
+        ));
     }
     Ok(rows)
 }
@@ -211,13 +241,22 @@ pub fn write_report(groups: &[JudgedGroup], file: &Path, dir: &Path) -> Result<(
             let name = group_name(g);
             series.push(Series {
                 label: format!("{name}: {}", g.assessment.describe().replace("**", "")),
-                points: g.errors.iter().map(|e| (e.1, e.2)).filter(|p| p.1 > 0.0).collect(),
+                points: g
+                    .errors
+                    .iter()
+                    .map(|e| (e.1, e.2))
+                    .filter(|p| p.1 > 0.0)
+                    .collect(),
                 markers: true,
                 line: false,
                 color: i,
                 thin: false,
             });
-            if let Some(f) = g.assessment.fit.filter(|_| g.assessment.verdict.supports_rate()) {
+            if let Some(f) = g
+                .assessment
+                .fit
+                .filter(|_| g.assessment.verdict.supports_rate())
+            {
                 let hs: Vec<f64> = g
                     .errors
                     .iter()

@@ -513,7 +513,8 @@ pub struct AsymptoteRow {
 pub fn asymptotes(rates: &[RateRow], errors: &[ErrorRecord]) -> Vec<AsymptoteRow> {
     let mortar = MethodLabel::Cone(crate::contact::Method::Mortar);
     let decomposition = decomposition(errors);
-    let find = |m: &MethodLabel, q: Quantity| rates.iter().find(|r| &r.method == m && r.quantity == q);
+    let find =
+        |m: &MethodLabel, q: Quantity| rates.iter().find(|r| &r.method == m && r.quantity == q);
     let series = |m: &MethodLabel, q: Quantity| -> Vec<(usize, f64, f64)> {
         errors
             .iter()
@@ -593,7 +594,9 @@ impl AsymptoteRow {
                 let se = self.asymptotic_stderr.unwrap_or(f64::NAN);
                 match (self.overtakes_from, self.predicted_from, self.predicted_to) {
                     (Some(l), _, _) => {
-                        format!("tends to D's rate {r:.3} ± {se:.3} (D >= e_mortar from level {l} on)")
+                        format!(
+                            "tends to D's rate {r:.3} ± {se:.3} (D >= e_mortar from level {l} on)"
+                        )
                     }
                     (None, Some(a), Some(b)) => {
                         format!("tends to D's rate {r:.3} ± {se:.3} past level {a:.1}-{b:.1}")
