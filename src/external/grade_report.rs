@@ -65,13 +65,7 @@ impl Graded {
                 .filter(|r| &r.method == m && r.quantity == self.key)
                 .collect();
             let verdict = match self.rate(m, self.key) {
-                Some(r) if r.supported_fit().is_none() => {
-                    let a = &r.assessment;
-                    format!(
-                        ": {}",
-                        crate::verify::rates::short_text(a.verdict, None, a.last_rate())
-                    )
-                }
+                Some(r) if r.supported_fit().is_none() => format!(": {}", r.short_text()),
                 _ => String::new(),
             };
             series.push(Series {

@@ -134,6 +134,11 @@ impl RateRow {
             None => format!("no rate: {}", self.assessment.describe().replace("**", "")),
         }
     }
+    /// The rate or what replaces it, in a few characters ([`rates::short_text`]).
+    pub fn short_text(&self) -> String {
+        let a = &self.assessment;
+        rates::short_text(a.verdict, a.fit.map(|f| f.rate), a.last_rate())
+    }
     /// The row of rates.csv.
     pub fn record(&self) -> RateRecord {
         RateRecord::from_parts(
@@ -249,11 +254,7 @@ pub fn judge_levels(
     resultant_fixed: bool,
     threshold: Option<Threshold>,
 ) -> Result<(Assessment, Option<Outcome>), EqualH> {
-    let quantity = match resultant_fixed {
-        true => Quantity::PressureResultant,
-        false => Quantity::Theorem,
-    };
-    let assessment = rates::judge(levels, truth_error, quantity, resultant_fixed)?;
+    let assessment = rates::judge(levels, truth_error, resultant_fixed)?;
     let max_error = levels.iter().map(|l| l.error).fold(0.0f64, f64::max);
     let outcome = threshold.map(|t| t.outcome(&assessment, max_error));
     Ok((assessment, outcome))
@@ -372,7 +373,7 @@ pub fn decomposition(errors: &[ErrorRecord]) -> Vec<DecompositionRow> {
 /// What a method's distance to mortar predicts of its error: the asymptotic rate
 /// min(r_D, r_mortar) and where D overtakes mortar's error, or why nothing is predicted.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Asymptote {
+enum Asymptote {
     /// D's verdict supports no rate (or mortar's none): nothing is predicted.
     Unsupported {
         /// D's verdict.
@@ -406,7 +407,7 @@ pub enum Asymptote {
 /// [`Asymptote`] of method X from the judged rows of D (`distance`) and of mortar's error
 /// in the same quantity, with their errors (`d_errors`, `m_errors`: (level, h, error),
 /// coarsest first).
-pub fn asymptote(
+fn asymptote(
     distance: &RateRow,
     mortar: &RateRow,
     d_errors: &[(usize, f64, f64)],

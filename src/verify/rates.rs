@@ -1,7 +1,5 @@
 //! Convergence rates: least-squares slopes with standard errors, and successive rates.
 
-use super::quantity::Quantity;
-
 /// A fitted rate: error ~ C h^rate.
 #[derive(Debug, Clone, Copy)]
 pub struct Fit {
@@ -815,17 +813,16 @@ pub fn short_text(verdict: Verdict, rate: Option<f64>, last: Option<f64>) -> Str
     }
 }
 
-/// [`assess`] of one quantity; where equilibrium fixes the contact resultant
-/// (`resultant_fixed`) and the quantity is its error, that error measures the load
+/// [`assess`] of one quantity; where it is a contact resultant that equilibrium fixes
+/// (`fixed_by_equilibrium`, decided by the caller), its error measures the load
 /// quadrature, not the discretization: it is named so and never fitted.
 pub fn judge(
     levels: &[LevelError],
     truth_error: f64,
-    quantity: Quantity,
-    resultant_fixed: bool,
+    fixed_by_equilibrium: bool,
 ) -> Result<Assessment, EqualH> {
     let mut a = assess(levels, truth_error)?;
-    if quantity == Quantity::PressureResultant && resultant_fixed {
+    if fixed_by_equilibrium {
         a.verdict = Verdict::FixedByEquilibrium;
         (a.fit, a.fit_dofs, a.fit_all, a.celik, a.asymptotic_ratio) =
             (None, None, None, None, None);

@@ -219,7 +219,7 @@ fn error_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
         // Without a supported rate, the legend says what the errors do instead.
         let verdict = match rate.supported_fit() {
             Some(_) => String::new(),
-            None => format!(": {}", verdict_text(rate)),
+            None => format!(": {}", rate.short_text()),
         };
         series.push(Series {
             label: format!("{m} ({}){verdict}", quantity_label(key)),
@@ -783,7 +783,7 @@ fn families_table(res: &StudyResult) -> Table {
             let mut cells = vec![q.to_string(), m.to_string()];
             cells.extend(rows.iter().map(|r| {
                 r.map_or("-".into(), |r| {
-                    format!("{} ({})", verdict_text(r), r.assessment.successive_text())
+                    format!("{} ({})", r.short_text(), r.assessment.successive_text())
                 })
             }));
             // Only rates the verdicts support: a pre-asymptotic fit is no rate to compare.
@@ -1029,7 +1029,7 @@ fn contact_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
                     .rates
                     .iter()
                     .find(|r| r.method == m && r.quantity == q)
-                    .map_or("n/a".into(), verdict_text);
+                    .map_or("n/a".into(), RateRow::short_text);
                 series.push(Series {
                     label: format!("{m} {q}: {rate}"),
                     points,
@@ -1057,11 +1057,6 @@ fn contact_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
     )
 }
 
-/// A rate or the verdict that replaces it, short ([`rates::short_text`]).
-fn verdict_text(r: &RateRow) -> String {
-    let a = &r.assessment;
-    rates::short_text(a.verdict, a.fit.map(|f| f.rate), a.last_rate())
-}
 
 /// The kind's outcome writes this report.
 impl Outcome for StudyResult {

@@ -140,10 +140,7 @@ fn cell(r: Option<&RateRow>) -> String {
     match r {
         Some(r) => match supported(r) {
             Some((rate, se)) => format!("{rate:.3} ± {se:.3}"),
-            None => {
-                let a = &r.assessment;
-                crate::verify::rates::short_text(a.verdict, None, a.last_rate())
-            }
+            None => r.short_text(),
         },
         None => "-".into(),
     }
@@ -170,7 +167,7 @@ impl Regularity {
                         Some(x) => format!("{m} {:.2} (**{:.2} below**)", x.0, best - x.0),
                         None => format!(
                             "{m} {}",
-                            crate::verify::rates::short_text(r.assessment.verdict, None, r.assessment.last_rate())
+                            r.short_text()
                         ),
                     },
                     None => format!("{m} not measured"),
