@@ -15,8 +15,8 @@
 //! Data: the scene's; 4 steps (1 for the perturbation).
 
 mod common;
-#[path = "common/solution_files.rs"]
-mod solution_files;
+#[path = "common/graded_series.rs"]
+mod graded_series;
 
 use contact_rates::case::Case;
 use contact_rates::contact::Method;
@@ -24,7 +24,7 @@ use contact_rates::external::export::Source;
 use contact_rates::external::grade::{GradeRequest, Graded, grade};
 use contact_rates::io::solution::FieldNames;
 use contact_rates::scene::Scene;
-use contact_rates::solve::{Solution as Solved, SolverKind, State};
+use contact_rates::solve::{Solution as Solved, SolverKind};
 use contact_rates::verify::exact_error::ExactComparison;
 use contact_rates::verify::field::P1Field;
 use contact_rates::verify::judge::RateRow;
@@ -33,60 +33,21 @@ use contact_rates::verify::rates::Verdict;
 use contact_rates::verify::solve_case;
 use contact_rates::verify::study_file::LoadedStudy;
 use contact_rates::verify::table::{ErrorRecord, read};
-use solution_files::{Encoding, Options, Solution};
+use graded_series::{outside, write_states, write_vtu};
 use std::path::Path;
-
-/// A solver state as an outside code writes it: the mesh of both bodies, the displacement,
-/// the P0 stress and the nodal pressure at the slave nodes (0 elsewhere).
-fn outside(case: &Case, state: &State, u: &[f64]) -> Solution {
-    let p = &case.problem;
-    let m = &p.model;
-    let mut pressure = vec![0.0; m.n_nodes];
-    for (row, l) in p.rows.iter().zip(&state.lambda) {
-        pressure[p.interface.pieces[row.piece].slave_nodes[row.i]] = row.pressure(*l);
-    }
-    Solution {
-        points: (0..m.n_nodes).map(|g| m.position(g)).collect(),
-        triangles: m.elements.iter().map(|e| e.nodes).collect(),
-        body: m.elements.iter().map(|e| e.body as u8 + 1).collect(),
-        displacement: (0..m.n_nodes).map(|g| [u[2 * g], u[2 * g + 1]]).collect(),
-        stress: state.sigma.iter().map(|s| [s[0], s[1], s[2]]).collect(),
-        pressure,
-    }
-}
-
-fn write_vtu(path: &Path, s: &Solution) {
-    let mut o = Options::new(Encoding::AppendedRaw);
-    o.compressed = true;
-    o.block_bytes = 1 << 15;
-    std::fs::write(path, s.vtu("Float64").write(&o)).unwrap();
-}
 
 /// A solve's steps t_1..t_N as `dir/level_L.pvd` with one .vtu per step.
 fn write_series(dir: &Path, level: usize, case: &Case, sol: &Solved) {
-    write_series_scaled(dir, level, case, sol, 1.0)
+    write_states(dir, level, case, &sol.states, |_| ())
 }
 
 /// [`write_series`] with every stress scaled by `factor`.
 fn write_series_scaled(dir: &Path, level: usize, case: &Case, sol: &Solved, factor: f64) {
-    let mut pvd = String::from(
-        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n",
-    );
-    for (n, s) in sol.states.iter().enumerate().skip(1) {
-        let name = format!("level_{level}_step_{n}.vtu");
-        let mut written = outside(case, s, &s.u);
-        written
-            .stress
+    write_states(dir, level, case, &sol.states, |w| {
+        w.stress
             .iter_mut()
-            .for_each(|v| v.iter_mut().for_each(|c| *c *= factor));
-        write_vtu(&dir.join(&name), &written);
-        pvd.push_str(&format!(
-            "<DataSet timestep=\"{:e}\" file=\"{name}\"/>\n",
-            s.time
-        ));
-    }
-    pvd.push_str("</Collection>\n</VTKFile>\n");
-    std::fs::write(dir.join(format!("level_{level}.pvd")), pvd).unwrap();
+            .for_each(|v| v.iter_mut().for_each(|c| *c *= factor))
+    })
 }
 
 fn request(source: Source, dir: &Path, compare: bool) -> GradeRequest {

@@ -2,6 +2,7 @@
 //! measured against the scene's exact solution with the studies' error integrals, judged by
 //! the studies' rate verdicts, beside this project's mortar and nts on the family's meshes.
 
+use super::checks::{self, CheckRecord, LevelCheck};
 use super::family::{Family, Source};
 use super::mesh_in::OutsideModel;
 use crate::case::Case;
@@ -74,6 +75,16 @@ pub struct GradedLevel {
     pub h: f64,
     pub dofs: usize,
     pub triangles: usize,
+    /// What was checked of the file: equilibrium, Gamma_C's forces, the pressure's scale.
+    pub check: LevelCheck,
+}
+
+impl GradedLevel {
+    /// Why this level is not a converged solution of the problem, given its error in the key
+    /// quantity (empty: it is one).
+    pub fn problems(&self, error: f64) -> Vec<String> {
+        self.check.problems(error)
+    }
 }
 
 /// What `grade` measured.
@@ -99,6 +110,10 @@ pub struct Graded {
     pub unverified: Vec<String>,
     /// The command that reproduces the grade (the report folder aside).
     pub command: String,
+    /// Each level's checks (checks.csv).
+    pub checks: Vec<CheckRecord>,
+    /// Why a level is set apart as no converged solution, one sentence per level.
+    pub flagged: Vec<String>,
 }
 
 /// The solution files of `dir`, per level: exactly one each.
@@ -299,7 +314,12 @@ fn rows(
         .collect()
 }
 
-/// Grade the solutions of `req`.
+/// This project's cones on the family's levels, each solved once and kept as a record.
+type Cones = Vec<(Method, usize, Case, Solution)>;
+
+/// Grade the solutions of `req`: the cones solved first (mortar's solution is what each
+/// graded level's distance to mortar is measured against), each level read, checked and
+/// measured, the levels that are no converged solution set apart, the rest judged.
 pub fn grade(req: &GradeRequest) -> Result<Graded> {
     let label = check_label(&req.name)?;
     let family = Family::resolve(&req.source)?;
@@ -318,38 +338,126 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
             s.file.reference.quadrature
         });
     let truth = Truth::Exact(exact, points);
+    let key = key_quantity(exact);
     let files = level_files(&req.solutions, req.levels.as_deref())?;
-    // This project's cones on the same levels, solved first (kept as records): mortar's
-    // solution is what each graded level's distance to mortar is measured against.
-    let compared = req.compare;
-    let cone_quantities: Vec<Quantity> = match &study {
-        Some(s) => s.file.quantities.clone(),
-        None => self::quantities(&family, None, true),
-    }
-    .into_iter()
-    .filter(|q| !q.is_distance())
-    .collect();
-    let jobs: Vec<(Method, usize)> = match compared {
+    let cones = solve_cones(&family, &files, req.compare)?;
+    let (levels, measured, resultant_fixed) = measure_levels(req, &family, &truth, &files, &cones)?;
+    check_distinct_h(&levels, &req.solutions)?;
+    let ratios: Vec<(usize, &Path, f64)> = levels
+        .iter()
+        .filter_map(|l| {
+            l.check
+                .pressure_ratio
+                .map(|r| (l.level, l.file.as_path(), r))
+        })
+        .collect();
+    checks::check_pressure_scale(&ratios)?;
+    let pressure = levels.iter().all(|l| l.pressure_given);
+    let quantities = quantities(&family, study.as_ref(), pressure);
+    let mut errors = graded_rows(&label, &levels, &measured, &quantities, key)?;
+    errors.extend(cone_rows(&family, study.as_ref(), &truth, &cones)?);
+    let threshold = |m: &MethodLabel, q: Quantity| {
+        req.threshold
+            .filter(|_| m == &label && q == key)
+            .map(Threshold::Rate)
+    };
+    let rules = Rules {
+        truth_error: &|_| 0.0,
+        resultant_fixed,
+        threshold: &threshold,
+    };
+    let rates = judge_errors(&errors, &rules)
+        .map_err(|e| Error::input(&req.solutions, "levels", e.to_string()))?;
+    let failures = rates.iter().filter_map(RateRow::failure).collect();
+    let unverified = rates.iter().filter_map(RateRow::unverified).collect();
+    let notes = notes(&levels, &family, pressure);
+    let command = command_line(req, &files);
+    let (checks, flagged) = level_checks(&levels, &measured, key);
+    Ok(Graded {
+        checks,
+        flagged,
+        scene: family.scene.name.clone(),
+        study: family.study.clone(),
+        label: label.name().to_string(),
+        levels,
+        errors,
+        rates,
+        key,
+        steps: family.steps,
+        compared: req.compare,
+        notes,
+        failures,
+        unverified,
+        command,
+    })
+}
+
+/// checks.csv's rows, and for each level that is no converged solution, why (its errors
+/// give no rate).
+fn level_checks(
+    levels: &[GradedLevel],
+    measured: &[BTreeMap<Quantity, f64>],
+    key: Quantity,
+) -> (Vec<CheckRecord>, Vec<String>) {
+    let mut flagged = Vec::new();
+    let records = levels
+        .iter()
+        .zip(measured)
+        .map(|(l, e)| {
+            let problems = l.problems(e[&key]);
+            if !problems.is_empty() {
+                flagged.push(format!(
+                    "level {} ({}) is not a converged solution of this problem, and gives no rate: {}",
+                    l.level,
+                    l.file.display(),
+                    problems.join("; ")
+                ));
+            }
+            CheckRecord::new(l.level, l.h, e[&key], &l.check)
+        })
+        .collect();
+    (records, flagged)
+}
+
+/// Mortar and nts on every graded level (none without `compare`), in parallel.
+fn solve_cones(
+    family: &Family,
+    files: &BTreeMap<usize, (Storage, PathBuf)>,
+    compare: bool,
+) -> Result<Cones> {
+    let jobs: Vec<(Method, usize)> = match compare {
         true => [Method::Mortar, Method::Nts]
             .into_iter()
             .flat_map(|m| files.keys().map(move |&l| (m, l)))
             .collect(),
         false => Vec::new(),
     };
-    let cones: Vec<(Method, usize, Case, Solution)> = jobs
-        .par_iter()
+    jobs.par_iter()
         .map(|&(method, level)| {
-            let (case, solution) = cone_solve(&family, method, level)?;
+            let (case, solution) = cone_solve(family, method, level)?;
             Ok((method, level, case, solution))
         })
-        .collect::<Result<Vec<_>>>()?;
-    let mortar_at = |level: usize| {
-        cones
-            .iter()
-            .find(|c| c.0 == Method::Mortar && c.1 == level)
-            .map(|c| (&c.2, &c.3))
-    };
-    // The levels are independent: measured in parallel, in level order.
+        .collect()
+}
+
+/// Mortar's solve of `level` among `cones`.
+fn mortar_at(cones: &Cones, level: usize) -> Option<(&Case, &Solution)> {
+    cones
+        .iter()
+        .find(|c| c.0 == Method::Mortar && c.1 == level)
+        .map(|c| (&c.2, &c.3))
+}
+
+/// Every level's file read, checked and measured (in parallel, in level order); with
+/// whether equilibrium fixes the contact resultant on them.
+#[allow(clippy::type_complexity)]
+fn measure_levels(
+    req: &GradeRequest,
+    family: &Family,
+    truth: &Truth,
+    files: &BTreeMap<usize, (Storage, PathBuf)>,
+    cones: &Cones,
+) -> Result<(Vec<GradedLevel>, Vec<BTreeMap<Quantity, f64>>, bool)> {
     let graded: Vec<(GradedLevel, BTreeMap<Quantity, f64>, bool)> = files
         .par_iter()
         .map(|(&level, (storage, path))| {
@@ -358,25 +466,36 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
                 *storage,
                 path,
                 &req.names,
-                &family,
-                &truth,
-                mortar_at(level),
+                family,
+                truth,
+                mortar_at(cones, level),
             )
         })
         .collect::<Result<Vec<_>>>()?;
     let resultant_fixed = graded.first().is_some_and(|g| g.2);
-    let (levels, measured): (Vec<GradedLevel>, Vec<BTreeMap<Quantity, f64>>) =
-        graded.into_iter().map(|(l, m, _)| (l, m)).unzip();
-    check_distinct_h(&levels, &req.solutions)?;
-    let pressure = levels.iter().all(|l| l.pressure_given);
-    let quantities = quantities(&family, study.as_ref(), pressure);
+    let (levels, measured) = graded.into_iter().map(|(l, m, _)| (l, m)).unzip();
+    Ok((levels, measured, resultant_fixed))
+}
+
+/// The graded code's rows of errors.csv: its converged levels only (a flagged level's
+/// errors are an iteration's, and give no rate; checks.csv keeps its key error).
+fn graded_rows(
+    label: &MethodLabel,
+    levels: &[GradedLevel],
+    measured: &[BTreeMap<Quantity, f64>],
+    quantities: &[Quantity],
+    key: Quantity,
+) -> Result<Vec<ErrorRecord>> {
     let mut errors = Vec::new();
-    for (l, e) in levels.iter().zip(&measured) {
-        let steps = l.times.len();
-        let mut quantities = quantities.clone();
+    for (l, e) in levels.iter().zip(measured) {
+        if !l.problems(e[&key]).is_empty() {
+            continue;
+        }
+        let mut quantities = quantities.to_vec();
         quantities.extend(DECOMPOSED_DISTANCES.iter().filter(|q| e.contains_key(q)));
+        let steps = l.times.len();
         errors.extend(rows(
-            &label,
+            label,
             l.level,
             l.h,
             l.dofs,
@@ -387,10 +506,29 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
             &l.file,
         )?);
     }
-    for (method, level, case, solution) in &cones {
+    Ok(errors)
+}
+
+/// The cones' rows of errors.csv: their errors against the truth and, for nts, its
+/// distance to mortar on the same level.
+fn cone_rows(
+    family: &Family,
+    study: Option<&LoadedStudy>,
+    truth: &Truth,
+    cones: &Cones,
+) -> Result<Vec<ErrorRecord>> {
+    let cone_quantities: Vec<Quantity> = match study {
+        Some(s) => s.file.quantities.clone(),
+        None => self::quantities(family, None, true),
+    }
+    .into_iter()
+    .filter(|q| !q.is_distance())
+    .collect();
+    let mut errors = Vec::new();
+    for (method, level, case, solution) in cones {
         let (mut errors_here, scale) = truth.measure_solved(case, solution);
         if *method == Method::Nts
-            && let Some((mc, ms)) = mortar_at(*level)
+            && let Some((mc, ms)) = mortar_at(cones, *level)
         {
             let (a, b) = (
                 P1History::of_solution(case, solution),
@@ -420,38 +558,7 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
             &family.scene.file,
         )?);
     }
-    let key = key_quantity(exact);
-    let threshold = |m: &MethodLabel, q: Quantity| {
-        req.threshold
-            .filter(|_| m == &label && q == key)
-            .map(Threshold::Rate)
-    };
-    let rules = Rules {
-        truth_error: &|_| 0.0,
-        resultant_fixed,
-        threshold: &threshold,
-    };
-    let rates = judge_errors(&errors, &rules)
-        .map_err(|e| Error::input(&req.solutions, "levels", e.to_string()))?;
-    let failures = rates.iter().filter_map(RateRow::failure).collect();
-    let unverified = rates.iter().filter_map(RateRow::unverified).collect();
-    let notes = notes(&levels, &family, pressure);
-    let command = command_line(req, &files);
-    Ok(Graded {
-        scene: family.scene.name.clone(),
-        study: family.study.clone(),
-        label: label.name().to_string(),
-        levels,
-        errors,
-        rates,
-        key,
-        steps: family.steps,
-        compared,
-        notes,
-        failures,
-        unverified,
-        command,
-    })
+    Ok(errors)
 }
 
 /// `contact-rates grade ...` with the request's options.
@@ -522,7 +629,12 @@ fn grade_level(
     if let Some(mortar) = mortar {
         errors.extend(distance_to_mortar(&history, mortar, &scale));
     }
+    let mut check = checks::equilibrium(&outside.model, &outside.interface, &history.steps)?;
+    if let Some(last) = history.steps.last() {
+        check.pressure_ratio = checks::pressure_ratio(&outside.model, &outside.interface, last)?;
+    }
     let graded = GradedLevel {
+        check,
         level,
         file: path.to_path_buf(),
         storage,

@@ -42,6 +42,7 @@ impl Graded {
     pub fn write(&self, dir: &Path) -> Result<()> {
         write_folder(dir, |d| {
             write(d, "errors.csv", &csv_bytes(&self.errors)?)?;
+            write(d, "checks.csv", &csv_bytes(&self.checks)?)?;
             let rates: Vec<RateRecord> = self.rates.iter().map(RateRow::record).collect();
             write(d, "rates.csv", &csv_bytes(&rates)?)?;
             let decomposition = crate::verify::judge::decomposition(&self.errors);
@@ -107,6 +108,12 @@ impl Graded {
         };
         doc.heading(1, format!("Grade of `{}` on {what}", self.label));
         doc.paragraph(self.lead());
+        if !self.flagged.is_empty() {
+            doc.paragraph(format!(
+                "**Not converged**: {}. Such a level's errors are left out of errors.csv and of every rate (checks.csv keeps its key error).",
+                self.flagged.join("; ")
+            ));
+        }
         if !self.failures.is_empty() {
             doc.paragraph(format!(
                 "**Threshold missed**: {}.",
@@ -142,6 +149,9 @@ impl Graded {
         doc.table(&self.rate_table());
         doc.heading(2, "The graded files");
         doc.table(&self.level_table());
+        doc.heading(2, "Checks");
+        doc.paragraph(CHECKS_TEXT);
+        doc.table(&self.check_table());
         doc.finish()
     }
 
@@ -380,11 +390,42 @@ impl Graded {
         table
     }
 
+    /// Per level, what was checked of the file (checks.csv).
+    fn check_table(&self) -> Table {
+        let mut table = Table::new([
+            "level",
+            "error",
+            "residual (limit)",
+            "normal imbalance",
+            "tangential",
+            "pulling",
+            "pressure resultant / exact",
+            "verdict",
+        ]);
+        let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.2e}"));
+        for c in &self.checks {
+            table.row([
+                c.level.to_string(),
+                format!("{:.4e}", c.error),
+                format!("{:.2e} ({:.2e})", c.residual, c.residual_limit),
+                opt(c.normal_imbalance),
+                opt(c.tangential),
+                opt(c.pulling),
+                c.pressure_ratio.map_or("-".into(), |r| format!("{r:.6}")),
+                c.verdict.clone(),
+            ]);
+        }
+        table
+    }
+
     /// The console summary.
     pub fn console(&self, dir: &Path) -> String {
         let mut out = String::new();
         out.push_str(&self.lead());
         out.push('\n');
+        for f in &self.flagged {
+            out.push_str(&format!("NOT CONVERGED: {f}\n"));
+        }
         for n in &self.notes {
             out.push_str(&format!("note: {n}\n"));
         }
@@ -392,3 +433,5 @@ impl Graded {
         out
     }
 }
+
+const CHECKS_TEXT: &str = "Before a level gives a rate, grade checks that it is a converged solution of this problem: the equilibrium residual r of the P1 problem on the file's mesh (its stress, or C eps(u_h); the scene's loads; the supports' and Gamma_C's dofs held) in energy, sqrt(r^T K^-1 r) / ||u_h||_E, at most 1/20 of the level's error (or 1e-10, round-off); on Gamma_C, the two sides' normal forces equal, no tangential and no pulling force, each to 1e-3 of the resultant. The pressure's resultant at T is read against the exact one's: a negative ratio or a constant factor is refused (docs/verify-your-code.md).";

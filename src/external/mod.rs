@@ -3,6 +3,7 @@
 //! loads); [`grade`] reads the solutions back and measures them with the same error
 //! integrals and rate verdicts as the studies, beside this project's two cones.
 
+pub mod checks;
 pub mod export;
 pub mod family;
 pub mod grade;
