@@ -63,7 +63,10 @@ CONTACT_RULE = "IM_STRUCTURED_COMPOSITE(IM_TRIANGLE(6),16)"
 # one moves u by less than CHECK_TOL of max |u| (at most MAX_CHECK), and the backward error
 # |R|_1 / (| |K| |x| |_1 + |f|_1) must be below ETA_TOL.
 NEWTON_TOL, MAX_ITER = 1e-8, 100
-CHECK_TOL, MAX_CHECK, ETA_TOL = 1e-10, 5, 1e-13
+# The linear solver, named: GetFEM's "auto" turned to gmres with an ILUT preconditioner on
+# crossover level 5 (115,000 unknowns), whose pivots failed ("pivot too small").
+LSOLVER = "mumps"
+CHECK_TOL, MAX_CHECK, ETA_TOL = 1e-10, 20, 1e-13
 
 
 def fail(msg):
@@ -360,7 +363,7 @@ def solve_level(export, out, level, problem, brick):
             f[number] = F
         load = sum(np.abs(F).sum() for F in f.values())
         t1 = time.perf_counter()
-        nbit, converged = md.solve("max_iter", MAX_ITER, "max_res", NEWTON_TOL * load)
+        nbit, converged = md.solve("max_iter", MAX_ITER, "max_res", NEWTON_TOL * load, "lsolver", LSOLVER)
         res_stop = residual(md) / load
         # The check: further Newton iterations, one at a time (max_res 0 lets GetFEM stop only
         # at max_iter), until one moves u by less than CHECK_TOL of max |u|. A semismooth
@@ -368,7 +371,7 @@ def solve_level(export, out, level, problem, brick):
         # not prove that (the contact rows are lengths, tiny in |R|_1).
         for extra in range(1, MAX_CHECK + 1):
             before = np.concatenate([md.variable(f"u{b}") for b in lv.bodies])
-            md.solve("max_iter", 1, "max_res", 0.0)
+            md.solve("max_iter", 1, "max_res", 0.0, "lsolver", LSOLVER)
             after = np.concatenate([md.variable(f"u{b}") for b in lv.bodies])
             du = np.abs(after - before).max() / max(np.abs(after).max(), 1e-300)
             if du < CHECK_TOL:

@@ -273,3 +273,31 @@ fn a_solve_stopped_early_and_a_cut_active_set_give_no_rate() {
         }
     }
 }
+
+#[test]
+fn swapped_body_marks_and_a_legacy_vtk_folder_get_their_message() {
+    let case = common::case("contact-mms", 0, Method::Mortar, &[]);
+    let (sol, _) = solve_case(&case, SolverKind::Newton, STEPS).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    write_states(dir.path(), 0, &case, &sol.states, |w| {
+        w.body.iter_mut().for_each(|b| *b = 3 - *b)
+    });
+    let msg = grade(&request(dir.path())).err().unwrap().to_string();
+    println!("{msg}");
+    assert!(
+        msg.contains("body marks are swapped") && msg.contains("body"),
+        "{msg}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("level_0.vtk"),
+        "# vtk DataFile Version 5.1\n",
+    )
+    .unwrap();
+    let msg = grade(&request(dir.path())).err().unwrap().to_string();
+    println!("{msg}");
+    assert!(
+        msg.contains("level_0.vtk") && msg.contains("meshio.write('level_0.vtu'"),
+        "{msg}"
+    );
+}

@@ -160,6 +160,9 @@ fn level_files(
         .into_iter()
         .map(|(l, mut f)| (l, f.remove(0)))
         .collect();
+    if let Some(legacy) = legacy_vtk(dir, &out, wanted) {
+        return Err(legacy);
+    }
     if let Some(wanted) = wanted {
         if let Some(missing) = wanted.iter().find(|l| !out.contains_key(l)) {
             return Err(Error::input(
@@ -194,6 +197,35 @@ fn level_files(
         ));
     }
     Ok(out)
+}
+
+/// A level given only as a legacy VTK file (`level_L.vtk`, which grade does not read),
+/// where it is missing or no level is found: refused with meshio's conversion.
+fn legacy_vtk(
+    dir: &Path,
+    found: &BTreeMap<usize, (Storage, PathBuf)>,
+    wanted: Option<&[usize]>,
+) -> Option<Error> {
+    let level = std::fs::read_dir(dir).ok()?.flatten().find_map(|entry| {
+        let name = entry.file_name().to_string_lossy().to_string();
+        let level: usize = name
+            .strip_prefix("level_")?
+            .strip_suffix(".vtk")?
+            .parse()
+            .ok()?;
+        let needed = match wanted {
+            Some(w) => w.contains(&level),
+            None => found.is_empty(),
+        };
+        (needed && !found.contains_key(&level)).then_some(level)
+    })?;
+    Some(Error::input(
+        dir.join(format!("level_{level}.vtk")),
+        "format",
+        format!(
+            "a legacy VTK file, which grade does not read; convert it to VTK XML with meshio (`pip install meshio`): python3 -c \"import meshio; meshio.write('level_{level}.vtu', meshio.read('level_{level}.vtk'))\" (keep the cell data `body`, or set it as the export's README.md shows), then grade again"
+        ),
+    ))
 }
 
 /// The states of one level's file, with their times.

@@ -162,8 +162,14 @@ impl Graded {
                 .map_or("no rate".into(), |r| r.describe_with_verdict())
         };
         let label = MethodLabel::External(self.label.clone());
+        let when = match self.levels.iter().all(|l| l.times.len() == 1) {
+            true => "at T",
+            false => "max over the steps",
+        };
         let norm = match self.key {
-            Quantity::Theorem => "Theorem 3.1's norm (||u - u_h||_H1 + ||sigma - sigma_h||_L2, max over the steps, relative)".to_string(),
+            Quantity::Theorem => format!(
+                "Theorem 3.1's norm (||u - u_h||_H1 + ||sigma - sigma_h||_L2, {when}, relative)"
+            ),
             q => format!("{q} (relative)"),
         };
         let mut text = format!(

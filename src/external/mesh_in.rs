@@ -104,10 +104,13 @@ impl OutsideModel {
         let size = diameter(&mesh.points);
         check_bodies_apart(mesh, file)?;
         check_triangles(mesh, file)?;
-        check_areas(scene, mesh, reference, file)?;
         // Straight boundaries match to round-off; a coarse tolerance would let an edge of a
         // wrong boundary through.
         let tolerance = mesh.precision.tolerance(size).max(1e-10 * size);
+        if marks_swapped(mesh, reference, raw, tolerance) {
+            return Err(swapped_marks_error(scene, file));
+        }
+        check_areas(scene, mesh, reference, file)?;
         let mut out = RawMesh {
             nodes: mesh.points.clone(),
             triangles: mesh
@@ -122,56 +125,7 @@ impl OutsideModel {
             out.physical_names
                 .insert((2, b as i32 + 1), scene.bodies[b].surface.clone());
         }
-        let mut tags: HashMap<String, i32> = HashMap::new();
-        for b in 0..2 {
-            let curves = curves_of_body(reference, raw, b);
-            for e in boundary_edges(mesh, b) {
-                let (p, q) = (mesh.points[e[0]], mesh.points[e[1]]);
-                let mid = [(p[0] + q[0]) / 2.0, (p[1] + q[1]) / 2.0];
-                let off = |segments: &[Segment]| {
-                    [p, q, mid]
-                        .iter()
-                        .map(|&x| {
-                            segments
-                                .iter()
-                                .map(|&s| distance_to_segment(x, s))
-                                .fold(f64::INFINITY, f64::min)
-                        })
-                        .fold(0.0f64, f64::max)
-                };
-                // The curve the edge lies on (the nearest; a corner's neighbours are farther).
-                let nearest = curves
-                    .iter()
-                    .map(|(name, segments)| (name, off(segments)))
-                    .min_by(|a, b| a.1.total_cmp(&b.1));
-                match nearest {
-                    Some((name, d)) if d <= tolerance => {
-                        let next = tags.len() as i32 + 10;
-                        let tag = *tags.entry(name.clone()).or_insert(next);
-                        out.physical_names.insert((1, tag), name.clone());
-                        out.lines.push((e, tag));
-                    }
-                    // A boundary edge of no curve: an inner hole, or a crack between
-                    // triangles that do not share their nodes.
-                    _ => {
-                        return Err(Error::input(
-                            file,
-                            "Cells",
-                            format!(
-                                "the boundary edge from ({}, {}) to ({}, {}) of body {} lies on no boundary curve of scene '{}' (nearest {:.3e} away): the mesh has a gap or a hole there, or its triangles do not share their nodes along it; write a conforming mesh of the bodies",
-                                p[0],
-                                p[1],
-                                q[0],
-                                q[1],
-                                b + 1,
-                                scene.name,
-                                nearest.map_or(f64::INFINITY, |n| n.1)
-                            ),
-                        ));
-                    }
-                }
-            }
-        }
+        assign_curves(scene, mesh, reference, raw, tolerance, file, &mut out)?;
         // Their errors name the scene file; here the mesh at fault is the solution's.
         let model = Model::new(scene, &out, file).map_err(|e| on_file(e, file))?;
         let interface = Interface::new(&model, &out).map_err(|e| on_file(e, file))?;
@@ -226,6 +180,100 @@ impl OutsideModel {
         P1Field::from_nodal(model, &self.interface, time, u, stress, pressure)
             .map_err(|e| Error::input(file, "stress", e.to_string()))
     }
+}
+
+/// Each boundary edge of the solution's mesh assigned to the scene's physical curve it lies
+/// on (within `tolerance`), as a line of `out`; an edge on no curve is refused.
+fn assign_curves(
+    scene: &Scene,
+    mesh: &SolutionMesh,
+    reference: &Model,
+    raw: &RawMesh,
+    tolerance: f64,
+    file: &Path,
+    out: &mut RawMesh,
+) -> Result<()> {
+    let mut tags: HashMap<String, i32> = HashMap::new();
+    for b in 0..2 {
+        let curves = curves_of_body(reference, raw, b);
+        for e in boundary_edges(mesh, b) {
+            let (p, q) = (mesh.points[e[0]], mesh.points[e[1]]);
+            let mid = [(p[0] + q[0]) / 2.0, (p[1] + q[1]) / 2.0];
+            let off = |segments: &[Segment]| {
+                [p, q, mid]
+                    .iter()
+                    .map(|&x| {
+                        segments
+                            .iter()
+                            .map(|&s| distance_to_segment(x, s))
+                            .fold(f64::INFINITY, f64::min)
+                    })
+                    .fold(0.0f64, f64::max)
+            };
+            // The curve the edge lies on (the nearest; a corner's neighbours are farther).
+            let nearest = curves
+                .iter()
+                .map(|(name, segments)| (name, off(segments)))
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            match nearest {
+                Some((name, d)) if d <= tolerance => {
+                    let next = tags.len() as i32 + 10;
+                    let tag = *tags.entry(name.clone()).or_insert(next);
+                    out.physical_names.insert((1, tag), name.clone());
+                    out.lines.push((e, tag));
+                }
+                // A boundary edge of no curve: an inner hole, or a crack between
+                // triangles that do not share their nodes.
+                _ => {
+                    return Err(Error::input(
+                        file,
+                        "Cells",
+                        format!(
+                            "the boundary edge from ({}, {}) to ({}, {}) of body {} lies on no boundary curve of scene '{}' (nearest {:.3e} away): the mesh has a gap or a hole there, or its triangles do not share their nodes along it; write a conforming mesh of the bodies",
+                            p[0],
+                            p[1],
+                            q[0],
+                            q[1],
+                            b + 1,
+                            scene.name,
+                            nearest.map_or(f64::INFINITY, |n| n.1)
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Whether every boundary edge of each mark's triangles lies on a curve of the other body:
+/// the marks 1 and 2 are swapped.
+fn marks_swapped(mesh: &SolutionMesh, reference: &Model, raw: &RawMesh, tolerance: f64) -> bool {
+    (0..2).all(|b| {
+        let other = curves_of_body(reference, raw, 1 - b);
+        let edges = boundary_edges(mesh, b);
+        !edges.is_empty()
+            && edges.iter().all(|e| {
+                [mesh.points[e[0]], mesh.points[e[1]]].iter().all(|&x| {
+                    other.iter().any(|(_, segments)| {
+                        segments
+                            .iter()
+                            .any(|&s| distance_to_segment(x, s) <= tolerance)
+                    })
+                })
+            })
+    })
+}
+
+fn swapped_marks_error(scene: &Scene, file: &Path) -> Error {
+    let (one, two) = (&scene.bodies[0].surface, &scene.bodies[1].surface);
+    Error::input(
+        file,
+        "body",
+        format!(
+            "the triangles marked body 1 lie where the scene's body 2 ('{two}') is, and those marked 2 where body 1 ('{one}') is: the body marks are swapped; write `body` = 1 on '{one}' (the slave) and 2 on '{two}' (the master), as the physical surfaces of mesh_L.msh number them"
+        ),
+    )
 }
 
 /// The two bodies share no point: a point of both (a writer that merged coincident points)
