@@ -185,10 +185,14 @@ impl Interface {
     /// discrete problem as in the exact one, in both cones. Its error then measures the
     /// load's quadrature, not the contact discretization.
     pub fn resultant_fixed_by_equilibrium(&self, model: &Model) -> bool {
-        let Some(first) = self.pieces.first() else {
-            return false;
-        };
-        let n = first.normal;
+        self.held_only_by_contact(model).is_some()
+    }
+
+    /// The body (0: body 1, 1: body 2) whose rigid translation along Gamma_C's normal no
+    /// clamp or roller holds, where Gamma_C is straight: only the contact holds it there
+    /// (the first such body, or `None`).
+    pub fn held_only_by_contact(&self, model: &Model) -> Option<usize> {
+        let n = self.pieces.first()?.normal;
         let straight = self
             .pieces
             .iter()
@@ -199,7 +203,7 @@ impl Interface {
                 .into_iter()
                 .all(|g| (0..2).all(|c| model.equation[2 * g + c] != FIXED || n[c].abs() <= 1e-12))
         };
-        straight && (free_along_normal(0) || free_along_normal(1))
+        (0..2).find(|&b| straight && free_along_normal(b))
     }
 
     /// Build Gamma_C from the scene's slave and master curves.

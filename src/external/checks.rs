@@ -308,24 +308,17 @@ fn exact_resultant(model: &Model, interface: &Interface, t: f64) -> Option<f64> 
 /// Where only the contact holds a body along Gamma_C's (straight) normal, its load along
 /// that normal toward the other body: the contact resultant equilibrium gives.
 fn normal_load(model: &Model, interface: &Interface, t: f64) -> Result<Option<f64>> {
-    if !interface.resultant_fixed_by_equilibrium(model) {
+    let Some(body) = interface.held_only_by_contact(model) else {
         return Ok(None);
-    }
+    };
     let n = interface.pieces[0].normal;
     let load = model.load(t)?;
-    let free = |b: usize| {
-        let nodes = model.node_offset[b]..model.node_offset[b] + model.meshes[b].nodes.len();
-        nodes
-            .clone()
-            .all(|g| (0..2).all(|c| model.equation[2 * g + c] != FIXED || n[c].abs() <= 1e-12))
-            .then(|| {
-                nodes
-                    .map(|g| load[2 * g] * n[0] + load[2 * g + 1] * n[1])
-                    .sum::<f64>()
-            })
-    };
+    let nodes = model.node_offset[body]..model.node_offset[body] + model.meshes[body].nodes.len();
+    let along: f64 = nodes
+        .map(|g| load[2 * g] * n[0] + load[2 * g + 1] * n[1])
+        .sum();
     // Body 1 pushes along nu^1 onto body 2; body 2 along -nu^1.
-    Ok(free(0).or_else(|| free(1).map(|v| -v)))
+    Ok(Some(if body == 0 { along } else { -along }))
 }
 
 /// Refuses pressures whose resultants `ratios` (per level, with its file) are of the wrong

@@ -63,6 +63,10 @@ pub fn export(source: &Source, levels: &[usize], out: &Path) -> Result<Exported>
         files: 0,
     };
     let mut first: Option<(ProblemFile, String)> = None;
+    let mut loading = Loading {
+        proportional: true,
+        held_by_contact: None,
+    };
     for &level in levels {
         let (case, raw) = family.case(level)?;
         let model = &case.problem.model;
@@ -73,8 +77,11 @@ pub fn export(source: &Source, levels: &[usize], out: &Path) -> Result<Exported>
             &format!("mesh_{level}.msh22.msh"),
             mesh.msh22().as_bytes(),
         )?;
-        exported.files += 2 + write_loads(&family, model, level, &dir)?;
+        let (files, proportional) = write_loads(&family, model, level, &dir)?;
+        exported.files += 2 + files;
+        loading.proportional &= proportional;
         if first.is_none() {
+            loading.held_by_contact = case.problem.interface.held_only_by_contact(model);
             let origin = Origin {
                 scene: &family.scene,
                 study: family.study.as_deref(),
@@ -110,7 +117,7 @@ pub fn export(source: &Source, levels: &[usize], out: &Path) -> Result<Exported>
     write(
         &dir,
         "README.md",
-        super::readme::export_readme(&family, &exported.levels).as_bytes(),
+        super::readme::export_readme(&family, &exported.levels, &loading).as_bytes(),
     )?;
     exported.files += 3;
     staging.commit()?;
@@ -127,17 +134,38 @@ fn header_comment(family: &Family) -> String {
     )
 }
 
-/// loads_L.csv at every step and, where the law needs one, source_L.csv; the files written.
+/// What the README says of the loading: whether the loads are proportional to t, and which
+/// body only the contact holds along Gamma_C's normal.
+pub struct Loading {
+    /// Every step's nodal loads are t_n / T times those at T (to 1e-12 of their largest).
+    pub proportional: bool,
+    /// The body (0: body 1) no support holds along Gamma_C's normal.
+    pub held_by_contact: Option<usize>,
+}
+
+/// loads_L.csv at every step and, where the law needs one, source_L.csv; the files written,
+/// and whether the loads are proportional to t.
 fn write_loads(
     family: &Family,
     model: &crate::fe::Model,
     level: usize,
     dir: &Path,
-) -> Result<usize> {
+) -> Result<(usize, bool)> {
     let mut loads = Vec::new();
     let mut sources = Vec::new();
-    for (n, t) in family.times().into_iter().enumerate() {
-        let f = model.load(t)?;
+    let times = family.times();
+    let per_step = times
+        .iter()
+        .map(|&t| model.load(t))
+        .collect::<Result<Vec<_>>>()?;
+    let (final_time, at_t) = (times[times.len() - 1], &per_step[per_step.len() - 1]);
+    let largest = at_t.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let proportional = times.iter().zip(&per_step).all(|(t, f)| {
+        f.iter()
+            .zip(at_t)
+            .all(|(a, b)| (a - t / final_time * b).abs() <= 1e-12 * largest)
+    });
+    for (n, (&t, f)) in times.iter().zip(&per_step).enumerate() {
         for node in 0..model.n_nodes {
             loads.push(LoadRow {
                 step: n + 1,
@@ -162,10 +190,10 @@ fn write_loads(
     }
     write(dir, &format!("loads_{level}.csv"), &csv_bytes(&loads)?)?;
     if sources.is_empty() {
-        return Ok(1);
+        return Ok((1, proportional));
     }
     write(dir, &format!("source_{level}.csv"), &csv_bytes(&sources)?)?;
-    Ok(2)
+    Ok((2, proportional))
 }
 
 /// Whether each body's exact stress is E eps(u), derived from the displacement (an elastic

@@ -127,6 +127,12 @@ fn level_files(
     let mut found: BTreeMap<usize, Vec<(Storage, PathBuf)>> = BTreeMap::new();
     for entry in entries.flatten() {
         let name = entry.file_name().to_string_lossy().to_string();
+        if entry.path().is_dir() {
+            if let Some((level, file)) = level_folder(&name, &entry.path())? {
+                found.entry(level).or_default().push(file);
+            }
+            continue;
+        }
         let Some(rest) = name.strip_prefix("level_") else {
             continue;
         };
@@ -197,6 +203,50 @@ fn level_files(
         ));
     }
     Ok(out)
+}
+
+/// A folder `level_L` (as `solve --out DIR/level_L` writes one): its one .pvd series, or its
+/// one .vtu or .msh file.
+fn level_folder(name: &str, path: &Path) -> Result<Option<(usize, (Storage, PathBuf))>> {
+    let Some(level) = name
+        .strip_prefix("level_")
+        .and_then(|l| l.parse::<usize>().ok())
+    else {
+        return Ok(None);
+    };
+    let mut files: Vec<(Storage, PathBuf)> = std::fs::read_dir(path)
+        .map_err(|e| Error::input(path, "--solutions", format!("cannot read the folder ({e})")))?
+        .flatten()
+        .filter_map(|entry| {
+            let p = entry.path();
+            let ext = p.extension()?.to_str()?.to_string();
+            Storage::ALL
+                .iter()
+                .find(|(_, e)| *e == ext)
+                .map(|(storage, _)| (*storage, p))
+        })
+        .collect();
+    files.sort_by(|a, b| a.1.cmp(&b.1));
+    // A series' steps are .vtu files beside its .pvd: the .pvd is the level.
+    if files.iter().any(|f| f.0 == Storage::Pvd) {
+        files.retain(|f| f.0 == Storage::Pvd);
+    }
+    match files.len() {
+        0 => Ok(None),
+        1 => Ok(Some((level, files.remove(0)))),
+        n => Err(Error::input(
+            path,
+            format!("level_{level}"),
+            format!(
+                "the folder of level {level} holds {n} solutions ({}); keep one .pvd, or one .vtu or .msh",
+                files
+                    .iter()
+                    .map(|f| f.1.display().to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        )),
+    }
 }
 
 /// A level given only as a legacy VTK file (`level_L.vtk`, which grade does not read),

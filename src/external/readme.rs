@@ -1,10 +1,16 @@
 //! The README.md of an exported problem: what to solve, what to write back, how to convert.
 
+use super::export::Loading;
 use super::family::Family;
 use std::fmt::Write as _;
 
-/// The README of an export of `family` at `levels` (level, h, nodes, triangles).
-pub fn export_readme(family: &Family, levels: &[(usize, f64, usize, usize)]) -> String {
+/// The README of an export of `family` at `levels` (level, h, nodes, triangles), with what
+/// `loading` says of the loads.
+pub fn export_readme(
+    family: &Family,
+    levels: &[(usize, f64, usize, usize)],
+    loading: &Loading,
+) -> String {
     let scene = &family.scene;
     let what = match &family.study {
         Some(s) => format!("study `{s}` (scene `{}`)", scene.name),
@@ -44,17 +50,67 @@ pub fn export_readme(family: &Family, levels: &[(usize, f64, usize, usize)]) -> 
     }
     out.push_str(MESH_TEXT);
     out.push_str(SOLVE_TEXT);
+    out.push_str(&loading_text(family, loading, viscoplastic));
+    out.push_str(SUPPORTS_TEXT);
     if viscoplastic {
         out.push_str(VISCOPLASTIC_TEXT);
     }
     out.push_str(WRITE_BACK_TEXT);
     let _ = writeln!(
         out,
-        "\n## This project's own solve of a level\n\n`{}` writes `out/solution.pvd` with its `.vtu` steps, which `grade` reads as it reads yours (`--solutions` holding `level_L.pvd` and the steps).",
-        family.solve_command(first)
+        "\n## This project's own solves\n\n`solve --out DIR` writes `DIR/solution.pvd` with its `.vtu` steps; `grade` reads a folder `level_L` per level as it reads `level_L.pvd` (one `.pvd`, or one `.vtu` or `.msh`, in it). Mortar's solves of every level, graded as yours would be (`--method nts` for the other cone):\n\n```sh"
+    );
+    for (level, ..) in levels {
+        let _ = writeln!(
+            out,
+            "{} --out cones/level_{level}",
+            family.solve_command(*level)
+        );
+    }
+    let _ = writeln!(
+        out,
+        "contact-rates grade {} {} --solutions cones --levels {first}-{last} --name own-mortar\n```",
+        family.option,
+        family.study.as_deref().unwrap_or(&scene.name),
     );
     out
 }
+
+/// What the loads do in time, and which body only the contact holds.
+fn loading_text(family: &Family, loading: &Loading, viscoplastic: bool) -> String {
+    let mut out = String::from("\n### The loading\n\n");
+    if loading.proportional {
+        out.push_str("The loads are proportional to t: every step's nodal loads are t_n / T times those at T (checked on every exported level to 1e-12 of the largest). ");
+        out.push_str(match viscoplastic {
+            false => "Both bodies are elastic, so the state at t_n is one solve with the loads at t_n: a code that solves t = T alone gives the state at T (`level_L.vtu`), graded at T only.\n",
+            true => "A viscoplastic body's state depends on its history: solve every step in turn.\n",
+        });
+    } else {
+        out.push_str("The loads are not proportional to t: solve every step with its own loads.\n");
+    }
+    if let Some(body) = loading.held_by_contact {
+        let _ = write!(
+            out,
+            "\nBody {} ('{}') is held along Gamma_C's normal by the contact alone: no support holds it there. A code that starts from u = 0 with the contact inactive sees a singular tangent (a rigid motion): start with every slave node in contact (the bodies touch at t = 0), or, in a penalty or augmented-Lagrangian code, from a start that presses body {} onto the other (a small displacement along Gamma_C's normal), so that the contact acts at the first iteration.\n",
+            body + 1,
+            family.scene.bodies[body].surface,
+            body + 1
+        );
+    }
+    out
+}
+
+const SUPPORTS_TEXT: &str = "
+### Supports
+
+`problem.toml`'s `[[supports]]` name a curve, its body and a `kind`, one of:
+
+| kind | condition on the curve |
+|---|---|
+| `clamp` | u = 0 |
+| `roller x` | u_x = 0; u_y free, with zero traction in y |
+| `roller y` | u_y = 0; u_x free, with zero traction in x |
+";
 
 const MESH_TEXT: &str = "
 ## The meshes
@@ -130,11 +186,25 @@ Fields (other names with `--displacement`, `--stress`, `--pressure`), in the sce
 Only P1 triangles are graded: split quadrilaterals into triangles, and write a P2 solution's
 vertex values as P1. Any mesh of the two bodies is accepted, not only these.
 
-**A pressure from contact forces or multipliers.** A nodal contact force F_i at slave node i
-(node-on-segment codes, GetFEM's nodal contact brick) is p_i = |F_i . nu^1| / w_i, with w_i
-half the length of the slave edges at node i. A multiplier that is already a traction
-(GetFEM's integral contact brick with a P1 multiplier, MOOSE's `contact_pressure`) is p as it
-is, sign flipped if it is negative in compression.
+**A pressure from contact forces or multipliers.** Write p at the slave curve's nodes,
+positive in compression, signed (a pulling force gives a negative p: do not take its
+absolute value, `grade` reads it as what the code did):
+- a nodal contact force F_i on slave node i (node-on-segment codes, GetFEM's nodal contact
+  brick, and a penalty code's forces summed at the slave nodes from its Gauss points) is
+  p_i = -(F_i . nu^1) / w_i, F_i the force the contact exerts on body 1 and w_i half the
+  length of the slave edges at node i (sum the slave side's forces only: the master side's
+  are their reaction);
+- a multiplier that is already a traction (GetFEM's integral contact brick with a P1
+  multiplier, MOOSE's `contact_pressure`) is p as it is, sign flipped if it is negative in
+  compression;
+- a scaled multiplier is p = the scale times the multiplier, sign as above: Kratos's mortar
+  ALM stores `LAGRANGE_MULTIPLIER_CONTACT_PRESSURE` divided by its `SCALE_FACTOR`
+  (p = -SCALE_FACTOR x that multiplier; examples/grade_kratos.py).
+
+`grade` checks the result: the resultant of p over Gamma_C at T against the exact one's; a
+negative ratio (the sign), or a ratio off 1 by more than 5% and the same to 1% at every
+level (a scale), or off by more than a factor 2 at every level (the units), is refused with
+the fix.
 
 **Converting with meshio** (`pip install meshio`), the element blocks numbered as the bodies:
 
