@@ -69,6 +69,16 @@ enum Command {
     /// Grade another code's solutions of an exported problem against the exact solution:
     /// errors, rates and verdicts beside this project's mortar and nts (reports/grade-NAME).
     Grade(GradeArgs),
+    /// Assemble the report of what real contact codes converge at (reports/codes) from grade
+    /// reports GRADES/PROBLEM/CODE/ (examples/codes/run.sh writes them).
+    Codes {
+        /// The folder of PROBLEM/CODE grade reports.
+        #[arg(long)]
+        grades: PathBuf,
+        /// Report folder.
+        #[arg(long, default_value = "reports/codes")]
+        out: PathBuf,
+    },
     /// Judge anyone's table of errors with the studies' rules: a CSV with columns h,error and
     /// optionally level, dofs, method, quantity (one verdict per method and quantity) and
     /// truth_error. Exits non-zero only where a threshold fails.
@@ -255,6 +265,11 @@ fn run() -> anyhow::Result<()> {
         }
         Command::Solve(args) => solve_one(&args.request()?),
         Command::Grade(args) => grade(args),
+        Command::Codes { grades, out } => {
+            contact_rates::external::codes::codes_report(&grades, &out)?;
+            println!("wrote {}", out.display());
+            Ok(())
+        }
         Command::Judge {
             file,
             threshold,

@@ -4,6 +4,7 @@
 //! integrals and rate verdicts as the studies, beside this project's two cones.
 
 pub mod checks;
+pub mod codes;
 pub mod export;
 pub mod family;
 pub mod grade;

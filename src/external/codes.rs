@@ -1,0 +1,412 @@
+//! `codes`: the report of what real contact codes converge at (reports/codes), assembled
+//! from `grade` reports, one per problem and code (`GRADES/PROBLEM/CODE/`), each graded beside
+//! this project's mortar and nts on the same meshes. The report leads with which cone each
+//! code sides with where the cones differ, and says where the levels cannot tell them apart.
+
+use super::checks::CheckRecord;
+use crate::error::{Error, Result};
+use crate::io::csv_bytes;
+use crate::report::folder::{write, write_folder};
+use crate::report::markdown::{Doc, Table};
+use crate::report::plot::{self, Series};
+use crate::verify::judge::AsymptoteRow;
+use crate::verify::quantity::Quantity;
+use crate::verify::rates::{Verdict, short_text};
+use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord, read};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// One row of reports/codes/errors.csv: one method's error in one quantity on one level of
+/// one problem (the cones once per problem).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct CodeError {
+    pub study: String,
+    pub method: MethodLabel,
+    pub level: usize,
+    pub h: f64,
+    pub dofs: usize,
+    pub quantity: Quantity,
+    pub error: f64,
+}
+
+/// One row of reports/codes/rates.csv: what one method's errors in one quantity support on
+/// one problem.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct CodeRate {
+    pub study: String,
+    pub method: MethodLabel,
+    pub quantity: Quantity,
+    pub rate: Option<f64>,
+    pub stderr: Option<f64>,
+    pub levels_used: String,
+    pub successive: String,
+    pub verdict: Verdict,
+    pub last_rate: Option<f64>,
+    /// What the errors give, in a few characters ([`short_text`]).
+    pub reads: String,
+}
+
+/// One row of reports/codes/checks.csv: a graded level's checks.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct CodeCheck {
+    pub study: String,
+    pub code: String,
+    pub level: usize,
+    pub error: f64,
+    pub residual: f64,
+    pub residual_limit: f64,
+    pub normal_imbalance: Option<f64>,
+    pub tangential: Option<f64>,
+    pub pulling: Option<f64>,
+    pub pressure_ratio: Option<f64>,
+    pub verdict: String,
+}
+
+/// One row of reports/codes/asymptotes.csv: a method read against its distance to mortar.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct CodeAsymptote {
+    pub study: String,
+    pub method: MethodLabel,
+    pub quantity: Quantity,
+    pub distance_verdict: Verdict,
+    pub asymptotic_rate: Option<f64>,
+    pub asymptotic_stderr: Option<f64>,
+    pub distance_sets_rate: Option<bool>,
+    pub finest_ratio: Option<f64>,
+}
+
+/// The grade reports of one problem.
+struct Problem {
+    study: String,
+    codes: Vec<String>,
+    errors: Vec<CodeError>,
+    rates: Vec<CodeRate>,
+    checks: Vec<CodeCheck>,
+    asymptotes: Vec<CodeAsymptote>,
+}
+
+/// The folders under `dir`, sorted.
+fn folders(dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut out: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| {
+            Error::input(
+                dir,
+                "--grades",
+                format!(
+                    "cannot read the folder ({e}); pass the folder of PROBLEM/CODE grade reports"
+                ),
+            )
+        })?
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.is_dir())
+        .collect();
+    out.sort();
+    Ok(out)
+}
+
+fn name(p: &Path) -> String {
+    p.file_name()
+        .map_or(String::new(), |f| f.to_string_lossy().to_string())
+}
+
+impl Problem {
+    /// The grade reports `dir/CODE/` of one problem: each code's rows, the cones' once.
+    fn read(dir: &Path) -> Result<Self> {
+        let study = name(dir);
+        let mut p = Problem {
+            study: study.clone(),
+            codes: Vec::new(),
+            errors: Vec::new(),
+            rates: Vec::new(),
+            checks: Vec::new(),
+            asymptotes: Vec::new(),
+        };
+        for code_dir in folders(dir)? {
+            let code = name(&code_dir);
+            let first = p.codes.is_empty();
+            let keep = |m: &MethodLabel| m.name() == code || (first && m.cone().is_some());
+            let errors: Vec<ErrorRecord> = read(&code_dir.join("errors.csv"))?;
+            p.errors.extend(
+                errors
+                    .into_iter()
+                    .filter(|r| keep(&r.method))
+                    .map(|r| CodeError {
+                        study: study.clone(),
+                        method: r.method,
+                        level: r.level,
+                        h: r.h,
+                        dofs: r.dofs,
+                        quantity: r.quantity,
+                        error: r.error,
+                    }),
+            );
+            let rates: Vec<RateRecord> = read(&code_dir.join("rates.csv"))?;
+            p.rates.extend(
+                rates
+                    .into_iter()
+                    .filter(|r| keep(&r.method))
+                    .map(|r| CodeRate {
+                        study: study.clone(),
+                        reads: short_text(r.verdict, r.rate, r.last_rate),
+                        method: r.method,
+                        quantity: r.quantity,
+                        rate: r.rate,
+                        stderr: r.stderr,
+                        levels_used: r.levels_used,
+                        successive: r.successive,
+                        verdict: r.verdict,
+                        last_rate: r.last_rate,
+                    }),
+            );
+            let checks: Vec<CheckRecord> = read(&code_dir.join("checks.csv"))?;
+            p.checks.extend(checks.into_iter().map(|c| CodeCheck {
+                study: study.clone(),
+                code: code.clone(),
+                level: c.level,
+                error: c.error,
+                residual: c.residual,
+                residual_limit: c.residual_limit,
+                normal_imbalance: c.normal_imbalance,
+                tangential: c.tangential,
+                pulling: c.pulling,
+                pressure_ratio: c.pressure_ratio,
+                verdict: c.verdict,
+            }));
+            let asymptotes = code_dir.join("asymptotes.csv");
+            if asymptotes.exists() {
+                let rows: Vec<AsymptoteRow> = read(&asymptotes)?;
+                p.asymptotes
+                    .extend(
+                        rows.into_iter()
+                            .filter(|r| keep(&r.method))
+                            .map(|r| CodeAsymptote {
+                                study: study.clone(),
+                                method: r.method,
+                                quantity: r.quantity,
+                                distance_verdict: r.distance_verdict,
+                                asymptotic_rate: r.asymptotic_rate,
+                                asymptotic_stderr: r.asymptotic_stderr,
+                                distance_sets_rate: r.distance_sets_rate,
+                                finest_ratio: r.finest_ratio,
+                            }),
+                    );
+            }
+            p.codes.push(code);
+        }
+        Ok(p)
+    }
+
+    /// The key quantity: the theorem norm, or l2_stress where no displacement is graded.
+    fn key(&self) -> Quantity {
+        match self.errors.iter().any(|r| r.quantity == Quantity::Theorem) {
+            true => Quantity::Theorem,
+            false => Quantity::L2Stress,
+        }
+    }
+
+    fn methods(&self) -> Vec<MethodLabel> {
+        let mut out: Vec<MethodLabel> = Vec::new();
+        for r in &self.errors {
+            if !out.contains(&r.method) {
+                out.push(r.method.clone());
+            }
+        }
+        out
+    }
+
+    fn finest(&self, m: &MethodLabel, q: Quantity) -> Option<&CodeError> {
+        self.errors
+            .iter()
+            .filter(|r| &r.method == m && r.quantity == q)
+            .max_by_key(|r| r.level)
+    }
+
+    fn rate(&self, m: &MethodLabel, q: Quantity) -> Option<&CodeRate> {
+        self.rates
+            .iter()
+            .find(|r| &r.method == m && r.quantity == q)
+    }
+
+    fn levels(&self) -> String {
+        let levels: Vec<usize> = self.errors.iter().map(|r| r.level).collect();
+        format!(
+            "{}-{}",
+            levels.iter().min().unwrap_or(&0),
+            levels.iter().max().unwrap_or(&0)
+        )
+    }
+}
+
+/// Which cone `code`'s finest key error is nearer (in ratio), or that the cones are
+/// within 5% of each other there.
+fn sides_with(p: &Problem, code: &MethodLabel) -> String {
+    let key = p.key();
+    let e = |m: &MethodLabel| p.finest(m, key).map(|r| r.error);
+    let (mortar, nts) = (
+        e(&MethodLabel::Cone(crate::contact::Method::Mortar)),
+        e(&MethodLabel::Cone(crate::contact::Method::Nts)),
+    );
+    let (Some(x), Some(m), Some(n)) = (e(code), mortar, nts) else {
+        return "-".into();
+    };
+    let far = |a: f64, b: f64| (a / b).ln().abs();
+    if far(m, n) < 0.05_f64.ln_1p() {
+        return format!("cones within 5% ({:.3}, {:.3} times)", x / m, x / n);
+    }
+    match far(x, m) <= far(x, n) {
+        true => format!("mortar ({:.3} times mortar's, {:.3} nts's)", x / m, x / n),
+        false => format!("nts ({:.3} times nts's, {:.3} mortar's)", x / n, x / m),
+    }
+}
+
+/// Assemble the report of the grade reports under `grades` into `out`, all or nothing.
+pub fn codes_report(grades: &Path, out: &Path) -> Result<()> {
+    let problems = folders(grades)?
+        .iter()
+        .map(|d| Problem::read(d))
+        .collect::<Result<Vec<_>>>()?;
+    if problems.is_empty() {
+        return Err(Error::input(
+            grades,
+            "--grades",
+            "holds no PROBLEM/CODE grade reports; run examples/codes/run.sh",
+        ));
+    }
+    write_folder(out, |d| {
+        let errors: Vec<&CodeError> = problems.iter().flat_map(|p| &p.errors).collect();
+        write(d, "errors.csv", &csv_bytes(&errors)?)?;
+        let rates: Vec<&CodeRate> = problems.iter().flat_map(|p| &p.rates).collect();
+        write(d, "rates.csv", &csv_bytes(&rates)?)?;
+        let checks: Vec<&CodeCheck> = problems.iter().flat_map(|p| &p.checks).collect();
+        write(d, "checks.csv", &csv_bytes(&checks)?)?;
+        let asymptotes: Vec<&CodeAsymptote> = problems.iter().flat_map(|p| &p.asymptotes).collect();
+        write(d, "asymptotes.csv", &csv_bytes(&asymptotes)?)?;
+        for p in &problems {
+            plot_problem(p, d)?;
+        }
+        write(d, "README.md", readme(&problems).as_bytes())
+    })
+}
+
+/// The key error against h of every method on one problem, `error_vs_h_STUDY.png`.
+fn plot_problem(p: &Problem, d: &Path) -> Result<()> {
+    let key = p.key();
+    let series: Vec<Series> = p
+        .methods()
+        .iter()
+        .enumerate()
+        .map(|(i, m)| Series {
+            label: format!(
+                "{m}: {}",
+                p.rate(m, key).map_or("-".into(), |r| r.reads.clone())
+            ),
+            points: p
+                .errors
+                .iter()
+                .filter(|r| &r.method == m && r.quantity == key)
+                .map(|r| (r.h, r.error))
+                .collect(),
+            markers: true,
+            line: true,
+            color: i,
+            thin: m.cone().is_some(),
+        })
+        .collect();
+    plot::loglog(
+        &d.join(format!("error_vs_h_{}.png", p.study)),
+        &format!("{}: error against h", p.study),
+        "h (max element diameter)",
+        &format!("relative error ({key})"),
+        &series,
+        &[(0.5, "1/2"), (1.0, "1")],
+    )
+}
+
+/// The README: per problem, each code's key rate, the cone it sides with, its contact
+/// quantities and its distance to mortar.
+fn readme(problems: &[Problem]) -> String {
+    let mut doc = Doc::new();
+    doc.heading(1, "What real contact codes converge at");
+    doc.paragraph(LEAD);
+    let flagged: Vec<String> = problems
+        .iter()
+        .flat_map(|p| &p.checks)
+        .filter(|c| c.verdict != "converged")
+        .map(|c| format!("{} {} level {}", c.study, c.code, c.level))
+        .collect();
+    doc.paragraph(match flagged.is_empty() {
+        true => format!(
+            "Every graded level passed grade's checks ({} levels: equilibrium residual, Gamma_C's forces, the pressure's resultant; checks.csv).",
+            problems.iter().map(|p| p.checks.len()).sum::<usize>()
+        ),
+        false => format!("**Not converged, no rate claimed**: {}.", flagged.join(", ")),
+    });
+    for p in problems {
+        section(&mut doc, p);
+    }
+    doc.heading(2, "How it is made");
+    doc.paragraph("`bash examples/codes/run.sh` exports each problem, solves it with examples/grade_getfem.py (both bricks) and examples/grade_kratos.py, grades every solution with `contact-rates grade` beside this project's cones, and assembles this folder with `contact-rates codes --grades DIR --out reports/codes`. errors.csv, rates.csv, checks.csv and asymptotes.csv hold every row, with the problem in the `study` column.");
+    doc.finish()
+}
+
+const LEAD: &str = "Three solvers of other projects, on the problems `export` writes: GetFEM 5.4's integral (mortar-type) and nodal (node-on-segment) contact bricks, and Kratos 10.4's mortar contact by the augmented Lagrangian method. Each is read beside this project's mortar (K_h^pi) and node-on-segment (K_h^I) cones on the same meshes, by the same judge. Where the cones differ (`crossover`, whose interface stays closed, and the singular `regularity` scenes) the node-on-segment brick sides with nts and the two mortar codes with mortar; on `rates-exact` the distance between the cones is a few percent of mortar's error at these levels, so no code can be told apart there, and its distance to mortar is `falling`: only `crossover` gives that distance an asymptotic rate.";
+
+fn section(doc: &mut Doc, p: &Problem) {
+    let key = p.key();
+    doc.heading(2, format!("{} (levels {})", p.study, p.levels()));
+    let mut table = Table::new([
+        "method",
+        &format!("{key} rate (verdict)"),
+        "finest error",
+        "sides with",
+        "l2_pressure (finest, reads)",
+        "distance to mortar / e_mortar (finest)",
+        "distance's verdict, asymptotic rate",
+    ]);
+    for m in p.methods() {
+        let rate = p.rate(&m, key);
+        let pressure = p.finest(&m, Quantity::L2Pressure).map_or("-".into(), |r| {
+            format!(
+                "{:.3e}, {}",
+                r.error,
+                p.rate(&m, Quantity::L2Pressure)
+                    .map_or("-".into(), |r| r.reads.clone())
+            )
+        });
+        let asymptote = p
+            .asymptotes
+            .iter()
+            .find(|a| a.method == m && a.quantity == key);
+        table.row([
+            format!("`{m}`"),
+            rate.map_or("-".into(), |r| match (r.verdict, r.rate, r.stderr) {
+                (Verdict::Fitted, Some(v), Some(s)) => format!("{v:.3} ± {s:.3} (fitted)"),
+                _ => format!("{} ({})", r.reads, r.verdict.name()),
+            }),
+            p.finest(&m, key)
+                .map_or("-".into(), |r| format!("{:.4e}", r.error)),
+            match m.cone() {
+                Some(_) => "-".into(),
+                None => sides_with(p, &m),
+            },
+            pressure,
+            asymptote
+                .and_then(|a| a.finest_ratio)
+                .map_or("-".into(), |r| format!("{r:.3}")),
+            asymptote.map_or("-".into(), |a| {
+                format!(
+                    "{}{}",
+                    a.distance_verdict.name(),
+                    a.asymptotic_rate
+                        .map_or(String::new(), |r| format!(", tends to {r:.3}"))
+                )
+            }),
+        ]);
+    }
+    doc.table(&table);
+    doc.image(
+        &format!("{}: error against h", p.study),
+        &format!("error_vs_h_{}.png", p.study),
+    );
+}
