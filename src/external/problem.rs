@@ -2,10 +2,10 @@
 //! expressions as sympy callables (problem.py), so that another code can solve exactly the
 //! problem this project solves and no user translates syntax by hand.
 
-use super::msh_write::ExportMesh;
 use crate::contact::Interface;
 use crate::expr::Expr;
 use crate::fe::Model;
+use crate::mesh::msh::ExportMesh;
 use crate::scene::Scene;
 use serde::Serialize;
 
