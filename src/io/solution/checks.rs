@@ -1,6 +1,6 @@
 //! Checks shared by the VTU and MSH readers: finite values, in-plane points and fields,
 //! symmetric plane stresses, both bodies present, the route for a refused element type, and
-//! the names a file has.
+//! the wording of a field missing.
 
 use super::Precision;
 use crate::error::{Error, Result};
@@ -202,6 +202,69 @@ pub(super) enum ElementKind {
     Other,
 }
 
+/// A field read by name, for the error of one missing: the grade flag that names it, the
+/// components a field of its kind has, and what grading without it means (`None`: the
+/// field is required).
+pub(super) struct Named {
+    flag: &'static str,
+    shapes: &'static [usize],
+    without: Option<&'static str>,
+}
+
+/// The nodal displacement: required, 2 or 3 components.
+pub(super) const DISPLACEMENT: Named = Named {
+    flag: "--displacement",
+    shapes: &[2, 3],
+    without: None,
+};
+
+/// The P0 stress: 3, 4 or 9 components; without it, E eps(u_h) is graded.
+pub(super) const STRESS: Named = Named {
+    flag: "--stress",
+    shapes: &[3, 4, 9],
+    without: Some("to grade E eps(u_h) in its place"),
+};
+
+/// The nodal pressure: 1 component; without it, the pressure quantities are not measured.
+pub(super) const PRESSURE: Named = Named {
+    flag: "--pressure",
+    shapes: &[1],
+    without: Some("(the pressure quantities are then not measured)"),
+};
+
+impl Named {
+    /// The fix of the field missing from a file whose fields of its kind (point arrays,
+    /// `$NodeData` views, ...) are `found`, as (name, components if known); `write` says
+    /// how to write it under the name looked for. Where a field found has the right number
+    /// of components, the fix is to pass its name with the flag (`pass --displacement u`).
+    pub(super) fn fix(&self, found: &[(&str, Option<usize>)], write: &str) -> String {
+        let mut passes: Vec<String> = Vec::new();
+        for &(name, components) in found {
+            let Some(k) = components.filter(|k| self.shapes.contains(k)) else {
+                continue;
+            };
+            let pass = format!(
+                "{} {} ({k} component{})",
+                self.flag,
+                shell_word(name),
+                if k == 1 { "" } else { "s" }
+            );
+            if !passes.contains(&pass) {
+                passes.push(pass);
+            }
+        }
+        let flag = self.flag;
+        match (passes.is_empty(), self.without) {
+            (false, None) => format!("pass {}, or {write}", passes.join(" or ")),
+            (false, Some(w)) => format!("pass {}, or leave {flag} out {w}", passes.join(" or ")),
+            (true, None) => {
+                format!("{write}, or pass {flag} with the name of the one that holds it")
+            }
+            (true, Some(w)) => format!("{write}, or leave {flag} out {w}"),
+        }
+    }
+}
+
 /// Names as a list, `'a', 'b'` (each once), or `none`.
 pub(super) fn quoted_list<'a>(names: impl Iterator<Item = &'a str>) -> String {
     let mut v: Vec<String> = Vec::new();
@@ -215,5 +278,15 @@ pub(super) fn quoted_list<'a>(names: impl Iterator<Item = &'a str>) -> String {
         "none".to_string()
     } else {
         v.join(", ")
+    }
+}
+
+/// `name` as one shell word: quoted where it holds anything but letters, digits and `_-./:`.
+fn shell_word(name: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "_-./:".contains(c);
+    if !name.is_empty() && name.chars().all(plain) {
+        name.to_string()
+    } else {
+        format!("'{}'", name.replace('\'', "'\\''"))
     }
 }

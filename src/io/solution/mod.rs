@@ -15,11 +15,14 @@
 //!
 //! Every refusal is an [`Error::input`](crate::error::Error::input) naming the file, the
 //! field (`PointData/displacement`, `CellData/body`, `Cells`, `$NodeData "displacement"
-//! (line 40)`, ...) and the fix. Counts in a file are checked against the bytes present
-//! before anything is allocated from them, so a corrupt header cannot ask for absurd
-//! memory. What must vanish (z, a third displacement component, the z row of a stress) or
-//! agree (s12 and s21) is judged to [`ROUNDING`] epsilons of the precision stored, relative
-//! to its array's size (`checks.rs`).
+//! (line 40)`, ...) and the fix. A field missing lists the fields of its kind the file has
+//! and, for one of the right number of components, the grade flag that reads it (`pass
+//! --displacement u`); a stress or pressure named other than by default is required. Counts
+//! in a file are checked against the bytes present before anything is allocated from them,
+//! so a corrupt header cannot ask for absurd memory. What must vanish (z, a third
+//! displacement component, the z row of a stress) or agree (s12 and s21) is judged to
+//! [`ROUNDING`] epsilons of the precision stored, relative to its array's size
+//! (`checks.rs`).
 //!
 //! Written by hand on quick-xml (the XML), base64 and flate2 (zlib) because no maintained
 //! Rust crate reads these files whole. Checked: vtkio's last release is 0.6.3 (2021); its
@@ -59,6 +62,20 @@ impl Default for FieldNames {
             stress: "stress".into(),
             pressure: "pressure".into(),
         }
+    }
+}
+
+impl FieldNames {
+    /// Whether the stress is named other than by default (`--stress`): a file without it
+    /// is then refused, where by default the stress is optional.
+    pub fn stress_named(&self) -> bool {
+        self.stress != FieldNames::default().stress
+    }
+
+    /// Whether the pressure is named other than by default (`--pressure`): a file without
+    /// it is then refused, where by default the pressure is optional.
+    pub fn pressure_named(&self) -> bool {
+        self.pressure != FieldNames::default().pressure
     }
 }
 

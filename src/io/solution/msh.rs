@@ -3,7 +3,8 @@
 //! surface, the nodes they use kept, and the views grouped into one step per time.
 
 use super::checks::{
-    ElementKind, check_both_bodies, conversion_route, displacement_2d, planar_points, stress_2d,
+    DISPLACEMENT, ElementKind, Named, PRESSURE, STRESS, check_both_bodies, conversion_route,
+    displacement_2d, planar_points, quoted_list, stress_2d,
 };
 use super::{FieldNames, Precision, SolutionMesh, SolutionStep};
 use crate::error::{Error, Result};
@@ -229,7 +230,8 @@ fn solution_mesh(
 }
 
 /// The views of each time, in time order: a view of the kind its field is (the stress per
-/// element, the others per node), one per field and time, and at least one.
+/// element, the others per node), one per field and time; a displacement in the file, and
+/// a stress or pressure named other than by default.
 fn views_by_time<'a>(
     file: &'a MshFile,
     path: &Path,
@@ -273,18 +275,72 @@ fn views_by_time<'a>(
             ));
         }
     }
-    if times.is_empty() {
-        return Err(Error::input(
+    let given = |k: usize| times.iter().any(|(_, views)| views[k].is_some());
+    if !given(0) {
+        return Err(missing_view(
+            file,
             path,
-            format!("$NodeData \"{}\"", names.displacement),
-            format!(
-                "no $NodeData view named '{}': write the displacement as a $NodeData view of that name per time step, or name the view the file has",
-                names.displacement
-            ),
+            &names.displacement,
+            &DISPLACEMENT,
+            false,
+            "write the displacement as a $NodeData view of that name per time step",
+        ));
+    }
+    if names.stress_named() && !given(1) {
+        return Err(missing_view(
+            file,
+            path,
+            &names.stress,
+            &STRESS,
+            true,
+            "write the P0 stress as an $ElementData view of that name per time step",
+        ));
+    }
+    if names.pressure_named() && !given(2) {
+        return Err(missing_view(
+            file,
+            path,
+            &names.pressure,
+            &PRESSURE,
+            false,
+            "write the nodal pressure as a $NodeData view of that name per time step",
         ));
     }
     times.sort_by(|a, b| a.0.total_cmp(&b.0));
     Ok(times)
+}
+
+/// The refusal of a file without a view named `name` of the field `named` (`per_element`:
+/// an `$ElementData` view): the views of its kind the file has, and the fix (`write` says
+/// how to write it under that name).
+fn missing_view(
+    file: &MshFile,
+    path: &Path,
+    name: &str,
+    named: &Named,
+    per_element: bool,
+    write: &str,
+) -> Error {
+    let section = if per_element {
+        "$ElementData"
+    } else {
+        "$NodeData"
+    };
+    let found: Vec<(&str, Option<usize>)> = file
+        .headers
+        .iter()
+        .filter(|h| h.per_element == per_element)
+        .map(|h| (h.name.as_str(), h.components))
+        .collect();
+    Error::input(
+        path,
+        format!("{section} \"{name}\""),
+        format!(
+            "no {section} view named '{name}' (the file's {section} views are {}): {}",
+            quoted_list(found.iter().map(|f| f.0)),
+            named.fix(&found, write)
+        ),
+    )
 }
 
 /// The nodes and triangles kept of a file, for the values of its views.

@@ -4,8 +4,8 @@
 //! decoded by `payload.rs`.
 
 use super::checks::{
-    ElementKind, check_both_bodies, conversion_route, displacement_2d, planar_points, quoted_list,
-    stress_2d,
+    DISPLACEMENT, ElementKind, PRESSURE, STRESS, check_both_bodies, conversion_route,
+    displacement_2d, planar_points, quoted_list, stress_2d,
 };
 use super::payload::{Appended, ArrayInfo, Numbers, Section};
 use super::vtu_xml::{VtuDocument, parse_vtu_xml, split_appended};
@@ -72,6 +72,13 @@ impl Grid<'_> {
     /// The names of the arrays of `section`, `'a', 'b'`, or `none`.
     fn names_in(&self, section: Section) -> String {
         quoted_list(self.arrays_in(section).map(|a| a.name.as_str()))
+    }
+
+    /// (name, components) of the arrays of `section`, for the fix of a field missing.
+    fn found_in(&self, section: Section) -> Vec<(&str, Option<usize>)> {
+        self.arrays_in(section)
+            .map(|a| (a.name.as_str(), Some(a.components)))
+            .collect()
     }
 
     /// Decode `a` as `tuples` tuples of its components, or as many as it holds (`None`).
@@ -342,10 +349,14 @@ impl Grid<'_> {
                 path,
                 format!("PointData/{d}"),
                 format!(
-                    "no point array '{d}'{} (the point arrays are {}): write the nodal displacement as point data named '{d}', or name the array the file has",
+                    "no point array '{d}'{} (the point arrays are {}): {}",
                     self.misplaced(d, Section::PointData, Section::CellData)
                         .unwrap_or_default(),
-                    self.names_in(Section::PointData)
+                    self.names_in(Section::PointData),
+                    DISPLACEMENT.fix(
+                        &self.found_in(Section::PointData),
+                        &format!("write the nodal displacement as point data named '{d}'")
+                    )
                 ),
             )
         })?;
@@ -381,6 +392,20 @@ impl Grid<'_> {
                     ),
                 ));
             }
+            if names.stress_named() {
+                return Err(Error::input(
+                    path,
+                    format!("CellData/{s}"),
+                    format!(
+                        "no cell array '{s}' (the cell arrays are {}): {}",
+                        self.names_in(Section::CellData),
+                        STRESS.fix(
+                            &self.found_in(Section::CellData),
+                            &format!("write the P0 stress as cell data named '{s}'")
+                        )
+                    ),
+                ));
+            }
             return Ok(None);
         };
         let (values, p) = self.numbers(a, Some(self.doc.cells))?;
@@ -401,6 +426,22 @@ impl Grid<'_> {
     fn pressure(&self, names: &FieldNames, precision: &mut Precision) -> Result<Option<Vec<f64>>> {
         let (path, q) = (self.path, &names.pressure);
         let Some(a) = self.get(Section::PointData, q) else {
+            if names.pressure_named() {
+                return Err(Error::input(
+                    path,
+                    format!("PointData/{q}"),
+                    format!(
+                        "no point array '{q}'{} (the point arrays are {}): {}",
+                        self.misplaced(q, Section::PointData, Section::CellData)
+                            .unwrap_or_default(),
+                        self.names_in(Section::PointData),
+                        PRESSURE.fix(
+                            &self.found_in(Section::PointData),
+                            &format!("write the nodal pressure as point data named '{q}'")
+                        )
+                    ),
+                ));
+            }
             return Ok(None);
         };
         if a.components != 1 {

@@ -5,7 +5,7 @@
 
 use super::cursor::{Cursor, Voice};
 use super::read_entities;
-use super::views::{View, read_view};
+use super::views::{View, ViewHeader, read_view};
 use crate::error::{Error, Result};
 use std::collections::HashMap;
 use std::path::Path;
@@ -47,6 +47,8 @@ pub struct MshFile {
     pub surface_elements: Vec<SurfaceElement>,
     /// The views asked for, in the file's order.
     pub views: Vec<View>,
+    /// Every view's header, asked for or not, in the file's order.
+    pub headers: Vec<ViewHeader>,
 }
 
 /// The refusal of a binary MSH, with the conversions to ASCII.
@@ -100,6 +102,7 @@ fn parse_text(text: &str, path: &Path, wanted: &[&str]) -> Result<MshFile> {
         node_tags: Vec::new(),
         surface_elements: Vec::new(),
         views: Vec::new(),
+        headers: Vec::new(),
     };
     let mut node_index: HashMap<u64, usize> = HashMap::new();
     let (mut format_seen, mut nodes_seen, mut elements_seen) = (false, false, false);
@@ -129,9 +132,9 @@ fn parse_text(text: &str, path: &Path, wanted: &[&str]) -> Result<MshFile> {
                 elements_seen = true;
             }
             "$NodeData" | "$ElementData" => {
-                if let Some(view) = read_view(&mut c, tok == "$ElementData", wanted)? {
-                    file.views.push(view);
-                }
+                let (header, view) = read_view(&mut c, tok == "$ElementData", wanted)?;
+                file.headers.push(header);
+                file.views.extend(view);
             }
             s if s.starts_with('$') && !s.starts_with("$End") => c.skip(s)?,
             other => {

@@ -21,6 +21,19 @@ pub struct View {
     data: Vec<f64>,
 }
 
+/// A view as its header gives it, read or skipped: for the errors that list the views a
+/// file has. `components` is `None` for a skipped view whose header does not read (a view
+/// not asked for is skipped unchecked).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ViewHeader {
+    /// `$ElementData` rather than `$NodeData`.
+    pub per_element: bool,
+    /// Its name.
+    pub name: String,
+    /// Values per node or element.
+    pub components: Option<usize>,
+}
+
 impl View {
     /// The error field of the view: `$NodeData "displacement" (time 0.5)`.
     pub fn field(&self) -> String {
@@ -61,9 +74,13 @@ impl View {
     }
 }
 
-/// Read a `$NodeData` or `$ElementData` view (its marker read); `None` for a view whose name
-/// is not one of `wanted` (skipped).
-pub fn read_view(c: &mut Cursor, per_element: bool, wanted: &[&str]) -> Result<Option<View>> {
+/// Read a `$NodeData` or `$ElementData` view (its marker read): its header, and the view if
+/// its name is one of `wanted` (else it is skipped).
+pub fn read_view(
+    c: &mut Cursor,
+    per_element: bool,
+    wanted: &[&str],
+) -> Result<(ViewHeader, Option<View>)> {
     let section = if per_element {
         "$ElementData"
     } else {
@@ -76,8 +93,13 @@ pub fn read_view(c: &mut Cursor, per_element: bool, wanted: &[&str]) -> Result<O
     }
     let name = strings.first().cloned().unwrap_or_default();
     if !wanted.contains(&name.as_str()) {
+        let header = ViewHeader {
+            per_element,
+            name,
+            components: peek_components(c),
+        };
         c.skip(section)?;
-        return Ok(None);
+        return Ok((header, None));
     }
     c.section = format!("{section} \"{name}\"");
     let (time, components, count) = read_tags(c)?;
@@ -106,7 +128,12 @@ pub fn read_view(c: &mut Cursor, per_element: bool, wanted: &[&str]) -> Result<O
         }
     }
     c.end(&format!("$End{}", &section[1..]))?;
-    Ok(Some(view))
+    let header = ViewHeader {
+        per_element,
+        name: view.name.clone(),
+        components: Some(components),
+    };
+    Ok((header, Some(view)))
 }
 
 /// A view's real and integer tags: its time (the first real tag), its components and its
@@ -139,4 +166,26 @@ fn read_tags(c: &mut Cursor) -> Result<(f64, usize, usize)> {
         )));
     }
     Ok((time, components as usize, count.max(0) as usize))
+}
+
+/// The components a skipped view's header announces, read ahead without moving `c` or
+/// refusing anything; `None` where the header does not read so. A header of more than a
+/// few real tags is not read ahead (gmsh writes one, the time), so that a corrupt count
+/// cannot make every skipped view scan the rest of the file.
+fn peek_components(c: &Cursor) -> Option<usize> {
+    let mut c = c.clone();
+    let reals: usize = c.token()?.parse().ok()?;
+    if reals > 8 {
+        return None;
+    }
+    for _ in 0..reals {
+        c.token()?;
+    }
+    let ints: usize = c.token()?.parse().ok()?;
+    if ints < 3 {
+        return None;
+    }
+    c.token()?;
+    let components: usize = c.token()?.parse().ok()?;
+    (components >= 1).then_some(components)
 }
