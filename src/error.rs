@@ -57,6 +57,14 @@ impl Error {
     }
 }
 
+/// The 1-based line of byte `at` in `text`, for a field such as `XML (line 12)`.
+pub fn line_of(text: &str, at: usize) -> usize {
+    1 + text.as_bytes()[..at.min(text.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+}
+
 /// Deserialize TOML `text` read from `file`; a syntax error, unknown key or missing field
 /// becomes one error naming the file, the line, the key (as a path: `bodies[0].young`) and
 /// the fix (`what` names the kind of file).

@@ -319,7 +319,11 @@ fn fields_are_found_by_the_names_given() {
         parse_vtu(&bytes, &path("named.vtu"), &FieldNames::default()),
         &path("named.vtu"),
         "PointData/displacement",
-        &["no point array 'displacement'", "'u'"],
+        &[
+            "no point array 'displacement'",
+            "'u'",
+            "pass --displacement u (3 components)",
+        ],
     );
     let text = solution_files::msh22(&[(0.5, &s)])
         .replace("\"displacement\"", "\"u\"")
@@ -625,7 +629,11 @@ fn a_missing_displacement_is_refused() {
     refused_vtu(
         &vtu_with(Encoding::Ascii, |v| v.remove("PointData", "displacement")),
         "PointData/displacement",
-        &["no point array 'displacement'", "'pressure', 'normal_jump'"],
+        &[
+            "no point array 'displacement'",
+            "'pressure', 'normal_jump'",
+            "or pass --displacement with the name of the one that holds it",
+        ],
     );
     // Found as cell data: the message says so.
     refused_vtu(
@@ -637,6 +645,97 @@ fn a_missing_displacement_is_refused() {
         }),
         "PointData/displacement",
         &["'displacement' is in CellData"],
+    );
+}
+
+/// The displacement under another name: the error lists the point arrays and names the
+/// grade flag that reads an array of 2 or 3 components.
+#[test]
+fn a_missing_displacement_names_the_flag_for_an_array_of_its_shape() {
+    for (components, encoding) in [(3, Encoding::Ascii), (2, Encoding::AppendedRaw)] {
+        let bytes = vtu_with(encoding, |v| {
+            let a = v.array_mut("PointData", "displacement");
+            a.name = "u".into();
+            if components == 2 {
+                a.components = 2;
+                a.values = a.values.chunks(3).flat_map(|t| [t[0], t[1]]).collect();
+            }
+        });
+        refused_vtu(
+            &bytes,
+            "PointData/displacement",
+            &[
+                "no point array 'displacement' (the point arrays are 'u', 'pressure', 'normal_jump')",
+                &format!(
+                    "pass --displacement u ({components} components), or write the nodal displacement as point data named 'displacement'"
+                ),
+            ],
+        );
+        // The flag read: the file reads.
+        let names = FieldNames {
+            displacement: "u".into(),
+            ..FieldNames::default()
+        };
+        assert!(parse_vtu(&bytes, &path("bad.vtu"), &names).is_ok());
+    }
+}
+
+/// A stress or pressure named with its flag and missing is refused (by default both are
+/// optional), with the flag for an array of its shape.
+#[test]
+fn a_named_stress_or_pressure_missing_is_refused_with_the_flag() {
+    let bytes = vtu_with(Encoding::Binary, |_| {});
+    let file = path("named.vtu");
+    let named = |stress: &str, pressure: &str| FieldNames {
+        stress: stress.into(),
+        pressure: pressure.into(),
+        ..FieldNames::default()
+    };
+    assert_refused(
+        parse_vtu(&bytes, &file, &named("sigma", "pressure")),
+        &file,
+        "CellData/sigma",
+        &[
+            "no cell array 'sigma' (the cell arrays are 'body', 'stress')",
+            "pass --stress stress (3 components), or leave --stress out to grade E eps(u_h) in its place",
+        ],
+    );
+    assert_refused(
+        parse_vtu(&bytes, &file, &named("stress", "p_n")),
+        &file,
+        "PointData/p_n",
+        &[
+            "no point array 'p_n'",
+            "pass --pressure pressure (1 component) or --pressure normal_jump (1 component), or leave --pressure out",
+        ],
+    );
+    // Under their default names they stay optional.
+    let bare = vtu_with(Encoding::Binary, |v| {
+        v.remove("CellData", "stress");
+        v.remove("PointData", "pressure");
+    });
+    let step = parse_vtu(&bare, &file, &FieldNames::default()).unwrap();
+    assert_eq!((step.stress, step.pressure), (None, None));
+    // In an MSH: the views of the kind the file has.
+    let text = msh(true);
+    assert_refused(
+        parse_msh_solution(text.as_bytes(), &file, &named("sigma", "pressure"), BODIES),
+        &file,
+        "$ElementData \"sigma\"",
+        &[
+            "no $ElementData view named 'sigma' (the file's $ElementData views are 'stress')",
+            "pass --stress stress (9 components)",
+        ],
+    );
+    // A name with a space is quoted for the shell.
+    assert_refused(
+        parse_msh_solution(text.as_bytes(), &file, &named("stress", "p_n"), BODIES),
+        &file,
+        "$NodeData \"p_n\"",
+        &[
+            "no $NodeData view named 'p_n' (the file's $NodeData views are 'displacement', 'von Mises', 'pressure')",
+            "pass --pressure 'von Mises' (1 component) or --pressure pressure (1 component)",
+        ],
     );
 }
 
@@ -1026,11 +1125,24 @@ fn quadrilaterals_in_a_body_are_refused() {
 
 #[test]
 fn a_missing_displacement_view_is_refused() {
-    for v41 in [true, false] {
+    for (v41, components) in [(true, 3), (false, 2)] {
+        // Under another name: the $NodeData views are listed, with the flag that reads one
+        // of the displacement's shape.
         refused_msh(
             msh(v41).replace("\"displacement\"", "\"u\"").as_bytes(),
-            "$NodeData \"displacement\" (time 0.5)",
-            &["no $NodeData view 'displacement' at time 0.5"],
+            "$NodeData \"displacement\"",
+            &[
+                "no $NodeData view named 'displacement' (the file's $NodeData views are 'u', ",
+                &format!(
+                    "pass --displacement u ({components} components), or write the displacement as a $NodeData view of that name per time step"
+                ),
+            ],
+        );
+        // Missing at one time (time 1, written first) only.
+        refused_msh(
+            msh(v41).replacen("\"displacement\"", "\"u\"", 1).as_bytes(),
+            "$NodeData \"displacement\" (time 1)",
+            &["no $NodeData view 'displacement' at time 1"],
         );
     }
     let text = msh(true);

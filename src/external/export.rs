@@ -5,10 +5,12 @@
 
 use super::family::Family;
 pub use super::family::Source;
-use super::msh_write::ExportMesh;
 use super::problem::{Origin, ProblemFile, problem_file, problem_py};
 use crate::error::{Error, Result};
+use crate::fe::Model;
 use crate::io::csv_bytes;
+use crate::mesh::RawMesh;
+use crate::mesh::msh::{ExportMesh, PhysicalGroup};
 use crate::report::folder::write;
 use crate::report::{Output, Staging};
 use crate::scene::Scene;
@@ -50,6 +52,49 @@ pub struct Exported {
     pub files: usize,
 }
 
+/// The mesh of `model` with its physical groups, the curves read from the mesh `raw` it
+/// was built on: the two bodies (surfaces 1 and 2, in the scene's order), then every
+/// physical curve that has edges on the model (tags from 3, by name).
+pub fn export_mesh(model: &Model, raw: &RawMesh) -> ExportMesh {
+    let nodes = (0..model.n_nodes).map(|g| model.position(g)).collect();
+    let mut groups: Vec<PhysicalGroup> = (0..2)
+        .map(|b| PhysicalGroup {
+            dim: 2,
+            tag: b + 1,
+            name: model.meshes[b].name.clone(),
+            elements: model.elements[model.body_elements(b)]
+                .iter()
+                .map(|e| e.nodes.to_vec())
+                .collect(),
+        })
+        .collect();
+    for name in raw.names_of_dim(1) {
+        let elements: Vec<Vec<usize>> = (0..2)
+            .flat_map(|b| {
+                let offset = model.node_offset[b];
+                model.meshes[b]
+                    .curve_edges(raw, &name)
+                    .into_iter()
+                    .map(move |e| vec![e[0] + offset, e[1] + offset])
+            })
+            .collect();
+        if !elements.is_empty() {
+            let tag = groups.len() + 1;
+            groups.push(PhysicalGroup {
+                dim: 1,
+                tag,
+                name,
+                elements,
+            });
+        }
+    }
+    ExportMesh {
+        nodes,
+        body_nodes: [0..model.node_offset[1], model.node_offset[1]..model.n_nodes],
+        groups,
+    }
+}
+
 /// Export `source` at `levels` into `out`, all or nothing.
 pub fn export(source: &Source, levels: &[usize], out: &Path) -> Result<Exported> {
     let family = Family::resolve(source)?;
@@ -70,7 +115,7 @@ pub fn export(source: &Source, levels: &[usize], out: &Path) -> Result<Exported>
     for &level in levels {
         let (case, raw) = family.case(level)?;
         let model = &case.problem.model;
-        let mesh = ExportMesh::new(model, &raw);
+        let mesh = export_mesh(model, &raw);
         write(&dir, &format!("mesh_{level}.msh"), mesh.msh41().as_bytes())?;
         write(
             &dir,

@@ -11,6 +11,5 @@ pub mod grade;
 pub mod grade_report;
 pub mod judge_file;
 pub mod mesh_in;
-pub mod msh_write;
 pub mod problem;
 mod readme;

@@ -2,10 +2,10 @@
 //! expressions as sympy callables (problem.py), so that another code can solve exactly the
 //! problem this project solves and no user translates syntax by hand.
 
-use super::msh_write::ExportMesh;
 use crate::contact::Interface;
 use crate::expr::Expr;
 use crate::fe::Model;
+use crate::mesh::msh::ExportMesh;
 use crate::scene::Scene;
 use serde::Serialize;
 
@@ -351,6 +351,15 @@ pub fn problem_py(
     derived_stress: [bool; 2],
 ) -> String {
     let mut out = String::new();
+    py_preamble(&mut out, problem);
+    py_fields(&mut out, problem);
+    py_boundary_and_check(&mut out, problem, samples, derived_stress);
+    out
+}
+
+/// problem.py's docstring, imports and parsing helpers; the times and each body's
+/// constants.
+fn py_preamble(out: &mut String, problem: &ProblemFile) {
     let mut line = |s: String| {
         out.push_str(&s);
         out.push('\n');
@@ -403,6 +412,14 @@ pub fn problem_py(
         ));
     }
     line("}".into());
+}
+
+/// problem.py's exact fields (displacement, stress, pressure) and body forces.
+fn py_fields(out: &mut String, problem: &ProblemFile) {
+    let mut line = |s: String| {
+        out.push_str(&s);
+        out.push('\n');
+    };
     match &problem.exact.displacement {
         Some(u) => line(format!(
             "displacement = {{1: {}, 2: {}}}",
@@ -435,6 +452,20 @@ pub fn problem_py(
         }
     }
     line("}".into());
+}
+
+/// problem.py's tractions, the pieces of Gamma_C, which stresses are derived, the sample
+/// points and the check itself.
+fn py_boundary_and_check(
+    out: &mut String,
+    problem: &ProblemFile,
+    samples: &[Vec<[f64; 2]>; 2],
+    derived_stress: [bool; 2],
+) {
+    let mut line = |s: String| {
+        out.push_str(&s);
+        out.push('\n');
+    };
     line(
         "# Per traction curve: its body, its outward normal (None where it varies), (g_x, g_y)."
             .into(),
@@ -482,7 +513,6 @@ pub fn problem_py(
     }
     line("}".into());
     line(CHECK_PY.into());
-    out
 }
 
 /// problem.py's check: sympy derives from the given fields what the file gives as derived.

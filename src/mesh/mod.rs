@@ -1,5 +1,5 @@
-//! Meshes: gmsh runs and caching ([`gmsh`]), the MSH 4.1 reader ([`msh`]), and the
-//! per-body triangulation used by everything downstream ([`BodyMesh`]).
+//! Meshes: gmsh runs and caching ([`gmsh`]), gmsh's MSH format read and written ([`msh`]),
+//! and the per-body triangulation used by everything downstream ([`BodyMesh`]).
 
 pub mod gmsh;
 pub mod msh;

@@ -92,6 +92,20 @@ impl Split {
     }
 }
 
+/// The gradient d u_c / d x_d of the P1 displacement with nodal values `uh` on a triangle
+/// whose shape functions have the gradients `grads`.
+fn p1_gradient(uh: &[[f64; 2]; 3], grads: &[[f64; 2]; 3]) -> [[f64; 2]; 2] {
+    let mut grad_h = [[0.0; 2]; 2];
+    for a in 0..3 {
+        for c in 0..2 {
+            for d in 0..2 {
+                grad_h[c][d] += uh[a][c] * grads[a][d];
+            }
+        }
+    }
+    grad_h
+}
+
 /// s11^2 + s22^2 + 2 s12^2, its part `p`, each component as (whole, singular part).
 fn tensor_square(p: Split, s: [(f64, f64); 3]) -> f64 {
     p.product(s[0], s[0]) + p.product(s[1], s[1]) + 2.0 * p.product(s[2], s[2])
@@ -130,14 +144,7 @@ impl<'a> ExactComparison<'a> {
             let b = el.body;
             let pos = el.nodes.map(|n| m.position(n));
             let uh = el.nodes.map(|n| [s.u[2 * n], s.u[2 * n + 1]]);
-            let mut grad_h = [[0.0; 2]; 2];
-            for a in 0..3 {
-                for c in 0..2 {
-                    for d in 0..2 {
-                        grad_h[c][d] += uh[a][c] * el.grads[a][d];
-                    }
-                }
-            }
+            let grad_h = p1_gradient(&uh, &el.grads);
             let sh = [s.stress[i][0], s.stress[i][1], s.stress[i][2]];
             for (part, rule) in
                 quadrature::singular::rules(pos, &kinks[b], &self.triangle, point, &powers)

@@ -11,8 +11,6 @@
 //! Written by hand: the two formats' ASCII forms are a few lines each, and the maintained
 //! crate (mshio) reads MSH but does not write it.
 
-use crate::fe::Model;
-use crate::mesh::RawMesh;
 use std::fmt::Write as _;
 
 /// A physical group: gmsh's dimension (1 curve, 2 surface), its tag and name, and its
@@ -24,8 +22,9 @@ pub struct PhysicalGroup {
     pub elements: Vec<Vec<usize>>,
 }
 
-/// The mesh of a model with its physical groups: the two bodies (tags 1 and 2, in the
-/// scene's order) and every physical curve of the mesh (tags from 3, by name).
+/// The mesh of two bodies with their physical groups: the two bodies (tags 1 and 2, in the
+/// scene's order) and every physical curve of the mesh (tags from 3, by name); made from a
+/// model by `external::export`.
 pub struct ExportMesh {
     /// Node coordinates by global node number (length units of the scene).
     pub nodes: Vec<[f64; 2]>,
@@ -36,48 +35,6 @@ pub struct ExportMesh {
 }
 
 impl ExportMesh {
-    /// The mesh of `model`, whose physical curves are read from the mesh `raw` it was built
-    /// on.
-    pub fn new(model: &Model, raw: &RawMesh) -> Self {
-        let nodes = (0..model.n_nodes).map(|g| model.position(g)).collect();
-        let mut groups: Vec<PhysicalGroup> = (0..2)
-            .map(|b| PhysicalGroup {
-                dim: 2,
-                tag: b + 1,
-                name: model.meshes[b].name.clone(),
-                elements: model.elements[model.body_elements(b)]
-                    .iter()
-                    .map(|e| e.nodes.to_vec())
-                    .collect(),
-            })
-            .collect();
-        for name in raw.names_of_dim(1) {
-            let elements: Vec<Vec<usize>> = (0..2)
-                .flat_map(|b| {
-                    let offset = model.node_offset[b];
-                    model.meshes[b]
-                        .curve_edges(raw, &name)
-                        .into_iter()
-                        .map(move |e| vec![e[0] + offset, e[1] + offset])
-                })
-                .collect();
-            if !elements.is_empty() {
-                let tag = groups.len() + 1;
-                groups.push(PhysicalGroup {
-                    dim: 1,
-                    tag,
-                    name,
-                    elements,
-                });
-            }
-        }
-        ExportMesh {
-            nodes,
-            body_nodes: [0..model.node_offset[1], model.node_offset[1]..model.n_nodes],
-            groups,
-        }
-    }
-
     /// The body (0 or 1) whose nodes carry the physical curve `name`, if the mesh has it.
     pub fn body_of_curve(&self, name: &str) -> Option<usize> {
         let g = self.groups.iter().find(|g| g.dim == 1 && g.name == name)?;
