@@ -17,7 +17,7 @@ one of GetFEM's contact bricks, solved at every t_n by GetFEM's Newton:
   --brick integral  add_integral_contact_between_nonmatching_meshes_brick: the small-sliding
                     integral (mortar-type) brick, Alart-Curnier, with a P1 multiplier on the
                     slave curve; the master displacement is projected onto the slave curve
-                    once, in the reference configuration (a fixed interface);
+                    once, in the reference configuration (a fixed interface); r = 100 E / h;
   --brick nodal     add_nodal_contact_between_nonmatching_meshes_brick: node-on-segment, one
                     multiplier (a nodal force) per slave node, master segments found once in
                     the reference configuration.
@@ -49,17 +49,19 @@ BULK_RULE = "IM_TRIANGLE(2)"
 # the master field projected onto the slave edge, which is piecewise linear with kinks where
 # master nodes project, and the positive part of the augmented multiplier, which kinks where
 # contact ends. No rule is exact across those kinks: each slave edge is cut in 16 pieces, with
-# IM_TRIANGLE(6)'s edge rule on each. On rates-exact level 4 the distance to mortar's
-# solution (grade's cone_distance) is 7.4e-6 with this rule, 3.0e-5 with 4 pieces and 5.8e-4
-# with IM_TRIANGLE(6) alone (r = E), for ~25% more Newton time than 4 pieces.
+# IM_TRIANGLE(6)'s edge rule on each. With r = E, on rates-exact level 4, the distance to
+# mortar's solution (grade's cone_distance) is 7.4e-6 with this rule, 3.0e-5 with 4 pieces and
+# 5.8e-4 with IM_TRIANGLE(6) alone, for ~25% more Newton time than 4 pieces (1.5e-6 with
+# this rule and r = R_FACTOR E / h).
 CONTACT_RULE = "IM_STRUCTURED_COMPOSITE(IM_TRIANGLE(6),16)"
 # The integral brick's discrete problem depends on Alart-Curnier's r: its multiplier equation
-# is the L2 projection of lambda = -(lambda - r [u.nu])_- onto the P1 multipliers, not the
-# mortar conditions. r = c E / h (a traction per gap, as Nitsche's gamma) keeps it near mortar:
-# on regularity/beta-0.75 (a singular pressure) levels 2-4, the distance to mortar D is
-# 0.08 (c = 10) and 0.008 (c = 100) of mortar's error, falling at mortar's rate; with GetFEM's
-# advice r = E it falls at 0.68 against mortar's 0.79 (0.35 of mortar's error at level 5),
-# and r = 10 E or 100 E do not follow the mesh (D grows from level 3 to 4 at 1000 E).
+# is lambda = min(0, lambda - r [u.nu]) tested against the P1 multipliers (integrated, not
+# node by node), not the mortar conditions. r = c E / h (a traction per gap, as Nitsche's
+# gamma) keeps it near mortar: on regularity/beta-0.75 (a singular pressure) levels 2-4, the
+# distance to mortar D is 0.08 (c = 10) and 0.008 (c = 100) of mortar's error, falling at
+# mortar's rate. With GetFEM's advice r = E, D falls at 0.68 against mortar's 0.79 (0.35 of
+# mortar's error at level 5); a fixed r of 10 E to 1000 E does not follow the mesh either (D
+# falls slower than mortar's error, or grows at 1000 E).
 R_FACTOR = 100.0
 # Newton: GetFEM 5.4 stops when |R|_1 / approx_external_load_norm < max_res (or when the
 # step is small), R the whole residual (force, constraint and contact rows); that norm is 1
