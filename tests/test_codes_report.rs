@@ -65,7 +65,7 @@ fn the_committed_codes_report_says_what_its_csvs_hold() {
                 .filter(|r| &r.study == study && r.method.name() == method && r.quantity == key)
                 .max_by_key(|r| r.level)
                 .unwrap();
-            assert_eq!(row[2], format!("{:.4e}", finest.error), "{study} {method}");
+            assert_eq!(row[3], format!("{:.4e}", finest.error), "{study} {method}");
             let rate = rates
                 .iter()
                 .find(|r| &r.study == study && r.method.name() == method && r.quantity == key)
@@ -73,15 +73,15 @@ fn the_committed_codes_report_says_what_its_csvs_hold() {
             match (rate.verdict, rate.rate, rate.stderr) {
                 (Verdict::Fitted, Some(v), Some(s)) => {
                     assert_eq!(
-                        row[1],
+                        row[2],
                         format!("{v:.3} ± {s:.3} (fitted)"),
                         "{study} {method}"
                     )
                 }
                 _ => assert!(
-                    row[1].starts_with(&rate.reads),
+                    row[2].starts_with(&rate.reads),
                     "{study} {method}: {}",
-                    row[1]
+                    row[2]
                 ),
             }
         }

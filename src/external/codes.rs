@@ -281,7 +281,7 @@ fn sides_with(p: &Problem, code: &MethodLabel) -> String {
         return match x <= EXACT {
             true => "mortar: exact, as mortar".into(),
             false => format!(
-                "not exact, as nts ({:.3} times nts's error; mortar exact)",
+                "not exact, as nts ({:.2e} times nts's error; mortar exact)",
                 x / n
             ),
         };
@@ -399,7 +399,7 @@ fn readme(problems: &[Problem]) -> String {
     doc.finish()
 }
 
-const LEAD: &str = "Three solvers of other projects, on the problems `export` writes: GetFEM 5.4's integral (mortar-type) and nodal (node-on-segment) contact bricks, and Kratos 10.4's mortar contact by the augmented Lagrangian method. Each is read beside this project's mortar (K_h^pi) and node-on-segment (K_h^I) cones on the same meshes, by the same judge. Where the cones differ (`crossover`, whose interface stays closed, and the singular `regularity` scenes) the node-on-segment brick sides with nts and the two mortar codes with mortar; on `rates-exact` the distance between the cones is a few percent of mortar's error at these levels, so no code can be told apart there, and its distance to mortar is `falling`: only `crossover` gives that distance an asymptotic rate.";
+const LEAD: &str = "Three solvers of other projects, on the problems `export` writes: GetFEM 5.4's integral (mortar-type) and nodal (node-on-segment) contact bricks, and Kratos 10.4's mortar contact by the augmented Lagrangian method. Each is read beside this project's mortar (K_h^pi) and node-on-segment (K_h^I) cones on the same meshes, by the same judge. Where the cones differ (`crossover`, whose interface stays closed, and `regularity-1.50`, singular at the transition; the rest of the regularity family is not graded here yet) the node-on-segment brick sides with nts and the two mortar codes with mortar; on `rates-exact` the distance between the cones is a few percent of mortar's error at these levels, so no code can be told apart there, and its distance to mortar is `falling`: only `crossover` gives that distance an asymptotic rate.";
 
 fn section(doc: &mut Doc, p: &Problem) {
     let key = p.key();
