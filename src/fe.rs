@@ -1082,6 +1082,15 @@ impl Model {
         }
     }
 
+    /// The elastic stress C eps(u) of every element (the displacement `u` over global dofs):
+    /// an elastic body's stress, and the energy product's other factor for any body.
+    pub fn elastic_stresses(&self, u: &[f64]) -> Vec<Stress> {
+        self.elements
+            .iter()
+            .map(|e| self.materials[e.body].elastic.apply(&e.strain(u)))
+            .collect()
+    }
+
     /// Elastic tangents of all elements (E of each body).
     pub fn elastic_tangents(&self) -> Vec<Matrix3<f64>> {
         self.elements

@@ -112,12 +112,7 @@ fn converged_solves_pass_every_check_and_wrong_pressures_are_refused() {
 
 /// K v over the global dofs: the internal force of the elastic stress of `v`.
 fn stiffness_times(model: &Model, v: &[f64]) -> Vec<f64> {
-    let stress: Vec<_> = model
-        .elements
-        .iter()
-        .map(|e| model.materials[e.body].elastic.apply(&e.strain(v)))
-        .collect();
-    model.internal_force(&stress)
+    model.internal_force(&model.elastic_stresses(v))
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -162,11 +157,7 @@ fn stopped_early(case: &Case, sol: &Solved, share: f64) -> Vec<State> {
             let alpha = dot(&r, &r) / dot(&stiffness_times(model, &r), &r);
             u.iter_mut().zip(&r).for_each(|(x, y)| *x += alpha * y);
         }
-        let sigma = model
-            .elements
-            .iter()
-            .map(|e| model.materials[e.body].elastic.apply(&e.strain(&u)))
-            .collect();
+        let sigma = model.elastic_stresses(&u);
         states.push(State {
             time: target.time,
             u,
@@ -209,11 +200,7 @@ fn tied(case: &Case, sol: &Solved) -> Vec<State> {
         x.resize(n + m, 0.0);
         system.solve(&mut x);
         let u = model.expand(&x[..n]);
-        let sigma = model
-            .elements
-            .iter()
-            .map(|e| model.materials[e.body].elastic.apply(&e.strain(&u)))
-            .collect();
+        let sigma = model.elastic_stresses(&u);
         states.push(State {
             time: target.time,
             u,

@@ -224,8 +224,9 @@ fn contact_balance(
     })
 }
 
-/// The equilibrium checks of one level's steps on `model` (maxima over the steps).
-pub fn equilibrium(model: &Model, interface: &Interface, steps: &[P1Field]) -> Result<LevelCheck> {
+/// The checks of one level's steps on `model`: equilibrium and Gamma_C's forces (maxima
+/// over the steps), and the pressure's resultant at the last step, T.
+pub fn check_level(model: &Model, interface: &Interface, steps: &[P1Field]) -> Result<LevelCheck> {
     let nodes = ContactNodes::new(interface);
     let held = nodes.held(model);
     let system = match held.n_free {
@@ -233,16 +234,15 @@ pub fn equilibrium(model: &Model, interface: &Interface, steps: &[P1Field]) -> R
         _ => Some(factored_stiffness(&held)?),
     };
     let mut out = LevelCheck::default();
+    let mut load = Vec::new();
     for step in steps {
-        let load = model.load(step.time)?;
+        load = model.load(step.time)?;
         let internal = model.internal_force(&step.stress);
         let reaction: Vec<f64> = internal.iter().zip(&load).map(|(a, b)| a - b).collect();
-        let elastic: Vec<_> = model
-            .elements
-            .iter()
-            .map(|e| model.materials[e.body].elastic.apply(&e.strain(&step.u)))
-            .collect();
-        let energy: f64 = dot(&model.internal_force(&elastic), &step.u);
+        let energy: f64 = dot(
+            &model.internal_force(&model.elastic_stresses(&step.u)),
+            &step.u,
+        );
         if let Some(system) = &system {
             let r = held.restrict(&reaction);
             let mut z = r.clone();
@@ -258,6 +258,9 @@ pub fn equilibrium(model: &Model, interface: &Interface, steps: &[P1Field]) -> R
             out.pulling = max(out.pulling, p);
         }
     }
+    if let Some(last) = steps.last() {
+        out.pressure_ratio = pressure_ratio(model, interface, last, &load);
+    }
     Ok(out)
 }
 
@@ -267,11 +270,15 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 /// The resultant of the file's pressure at T over the reference's: the exact pressure's
 /// integral over Gamma_C, or where only the contact holds a body along Gamma_C's normal,
-/// that body's normal load. `None` without a pressure or a reference.
-pub fn pressure_ratio(model: &Model, interface: &Interface, last: &P1Field) -> Result<Option<f64>> {
-    let Some(profile) = &last.pressure else {
-        return Ok(None);
-    };
+/// that body's normal load (from `load`, the nodal loads at T). `None` without a pressure
+/// or a reference.
+fn pressure_ratio(
+    model: &Model,
+    interface: &Interface,
+    last: &P1Field,
+    load: &[f64],
+) -> Option<f64> {
+    let profile = last.pressure.as_ref()?;
     let given: f64 = profile
         .iter()
         .flat_map(|piece| piece.windows(2))
@@ -280,11 +287,9 @@ pub fn pressure_ratio(model: &Model, interface: &Interface, last: &P1Field) -> R
             (b[0] - a[0]).hypot(b[1] - a[1]) * 0.5 * (w[0].1 + w[1].1)
         })
         .sum();
-    let reference = match exact_resultant(model, interface, last.time) {
-        Some(r) => Some(r),
-        None => normal_load(model, interface, last.time)?,
-    };
-    Ok(reference.filter(|r| r.abs() > 0.0).map(|r| given / r))
+    let reference = exact_resultant(model, interface, last.time)
+        .or_else(|| normal_load(model, interface, load))?;
+    (reference.abs() > 0.0).then(|| given / reference)
 }
 
 /// The exact pressure's integral over Gamma_C at `t`, by 8 Gauss points on each segment of
@@ -307,18 +312,15 @@ fn exact_resultant(model: &Model, interface: &Interface, t: f64) -> Option<f64> 
 
 /// Where only the contact holds a body along Gamma_C's (straight) normal, its load along
 /// that normal toward the other body: the contact resultant equilibrium gives.
-fn normal_load(model: &Model, interface: &Interface, t: f64) -> Result<Option<f64>> {
-    let Some(body) = interface.held_only_by_contact(model) else {
-        return Ok(None);
-    };
+fn normal_load(model: &Model, interface: &Interface, load: &[f64]) -> Option<f64> {
+    let body = interface.held_only_by_contact(model)?;
     let n = interface.pieces[0].normal;
-    let load = model.load(t)?;
     let nodes = model.node_offset[body]..model.node_offset[body] + model.meshes[body].nodes.len();
     let along: f64 = nodes
         .map(|g| load[2 * g] * n[0] + load[2 * g + 1] * n[1])
         .sum();
     // Body 1 pushes along nu^1 onto body 2; body 2 along -nu^1.
-    Ok(Some(if body == 0 { along } else { -along }))
+    Some(if body == 0 { along } else { -along })
 }
 
 /// Refuses pressures whose resultants `ratios` (per level, with its file) are of the wrong

@@ -12,7 +12,7 @@ use crate::report::plot::{self, Series};
 use crate::verify::judge::AsymptoteRow;
 use crate::verify::quantity::Quantity;
 use crate::verify::rates::{Verdict, short_text};
-use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord, read};
+use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord, methods_in_order, read};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -219,13 +219,7 @@ impl Problem {
     }
 
     fn methods(&self) -> Vec<MethodLabel> {
-        let mut out: Vec<MethodLabel> = Vec::new();
-        for r in &self.errors {
-            if !out.contains(&r.method) {
-                out.push(r.method.clone());
-            }
-        }
-        out
+        methods_in_order(self.errors.iter().map(|r| &r.method))
     }
 
     fn finest(&self, m: &MethodLabel, q: Quantity) -> Option<&CodeError> {

@@ -711,10 +711,7 @@ fn grade_level(
     if let Some(mortar) = mortar {
         errors.extend(distance_to_mortar(&history, mortar, &scale));
     }
-    let mut check = checks::equilibrium(&outside.model, &outside.interface, &history.steps)?;
-    if let Some(last) = history.steps.last() {
-        check.pressure_ratio = checks::pressure_ratio(&outside.model, &outside.interface, last)?;
-    }
+    let check = checks::check_level(&outside.model, &outside.interface, &history.steps)?;
     let graded = GradedLevel {
         check,
         level,

@@ -11,19 +11,13 @@ use crate::report::plot::{self, Series};
 use crate::verify::judge::RateRow;
 use crate::verify::quantity::Quantity;
 use crate::verify::rates::Verdict;
-use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord};
+use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord, methods_in_order};
 use std::path::Path;
 
 impl Graded {
     /// The methods in the order of the report: the graded code first.
     fn methods(&self) -> Vec<MethodLabel> {
-        let mut out: Vec<MethodLabel> = Vec::new();
-        for r in &self.errors {
-            if !out.contains(&r.method) {
-                out.push(r.method.clone());
-            }
-        }
-        out
+        methods_in_order(self.errors.iter().map(|r| &r.method))
     }
 
     fn rate(&self, method: &MethodLabel, q: Quantity) -> Option<&RateRow> {

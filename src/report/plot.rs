@@ -48,11 +48,12 @@ fn titled_figure<'p>(
 }
 
 /// Colours of the series (colour-blind friendly).
-pub const COLORS: [RGBColor; 4] = [
+pub const COLORS: [RGBColor; 5] = [
     RGBColor(0, 114, 178),
     RGBColor(213, 94, 0),
     RGBColor(0, 0, 0),
     RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
 ];
 
 /// Font size of the tick labels of [`loglog`] and [`lines`] (pixels).

@@ -161,11 +161,7 @@ fn elastic_stress(model: &Model, u: &[f64]) -> Result<Vec<Stress>, FieldError> {
             why: "has a constitutive source (the scene gives its exact stress)",
         });
     }
-    Ok(model
-        .elements
-        .iter()
-        .map(|e| model.materials[e.body].elastic.apply(&e.strain(u)))
-        .collect())
+    Ok(model.elastic_stresses(u))
 }
 
 /// The pressure of a discrete solution of this project's solver: the nodal multiplier over

@@ -107,6 +107,17 @@ impl<'de> Deserialize<'de> for Verdict {
     }
 }
 
+/// The distinct methods of `labels`, in the order they first appear (a report's order).
+pub fn methods_in_order<'a>(labels: impl IntoIterator<Item = &'a MethodLabel>) -> Vec<MethodLabel> {
+    let mut out: Vec<MethodLabel> = Vec::new();
+    for m in labels {
+        if !out.contains(m) {
+            out.push(m.clone());
+        }
+    }
+    out
+}
+
 /// One row of errors.csv: one method's error in one quantity on one level.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ErrorRecord {
