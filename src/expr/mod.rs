@@ -8,10 +8,15 @@
 //! derivative to be continuous, the branches agree at z = 0, so the choice there does not
 //! matter.
 
+mod program;
+
 use crate::error::{Error, Result};
 use exmex::Differentiate;
 use exmex::prelude::*;
+pub use program::Program;
+use std::cell::RefCell;
 use std::path::Path;
+use std::sync::Arc;
 
 /// Inputs an expression may read: x, y, t, pi, then the sign variables s0, s1, ...
 const NAMED: [&str; 4] = ["x", "y", "t", "pi"];
@@ -29,6 +34,14 @@ pub struct Expr {
     slots: Vec<usize>,
     /// The arguments z_k of the `abs` calls, whose signs are the s_k.
     signs: Vec<Expr>,
+    /// The expression compiled ([`Program`]); None if exmex wrote text the compiler does
+    /// not read (then exmex evaluates it).
+    program: Option<Arc<Program>>,
+}
+
+thread_local! {
+    /// Scratch registers of [`Expr::eval`].
+    static REGISTERS: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
 }
 
 impl Expr {
@@ -54,7 +67,9 @@ impl Expr {
             flat: Box::new(flat),
             slots,
             signs,
-        })
+            program: None,
+        }
+        .compiled())
     }
 
     /// A number as an expression.
@@ -62,14 +77,40 @@ impl Expr {
         Self::parse(&format!("{v}"), Path::new(""), "").expect("a number parses")
     }
 
+    /// This expression with its [`Program`].
+    fn compiled(mut self) -> Self {
+        self.program = compile(&[&self]).map(Arc::new);
+        self
+    }
+
     /// Evaluate at (x, y, t). Non-finite values are returned as they are; callers check.
     pub fn eval(&self, x: f64, y: f64, t: f64) -> f64 {
+        if let Some(program) = &self.program {
+            let mut out = [0.0];
+            REGISTERS.with_borrow_mut(|r| program.eval_point(x, y, t, r, &mut out));
+            return out[0];
+        }
+        self.eval_interpreted(x, y, t)
+    }
+
+    /// Whether [`Expr::eval`] runs a compiled [`Program`].
+    pub fn is_compiled(&self) -> bool {
+        self.program.is_some()
+    }
+
+    /// Evaluate with exmex's evaluator (what [`Expr::eval`] falls back to, and what the
+    /// compiled program is checked against).
+    pub fn eval_interpreted(&self, x: f64, y: f64, t: f64) -> f64 {
         let mut inputs = [0.0f64; 16];
         inputs[..4].copy_from_slice(&[x, y, t, std::f64::consts::PI]);
         for (k, z) in self.signs.iter().enumerate() {
             // sign(0) = +1: at a kink the branches' derivatives agree where the law needs
             // them to.
-            inputs[4 + k] = if z.eval(x, y, t) < 0.0 { -1.0 } else { 1.0 };
+            inputs[4 + k] = if z.eval_interpreted(x, y, t) < 0.0 {
+                -1.0
+            } else {
+                1.0
+            };
         }
         let mut vals = [0.0f64; 16];
         for (k, &s) in self.slots.iter().enumerate() {
@@ -105,7 +146,9 @@ impl Expr {
             flat: Box::new(derivative),
             slots,
             signs: self.signs.clone(),
+            program: None,
         }
+        .compiled()
     }
 
     /// The expression in the syntax scenes are written in (x, y, t, pi, numbers, + - * / ^,
@@ -166,8 +209,48 @@ impl Expr {
             flat: Box::new(flat),
             slots,
             signs,
+            program: None,
         }
+        .compiled()
     }
+}
+
+/// The expressions compiled into one [`Program`] whose outputs are their values, in order:
+/// the operations they share are computed once. None if one of them holds text the compiler
+/// does not read.
+pub fn compile(exprs: &[&Expr]) -> Option<Program> {
+    let mut builder = program::Builder::default();
+    let outputs = exprs
+        .iter()
+        .map(|e| compile_into(&mut builder, e))
+        .collect::<std::result::Result<Vec<u32>, String>>()
+        .ok()?;
+    Some(builder.program(&outputs))
+}
+
+fn compile_into(b: &mut program::Builder, e: &Expr) -> std::result::Result<u32, String> {
+    let mut signs = Vec::with_capacity(e.signs.len());
+    for z in &e.signs {
+        let node = compile_into(b, z)?;
+        signs.push(b.branch(node));
+    }
+    let variable = |b: &mut program::Builder, name: &str| match name {
+        "x" => Some(b.x()),
+        "y" => Some(b.y()),
+        "t" => Some(b.t()),
+        "pi" => Some(b.constant(std::f64::consts::PI)),
+        _ => {
+            let k: usize = name.strip_prefix('s')?.parse().ok()?;
+            signs.get(k).copied()
+        }
+    };
+    // The deep form's text is exmex's own structure, fully parenthesized (a parsed
+    // expression's `unparse` is its source text, in the user's precedence).
+    let deep = (*e.flat)
+        .clone()
+        .to_deepex()
+        .map_err(|err| err.to_string())?;
+    b.compile(deep.unparse(), &variable)
 }
 
 /// `text` with every number in exponent notation (as exmex unparses very small or large
@@ -311,14 +394,15 @@ pub fn distinct_kinks<'a>(exprs: impl IntoIterator<Item = &'a Expr>) -> Vec<&'a 
 
 /// Each kink of `kinks` at time `t` as a function of the point, for
 /// [`crate::quadrature::split_triangle`] and [`crate::quadrature::segment_rule`].
-pub fn kink_functions<'a>(kinks: &[&'a Expr], t: f64) -> Vec<Box<dyn Fn([f64; 2]) -> f64 + 'a>> {
+pub fn kink_functions<'a>(kinks: &[&'a Expr], t: f64) -> Vec<KinkFunction<'a>> {
     kinks
         .iter()
-        .map(|&z| {
-            Box::new(move |x: [f64; 2]| z.eval(x[0], x[1], t)) as Box<dyn Fn([f64; 2]) -> f64 + 'a>
-        })
+        .map(|&z| Box::new(move |x: [f64; 2]| z.eval(x[0], x[1], t)) as KinkFunction<'a>)
         .collect()
 }
+
+/// A kink as a function of the point (shared by the threads of a load integral).
+pub type KinkFunction<'a> = Box<dyn Fn([f64; 2]) -> f64 + Send + Sync + 'a>;
 
 /// A vector field given by two expressions.
 #[derive(Debug, Clone)]

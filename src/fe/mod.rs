@@ -3,7 +3,7 @@
 //! loads from tractions and body forces, and assembly of internal force and tangent.
 
 use crate::error::{Error, Result};
-use crate::expr::{distinct_kinks, kink_functions};
+use crate::expr::kink_functions;
 use crate::material::{LANES, Material, Strain, Stress};
 use crate::mesh::{BodyMesh, MeshSource, RawMesh};
 use crate::quadrature;
@@ -11,6 +11,8 @@ use crate::scene::Scene;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
+
+mod load;
 use std::path::Path;
 
 /// Marker for a constrained degree of freedom.
@@ -439,30 +441,6 @@ impl Model {
         })
     }
 
-    /// The traction sigma(u) n of the manufactured solution on traction edge `e`, of the
-    /// scene's `traction[i]`.
-    fn derived_traction(&self, e: usize, i: usize, x: f64, y: f64, t: f64) -> Result<[f64; 2]> {
-        let (body, n) = self.traction_normals[e];
-        let s = self
-            .scene
-            .exact
-            .as_ref()
-            .and_then(|ex| ex.stress_at(body, x, y, t))
-            .expect("a scene without g on a traction is manufactured, with a stress");
-        let g = crate::analytical::traction(s, n);
-        if g.iter().any(|v| !v.is_finite()) {
-            return Err(Error::input(
-                &self.scene.file,
-                "exact",
-                format!(
-                    "the traction on traction[{i}] (curve '{}') derived from the exact fields is not finite at x = {x}, y = {y}, t = {t}; fix the displacement (or the stress)",
-                    self.scene.tractions[i].curve
-                ),
-            ));
-        }
-        Ok(g)
-    }
-
     /// Coordinates of global node `g`.
     pub fn position(&self, g: usize) -> [f64; 2] {
         if g < self.node_offset[1] {
@@ -624,116 +602,6 @@ impl Model {
             })
             .collect();
         (pattern, slots)
-    }
-
-    /// External load vector at time `t` over global dofs (force): tractions on their edges
-    /// (8 Gauss-Legendre points, exact to degree 15) and body forces on the triangles
-    /// ([`quadrature::dunavant8`], degree 8). Where a load expression changes branch (an `abs`) inside an element,
-    /// the element is split along the branch's zero line and the rule applied on each piece
-    /// ([`quadrature::triangle_rule`], [`quadrature::segment_rule`]): the load of a
-    /// manufactured field is then as exact on a kinked element as on a smooth one (for an
-    /// affine branch argument; see [`quadrature::split_triangle`] otherwise).
-    pub fn load(&self, t: f64) -> Result<Vec<f64>> {
-        let mut f = vec![0.0; 2 * self.n_nodes];
-        let (segment, triangle) = (quadrature::gauss_legendre(8), quadrature::dunavant8());
-        let exact = self.scene.exact.as_deref();
-        // The kinks at t of each traction's expressions (a derived traction: of the body's
-        // stress), built once per call rather than per edge.
-        let traction_kinks: Vec<_> = self
-            .scene
-            .tractions
-            .iter()
-            .map(|tr| match &tr.g {
-                Some(g) => kink_functions(&distinct_kinks(&g.0), t),
-                None => Vec::new(),
-            })
-            .collect();
-        let stress_kinks = [0, 1].map(|b| match exact.and_then(|e| e.stress.as_ref()) {
-            Some(st) => kink_functions(&distinct_kinks(&st[b]), t),
-            None => Vec::new(),
-        });
-        for (e, &(i, [a, b])) in self.traction_edges.iter().enumerate() {
-            let (pa, pb) = (self.position(a), self.position(b));
-            let len = (pb[0] - pa[0]).hypot(pb[1] - pa[1]);
-            let kinks = match &self.scene.tractions[i].g {
-                Some(_) => &traction_kinks[i],
-                None => &stress_kinks[self.traction_normals[e].0],
-            };
-            for &(s, w) in quadrature::segment_rule(pa, pb, kinks, &segment).iter() {
-                let x = pa[0] + s * (pb[0] - pa[0]);
-                let y = pa[1] + s * (pb[1] - pa[1]);
-                let g = match &self.scene.tractions[i].g {
-                    Some(g) => g.eval(x, y, t, &self.scene.file, &format!("traction[{i}].g"))?,
-                    None => self.derived_traction(e, i, x, y, t)?,
-                };
-                let w = w * len;
-                for c in 0..2 {
-                    f[2 * a + c] += w * (1.0 - s) * g[c];
-                    f[2 * b + c] += w * s * g[c];
-                }
-            }
-        }
-        for body in 0..2 {
-            let Some(bf) = &self.scene.bodies[body].body_force else {
-                continue;
-            };
-            let kinks = kink_functions(&distinct_kinks(&bf.0), t);
-            // A manufactured scene derives the body force from its exact fields.
-            let derived = exact.is_some_and(|e| e.body_force.is_some());
-            let field = format!("bodies[{}].body_force", self.scene.bodies[body].file_index);
-            // A singular part's load r^(beta-2) (times P1, smooth along the rays) and the
-            // rest of the load, each with its own rule on the triangles at the point.
-            let singular = exact.and_then(|e| e.singular.as_ref());
-            let powers = singular.map_or([0.0; 2], |s| [0.0, s.exponent - 2.0]);
-            let point = singular.map(|s| s.point);
-            for e in self.elements.iter().filter(|e| e.body == body) {
-                let p = e.nodes.map(|n| self.position(n));
-                for (part, rule) in
-                    quadrature::singular::rules(p, &kinks, &triangle, point, &powers)
-                {
-                    for &(l1, l2, w) in rule.iter() {
-                        let lam = [1.0 - l1 - l2, l1, l2];
-                        let x = lam[0] * p[0][0] + lam[1] * p[1][0] + lam[2] * p[2][0];
-                        let y = lam[0] * p[0][1] + lam[1] * p[1][1] + lam[2] * p[2][1];
-                        let v = if derived {
-                            let whole = || [bf.0[0].eval(x, y, t), bf.0[1].eval(x, y, t)];
-                            let sing = || {
-                                let fs = &singular.expect("a part is singular").body_force[body];
-                                [fs[0].eval(x, y, t), fs[1].eval(x, y, t)]
-                            };
-                            let v = match part {
-                                None => whole(),
-                                // The rest: smooth at the point.
-                                Some(0) => {
-                                    let (a, b) = (whole(), sing());
-                                    [a[0] - b[0], a[1] - b[1]]
-                                }
-                                Some(_) => sing(),
-                            };
-                            if v.iter().any(|c| !c.is_finite()) {
-                                return Err(Error::input(
-                                    &self.scene.file,
-                                    "exact",
-                                    format!(
-                                        "the body force -div sigma of body '{}' derived from the exact fields is not finite at x = {x}, y = {y}, t = {t}; fix the displacement (or the stress)",
-                                        self.scene.bodies[body].surface
-                                    ),
-                                ));
-                            }
-                            v
-                        } else {
-                            bf.eval(x, y, t, &self.scene.file, &field)?
-                        };
-                        for a in 0..3 {
-                            for c in 0..2 {
-                                f[2 * e.nodes[a] + c] += w * e.area * lam[a] * v[c];
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        Ok(f)
     }
 
     /// The constitutive source of a manufactured solution at time `t`, per element: the
