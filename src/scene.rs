@@ -641,23 +641,40 @@ fn exact_solution(
     if spec.manufactured {
         check_manufactured(displacement.is_some(), stress.is_some(), bodies, file)?;
     }
-    let mut exact = Exact::new(
-        displacement,
-        stress,
-        pressure,
-        spec.manufactured,
-        [&bodies[0].material, &bodies[1].material],
-    );
+    // The exact fields and the singular part's, derived side by side. With a singular part
+    // and no given stress, the whole fields are the smooth part's plus the singular part's:
+    // exmex differentiates the two small displacements, not their sum (its cost grows
+    // faster than the expression).
+    let materials = [&bodies[0].material, &bodies[1].material];
+    let mut exact = match singular {
+        Some((sp, part, smooth)) if stress.is_none() => {
+            let smooth_copy = smooth.clone();
+            let (smooth_fields, singular) = rayon::join(
+                || Exact::new(Some(smooth_copy), None, None, spec.manufactured, materials),
+                || crate::analytical::Singular::new(sp.point, sp.exponent, part, smooth, materials),
+            );
+            Exact::with_singular(displacement, pressure, smooth_fields, singular)
+        }
+        singular => {
+            let (mut exact, singular) = rayon::join(
+                || Exact::new(displacement, stress, pressure, spec.manufactured, materials),
+                || {
+                    singular.map(|(sp, part, smooth)| {
+                        crate::analytical::Singular::new(
+                            sp.point,
+                            sp.exponent,
+                            part,
+                            smooth,
+                            materials,
+                        )
+                    })
+                },
+            );
+            exact.singular = singular;
+            exact
+        }
+    };
     exact.asymmetry = asymmetry;
-    exact.singular = singular.map(|(sp, part, smooth)| {
-        crate::analytical::Singular::new(
-            sp.point,
-            sp.exponent,
-            part,
-            smooth,
-            [&bodies[0].material, &bodies[1].material],
-        )
-    });
     if let Some(f) = &exact.body_force {
         for (b, body) in bodies.iter_mut().enumerate() {
             body.body_force = Some(VectorExpr(f[b].clone()));

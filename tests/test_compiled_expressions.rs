@@ -123,3 +123,30 @@ fn compiled_programs_agree_with_exmex_on_every_scene() {
     println!("{checked} expressions, largest difference {worst:.2e} of the field's size");
     assert!(checked > 100, "only {checked} expressions found");
 }
+
+/// Reference: the regularity family's exact solution (src/analytical/singular.rs): r^beta
+/// Phi(theta) at c = (0.5871, 1), written with powers (r^2)^(k/4).
+/// Goal: the body force of `regularity-1.50` (five fractional powers of r^2 after two
+/// differentiations) compiled with its two components together takes the fourth root of
+/// one base, r^2, once: two square roots for both components, every power a product of it.
+/// Data: scenes/regularity-1.50.toml, body 1.
+#[test]
+fn regularity_body_force_takes_one_fourth_root() {
+    let scene = Scene::load("regularity-1.50").unwrap();
+    let f = &scene.exact.as_ref().unwrap().body_force.as_ref().unwrap()[0];
+    let together = contact_rates::expr::compile(&[&f[0], &f[1]]).unwrap();
+    let apart: usize = f
+        .iter()
+        .map(|e| contact_rates::expr::compile(&[e]).unwrap().operations())
+        .sum();
+    println!(
+        "body force of body 1: {} operations together, {apart} compiled apart, {} square roots",
+        together.operations(),
+        together.square_roots()
+    );
+    assert_eq!(together.square_roots(), 2);
+    assert!(
+        together.operations() < apart,
+        "the components share no work"
+    );
+}

@@ -2,7 +2,8 @@
 # reports/codes: what real contact codes converge at. Exports each problem, solves it with
 # GetFEM 5.4 (both contact bricks) and Kratos 10.4 (mortar ALM), grades every solution beside
 # this project's cones, and assembles reports/codes. Not run in CI (the libraries are not
-# installed there); about 40 minutes on 2 cores.
+# installed there); about 90 minutes on 2 cores, most of it Kratos's regularity solves
+# (about 5 minutes each at level 5).
 #
 # Install first:
 #   apt-get install -y python3-getfem                      # GetFEM 5.4, Debian's python3
@@ -20,8 +21,12 @@ export OMP_NUM_THREADS=1
 problems=(
   "rates-exact rates-exact 0-4"
   "crossover crossover 0-6"
+  "regularity-0.60 regularity/beta-0.60 0-5"
   "regularity-0.75 regularity/beta-0.75 0-5"
+  "regularity-0.90 regularity/beta-0.90 0-5"
+  "regularity-1.25 regularity/beta-1.25 0-5"
   "regularity-1.50 regularity/beta-1.50 0-5"
+  "regularity-2.00 regularity/beta-2.00 0-5"
   "patch patch 0-3"
 )
 rm -rf "$work/grades"

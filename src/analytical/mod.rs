@@ -83,9 +83,14 @@ impl Singular {
         smooth: [Displacement; 2],
         materials: [&Material; 2],
     ) -> Self {
-        let gradient = [gradient(&displacement[0]), gradient(&displacement[1])];
-        let stress = [0, 1].map(|b| elastic_stress(materials[b], &gradient[b]));
-        let body_force = [body_force(&stress[0]), body_force(&stress[1])];
+        let derived = per_body(|b| {
+            let g = gradient(&displacement[b]);
+            let s = elastic_stress(materials[b], &g);
+            let f = body_force(&s);
+            (g, s, f)
+        });
+        let [(g0, s0, f0), (g1, s1, f1)] = derived;
+        let (gradient, stress, body_force) = ([g0, g1], [s0, s1], [f0, f1]);
         Singular {
             point,
             exponent,
@@ -101,6 +106,13 @@ impl Singular {
     pub fn distance(&self, x: f64, y: f64) -> f64 {
         (x - self.point[0]).hypot(y - self.point[1])
     }
+}
+
+/// `f` of body 0 and of body 1, side by side: exmex's symbolic derivatives of a
+/// manufactured scene take tenths of a second per body (regularity family).
+pub fn per_body<T: Send>(f: impl Fn(usize) -> T + Sync) -> [T; 2] {
+    let (a, b) = rayon::join(|| f(0), || f(1));
+    [a, b]
 }
 
 /// Two displacements added component by component.
@@ -174,9 +186,7 @@ impl Exact {
         manufactured: bool,
         materials: [&Material; 2],
     ) -> Self {
-        let gradient = displacement
-            .as_ref()
-            .map(|u| [gradient(&u[0]), gradient(&u[1])]);
+        let gradient = displacement.as_ref().map(|u| per_body(|b| gradient(&u[b])));
         let elastic = materials.iter().all(|m| m.viscoplastic.is_none());
         let stress_given = stress.is_some();
         let stress = stress.or_else(|| {
@@ -186,7 +196,7 @@ impl Exact {
         let body_force = stress
             .as_ref()
             .filter(|_| manufactured)
-            .map(|s| [body_force(&s[0]), body_force(&s[1])]);
+            .map(|s| per_body(|b| body_force(&s[b])));
         let source_rate = match (&gradient, &stress) {
             (Some(g), Some(s)) if manufactured && stress_given => {
                 Some([0, 1].map(|b| source_rate(materials[b], &g[b], &s[b])))
@@ -202,6 +212,40 @@ impl Exact {
             source_rate,
             asymmetry: [None, None],
             singular: None,
+        }
+    }
+
+    /// The exact solution whose fields are `smooth`'s (derived from the smooth part of the
+    /// displacement) plus `singular`'s, field by field; `displacement` is their sum, given.
+    pub fn with_singular(
+        displacement: Option<[Displacement; 2]>,
+        pressure: Option<Expr>,
+        smooth: Exact,
+        singular: Singular,
+    ) -> Self {
+        let add = |a: &Expr, b: &Expr| Expr::combine(&[(1.0, a), (1.0, b)]);
+        let gradient = smooth.gradient.as_ref().map(|g| {
+            [0, 1].map(|b| {
+                [0, 1].map(|c| [0, 1].map(|d| add(&g[b][c][d], &singular.gradient[b][c][d])))
+            })
+        });
+        let stress = smooth
+            .stress
+            .as_ref()
+            .map(|s| [0, 1].map(|b| [0, 1, 2].map(|k| add(&s[b][k], &singular.stress[b][k]))));
+        let body_force = smooth
+            .body_force
+            .as_ref()
+            .map(|f| [0, 1].map(|b| [0, 1].map(|c| add(&f[b][c], &singular.body_force[b][c]))));
+        Exact {
+            displacement,
+            gradient,
+            stress,
+            pressure,
+            body_force,
+            source_rate: smooth.source_rate,
+            asymmetry: [None, None],
+            singular: Some(singular),
         }
     }
 

@@ -16,7 +16,7 @@ use exmex::prelude::*;
 pub use program::Program;
 use std::cell::RefCell;
 use std::path::Path;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 /// Inputs an expression may read: x, y, t, pi, then the sign variables s0, s1, ...
 const NAMED: [&str; 4] = ["x", "y", "t", "pi"];
@@ -34,9 +34,14 @@ pub struct Expr {
     slots: Vec<usize>,
     /// The arguments z_k of the `abs` calls, whose signs are the s_k.
     signs: Vec<Expr>,
-    /// The expression compiled ([`Program`]); None if exmex wrote text the compiler does
-    /// not read (then exmex evaluates it).
-    program: Option<Arc<Program>>,
+    /// Whether `flat`'s text is exmex's own fully parenthesized form (a derivative, or a
+    /// combination of such), which [`compile`] reads directly; a parsed expression's text
+    /// is its source, in the user's precedence, and goes through exmex's deep form first.
+    raw: bool,
+    /// The expression compiled ([`Program`]) at its first evaluation (a derived field's
+    /// intermediate steps are never evaluated); None inside if exmex wrote text the
+    /// compiler does not read (then exmex evaluates it).
+    program: OnceLock<Option<Arc<Program>>>,
 }
 
 thread_local! {
@@ -67,9 +72,9 @@ impl Expr {
             flat: Box::new(flat),
             slots,
             signs,
-            program: None,
-        }
-        .compiled())
+            raw: false,
+            program: OnceLock::new(),
+        })
     }
 
     /// A number as an expression.
@@ -77,15 +82,16 @@ impl Expr {
         Self::parse(&format!("{v}"), Path::new(""), "").expect("a number parses")
     }
 
-    /// This expression with its [`Program`].
-    fn compiled(mut self) -> Self {
-        self.program = compile(&[&self]).map(Arc::new);
-        self
+    /// Its [`Program`], compiled at the first call.
+    fn program(&self) -> Option<&Program> {
+        self.program
+            .get_or_init(|| compile(&[self]).map(Arc::new))
+            .as_deref()
     }
 
     /// Evaluate at (x, y, t). Non-finite values are returned as they are; callers check.
     pub fn eval(&self, x: f64, y: f64, t: f64) -> f64 {
-        if let Some(program) = &self.program {
+        if let Some(program) = self.program() {
             let mut out = [0.0];
             REGISTERS.with_borrow_mut(|r| program.eval_point(x, y, t, r, &mut out));
             return out[0];
@@ -95,7 +101,7 @@ impl Expr {
 
     /// Whether [`Expr::eval`] runs a compiled [`Program`].
     pub fn is_compiled(&self) -> bool {
-        self.program.is_some()
+        self.program().is_some()
     }
 
     /// Evaluate with exmex's evaluator (what [`Expr::eval`] falls back to, and what the
@@ -146,9 +152,9 @@ impl Expr {
             flat: Box::new(derivative),
             slots,
             signs: self.signs.clone(),
-            program: None,
+            raw: true,
+            program: OnceLock::new(),
         }
-        .compiled()
     }
 
     /// The expression in the syntax scenes are written in (x, y, t, pi, numbers, + - * / ^,
@@ -209,9 +215,9 @@ impl Expr {
             flat: Box::new(flat),
             slots,
             signs,
-            program: None,
+            raw: terms.iter().all(|(_, e)| e.raw),
+            program: OnceLock::new(),
         }
-        .compiled()
     }
 }
 

@@ -551,6 +551,22 @@ impl Program {
         self.code.is_empty()
     }
 
+    /// Number of square roots it takes (a fourth root is two).
+    pub fn square_roots(&self) -> usize {
+        self.code
+            .iter()
+            .filter(|op| matches!(op, Op::Unary(Unary::Sqrt, _)))
+            .count()
+    }
+
+    /// Number of operations other than x, y, t and constants.
+    pub fn operations(&self) -> usize {
+        self.code
+            .iter()
+            .filter(|op| matches!(op, Op::Unary(..) | Op::Binary(..)))
+            .count()
+    }
+
     /// Number of outputs.
     pub fn n_outputs(&self) -> usize {
         self.outputs.len()

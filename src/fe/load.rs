@@ -19,30 +19,34 @@ use std::sync::{Arc, Mutex};
 static FIELDS: Mutex<Vec<(u64, Arc<Vec<f64>>)>> = Mutex::new(Vec::new());
 const FIELDS_KEPT: usize = 4;
 
-/// The load's expressions of a model, compiled.
-struct LoadPrograms<'m> {
+/// The load's expressions of a model, compiled (once per model: [`Model::load`] keeps them).
+#[derive(Debug)]
+pub(crate) struct LoadPrograms {
     /// Per traction curve with a given g: its two components.
     given: Vec<Option<Program>>,
     /// Per body, for the tractions derived from the exact stress: s11, s22, s12.
     stress: [Option<Program>; 2],
     /// Per body with a body force: its program and what the singular rules need.
-    body: [Option<BodyForce<'m>>; 2],
+    body: [Option<BodyForce>; 2],
+    /// [`LoadPrograms::fingerprint`] of the model they were compiled for.
+    fingerprint: u64,
 }
 
-struct BodyForce<'m> {
+#[derive(Debug)]
+struct BodyForce {
     /// The two components.
     whole: Program,
     /// The two components, then the singular part's two (a manufactured scene with a
     /// singular point).
     with_singular: Option<Program>,
-    /// Its expressions (for the kinks).
-    exprs: Vec<&'m Expr>,
+    /// Its expressions (for the kinks and messages).
+    exprs: Vec<Expr>,
     /// Derived from the exact fields (the error then says so).
     derived: bool,
 }
 
-impl<'m> LoadPrograms<'m> {
-    fn new(model: &'m Model) -> Self {
+impl LoadPrograms {
+    fn new(model: &Model) -> Self {
         let scene = &model.scene;
         let exact = scene.exact.as_deref();
         let compiled = |exprs: &[&Expr]| {
@@ -62,7 +66,7 @@ impl<'m> LoadPrograms<'m> {
         let derived = exact.is_some_and(|e| e.body_force.is_some());
         let body = [0, 1].map(|b| {
             let bf = scene.bodies[b].body_force.as_ref()?;
-            let exprs: Vec<&Expr> = bf.0.iter().collect();
+            let exprs: Vec<Expr> = bf.0.to_vec();
             let with_singular = exact
                 .and_then(|e| e.singular.as_ref())
                 .filter(|_| derived)
@@ -71,17 +75,20 @@ impl<'m> LoadPrograms<'m> {
                     compiled(&[&bf.0[0], &bf.0[1], &fs[0], &fs[1]])
                 });
             Some(BodyForce {
-                whole: compiled(&exprs),
+                whole: compiled(&[&bf.0[0], &bf.0[1]]),
                 with_singular,
                 exprs,
                 derived,
             })
         });
-        LoadPrograms {
+        let mut programs = LoadPrograms {
             given,
             stress,
             body,
-        }
+            fingerprint: 0,
+        };
+        programs.fingerprint = programs.fingerprint(model);
+        programs
     }
 
     /// The k with the whole load t^k times a field of (x, y) for t > 0, if there is one.
@@ -136,6 +143,14 @@ impl<'m> LoadPrograms<'m> {
     }
 }
 
+/// Forget every load integrated so far (the speed study times a fresh process's work).
+pub fn forget_loads() {
+    FIELDS
+        .lock()
+        .expect("no thread panics holding the loads")
+        .clear();
+}
+
 impl Model {
     /// External load vector at time `t` over global dofs (force): tractions on their edges
     /// (8 Gauss-Legendre points, exact to degree 15) and body forces on the triangles
@@ -147,11 +162,13 @@ impl Model {
     /// [`quadrature::split_triangle`] otherwise). A load t^k g(x, y) is integrated once, at
     /// t = 1, and scaled by t^k (for t > 0).
     pub fn load(&self, t: f64) -> Result<Vec<f64>> {
-        let programs = LoadPrograms::new(self);
+        let programs = self
+            .load_programs
+            .get_or_init(|| Arc::new(LoadPrograms::new(self)));
         let Some(k) = programs.time_degree().filter(|_| t > 0.0) else {
-            return self.integrate_load(&programs, t);
+            return Ok(self.integrate_load(programs, t)?.0);
         };
-        let key = programs.fingerprint(self);
+        let key = programs.fingerprint;
         let cached = FIELDS
             .lock()
             .expect("no thread panics holding the loads")
@@ -161,7 +178,7 @@ impl Model {
         let field = match cached {
             Some(field) => field,
             None => {
-                let field = Arc::new(self.integrate_load(&programs, 1.0)?);
+                let field = Arc::new(self.integrate_load(programs, 1.0)?.0);
                 let mut fields = FIELDS.lock().expect("no thread panics holding the loads");
                 if fields.len() >= FIELDS_KEPT {
                     fields.remove(0);
@@ -174,20 +191,27 @@ impl Model {
         Ok(field.iter().map(|v| scale * v).collect())
     }
 
-    /// The load at `t`, integrated.
-    fn integrate_load(&self, programs: &LoadPrograms, t: f64) -> Result<Vec<f64>> {
-        let mut f = vec![0.0; 2 * self.n_nodes];
-        self.add_tractions(programs, t, &mut f)?;
-        for body in 0..2 {
-            if let Some(bf) = &programs.body[body] {
-                self.add_body_force(bf, body, t, &mut f)?;
-            }
-        }
-        Ok(f)
+    /// The load at `t` integrated from scratch, its expressions compiled anew, nothing
+    /// cached: the number of quadrature points it took (what `study speed` divides the
+    /// time by).
+    pub fn integrate_load_from_scratch(&self, t: f64) -> Result<usize> {
+        Ok(self.integrate_load(&LoadPrograms::new(self), t)?.1)
     }
 
-    /// The tractions' share of the load.
-    fn add_tractions(&self, programs: &LoadPrograms, t: f64, f: &mut [f64]) -> Result<()> {
+    /// The load at `t`, integrated, and the number of quadrature points.
+    fn integrate_load(&self, programs: &LoadPrograms, t: f64) -> Result<(Vec<f64>, usize)> {
+        let mut f = vec![0.0; 2 * self.n_nodes];
+        let mut points = self.add_tractions(programs, t, &mut f)?;
+        for body in 0..2 {
+            if let Some(bf) = &programs.body[body] {
+                points += self.add_body_force(bf, body, t, &mut f)?;
+            }
+        }
+        Ok((f, points))
+    }
+
+    /// The tractions' share of the load; returns the number of quadrature points.
+    fn add_tractions(&self, programs: &LoadPrograms, t: f64, f: &mut [f64]) -> Result<usize> {
         let segment = quadrature::gauss_legendre(8);
         let exact = self.scene.exact.as_deref();
         // The kinks at t of each traction's expressions (a derived traction: of the body's
@@ -206,6 +230,7 @@ impl Model {
             None => Vec::new(),
         });
         let mut registers = Vec::new();
+        let mut points = 0;
         for (e, &(i, [a, b])) in self.traction_edges.iter().enumerate() {
             let (pa, pb) = (self.position(a), self.position(b));
             let len = (pb[0] - pa[0]).hypot(pb[1] - pa[1]);
@@ -214,6 +239,7 @@ impl Model {
                 None => &stress_kinks[self.traction_normals[e].0],
             };
             for &(s, w) in quadrature::segment_rule(pa, pb, kinks, &segment).iter() {
+                points += 1;
                 let x = pa[0] + s * (pb[0] - pa[0]);
                 let y = pa[1] + s * (pb[1] - pa[1]);
                 let g = match &programs.given[i] {
@@ -261,13 +287,14 @@ impl Model {
                 }
             }
         }
-        Ok(())
+        Ok(points)
     }
 
     /// Body `body`'s body force share of the load: each triangle's three nodal forces on a
     /// core of its own, added in element order (the same sums for any number of threads).
-    fn add_body_force(&self, bf: &BodyForce, body: usize, t: f64, f: &mut [f64]) -> Result<()> {
-        let kinks = kink_functions(&distinct_kinks(bf.exprs.iter().copied()), t);
+    /// Returns the number of quadrature points.
+    fn add_body_force(&self, bf: &BodyForce, body: usize, t: f64, f: &mut [f64]) -> Result<usize> {
+        let kinks = kink_functions(&distinct_kinks(&bf.exprs), t);
         let triangle = quadrature::dunavant8();
         // A singular part's load r^(beta-2) (times P1, smooth along the rays) and the rest
         // of the load, each with its own rule on the triangles at the point.
@@ -279,52 +306,82 @@ impl Model {
         let powers = singular.map_or([0.0; 2], |s| [0.0, s.exponent - 2.0]);
         let point = singular.map(|s| s.point);
         let elements: Vec<&Element> = self.elements.iter().filter(|e| e.body == body).collect();
-        let nodal: Vec<Result<[f64; 6]>> = elements
-            .par_iter()
-            .map_init(Lanes::default, |lanes, e| {
-                let p = e.nodes.map(|n| self.position(n));
-                let mut out = [0.0; 6];
-                for (part, rule) in
-                    quadrature::singular::rules(p, &kinks, &triangle, point, &powers)
-                {
-                    let program = match part {
-                        None => &bf.whole,
-                        Some(_) => bf.with_singular.as_ref().expect("a part is singular"),
-                    };
-                    lanes.evaluate(program, p, &rule, t);
-                    let n = rule.len();
-                    for (q, &(l1, l2, w)) in rule.iter().enumerate() {
-                        let value = |o: usize| lanes.values[o * n + q];
-                        let v = match part {
-                            None => [value(0), value(1)],
-                            // The rest: smooth at the point.
-                            Some(0) => [value(0) - value(2), value(1) - value(3)],
-                            Some(_) => [value(2), value(3)],
-                        };
-                        if let Some(c) = v.iter().position(|c| !c.is_finite()) {
-                            let (x, y) = (lanes.xs[q], lanes.ys[q]);
-                            return Err(self.body_force_not_finite(bf, body, c, x, y, t));
+        // Chunks of triangles, their rules' points evaluated together: one operation of the
+        // program then runs over a few hundred points, not over one rule's 16.
+        let chunks: Vec<Result<Vec<([f64; 6], usize)>>> = elements
+            .par_chunks(TRIANGLES_PER_CHUNK)
+            .map_init(
+                || [Lanes::default(), Lanes::default()],
+                |[whole, split], chunk| {
+                    whole.clear();
+                    split.clear();
+                    // (triangle of the chunk, part, rule, its first point in its lanes)
+                    let mut pieces = Vec::new();
+                    for (k, e) in chunk.iter().enumerate() {
+                        let p = e.nodes.map(|n| self.position(n));
+                        for (part, rule) in
+                            quadrature::singular::rules(p, &kinks, &triangle, point, &powers)
+                        {
+                            let lanes = if part.is_none() {
+                                &mut *whole
+                            } else {
+                                &mut *split
+                            };
+                            let start = lanes.push(p, &rule);
+                            pieces.push((k, part, rule, start));
                         }
-                        let lam = [1.0 - l1 - l2, l1, l2];
-                        for a in 0..3 {
-                            for c in 0..2 {
-                                out[2 * a + c] += w * e.area * lam[a] * v[c];
+                    }
+                    whole.evaluate(&bf.whole, t);
+                    if let Some(program) =
+                        bf.with_singular.as_ref().filter(|_| !split.xs.is_empty())
+                    {
+                        split.evaluate(program, t);
+                    }
+                    let mut out = vec![([0.0; 6], 0); chunk.len()];
+                    for (k, part, rule, start) in pieces {
+                        let lanes = if part.is_none() { &*whole } else { &*split };
+                        let n = lanes.xs.len();
+                        let area = chunk[k].area;
+                        out[k].1 += rule.len();
+                        for (q, &(l1, l2, w)) in rule.iter().enumerate() {
+                            let value = |o: usize| lanes.values[o * n + start + q];
+                            let v = match part {
+                                None => [value(0), value(1)],
+                                // The rest: smooth at the point.
+                                Some(0) => [value(0) - value(2), value(1) - value(3)],
+                                Some(_) => [value(2), value(3)],
+                            };
+                            if let Some(c) = v.iter().position(|c| !c.is_finite()) {
+                                let (x, y) = (lanes.xs[start + q], lanes.ys[start + q]);
+                                return Err(self.body_force_not_finite(bf, body, c, x, y, t));
+                            }
+                            let lam = [1.0 - l1 - l2, l1, l2];
+                            for a in 0..3 {
+                                for c in 0..2 {
+                                    out[k].0[2 * a + c] += w * area * lam[a] * v[c];
+                                }
                             }
                         }
                     }
-                }
-                Ok(out)
-            })
+                    Ok(out)
+                },
+            )
             .collect();
+        let mut nodal = Vec::with_capacity(elements.len());
+        for chunk in chunks {
+            nodal.extend(chunk?.into_iter().map(Ok::<_, Error>));
+        }
+        let mut points = 0;
         for (e, forces) in elements.iter().zip(nodal) {
-            let forces = forces?;
+            let (forces, n) = forces?;
+            points += n;
             for a in 0..3 {
                 for c in 0..2 {
                     f[2 * e.nodes[a] + c] += forces[2 * a + c];
                 }
             }
         }
-        Ok(())
+        Ok(points)
     }
 
     fn body_force_not_finite(
@@ -350,7 +407,7 @@ impl Model {
             "bodies[{}].body_force[{c}]",
             self.scene.bodies[body].file_index
         );
-        not_finite(&self.scene.file, &field, bf.exprs[c], x, y, t)
+        not_finite(&self.scene.file, &field, &bf.exprs[c], x, y, t)
     }
 }
 
@@ -366,7 +423,11 @@ fn not_finite(file: &std::path::Path, field: &str, expr: &Expr, x: f64, y: f64, 
     )
 }
 
-/// One thread's scratch space for a rule's points and values.
+/// Triangles whose quadrature points are evaluated in one call of a program (about 500
+/// points with Dunavant's 16 per triangle).
+const TRIANGLES_PER_CHUNK: usize = 32;
+
+/// One thread's scratch space for the points of several rules and their values.
 #[derive(Default)]
 struct Lanes {
     xs: Vec<f64>,
@@ -376,16 +437,26 @@ struct Lanes {
 }
 
 impl Lanes {
-    /// `program` at the points of `rule` (barycentric l1, l2) on the triangle `p`.
-    fn evaluate(&mut self, program: &Program, p: [[f64; 2]; 3], rule: &[(f64, f64, f64)], t: f64) {
+    fn clear(&mut self) {
         self.xs.clear();
         self.ys.clear();
+    }
+
+    /// Add the points of `rule` (barycentric l1, l2) on the triangle `p`; returns the index
+    /// of its first point.
+    fn push(&mut self, p: [[f64; 2]; 3], rule: &[(f64, f64, f64)]) -> usize {
+        let start = self.xs.len();
         for &(l1, l2, _) in rule {
             let l0 = 1.0 - l1 - l2;
             self.xs.push(l0 * p[0][0] + l1 * p[1][0] + l2 * p[2][0]);
             self.ys.push(l0 * p[0][1] + l1 * p[1][1] + l2 * p[2][1]);
         }
-        self.values.resize(program.n_outputs() * rule.len(), 0.0);
+        start
+    }
+
+    /// `program` at every point added: output o at point i is `values[o * n + i]`.
+    fn evaluate(&mut self, program: &Program, t: f64) {
+        self.values.resize(program.n_outputs() * self.xs.len(), 0.0);
         program.eval_lanes(&self.xs, &self.ys, t, &mut self.registers, &mut self.values);
     }
 }

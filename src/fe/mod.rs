@@ -13,6 +13,8 @@ use rayon::prelude::*;
 use std::mem::MaybeUninit;
 
 mod load;
+
+pub use load::forget_loads;
 use std::path::Path;
 
 /// Marker for a constrained degree of freedom.
@@ -232,6 +234,9 @@ pub struct Model {
     pub scene: Scene,
     /// The mesh file (for messages).
     pub mesh_file: std::path::PathBuf,
+    /// The load's compiled expressions, built at the first [`Model::load`]; the model's
+    /// mesh and scene must not change after it.
+    load_programs: std::sync::OnceLock<std::sync::Arc<load::LoadPrograms>>,
 }
 
 /// The body and outward unit normal of each boundary edge: away from the third vertex of
@@ -438,6 +443,7 @@ impl Model {
             traction_edges,
             scene: scene.clone(),
             mesh_file: mesh_file.to_path_buf(),
+            load_programs: Default::default(),
         })
     }
 

@@ -10,7 +10,7 @@ use super::field::{P1Field, PressureProfile};
 use super::norms::SquaredNorms;
 use crate::analytical::Exact;
 use crate::contact::Interface;
-use crate::expr::kink_functions;
+use crate::expr::{Expr, Program, compile, kink_functions};
 use crate::fe::Model;
 use crate::quadrature;
 
@@ -22,6 +22,58 @@ pub struct ExactComparison<'a> {
     exact: &'a Exact,
     triangle: Vec<(f64, f64, f64)>,
     segment: Vec<(f64, f64)>,
+    /// Each body's exact fields compiled together.
+    fields: [BodyFields; 2],
+}
+
+/// One body's exact displacement, gradient and stress compiled into one program (they
+/// share their subexpressions), and its singular part's into another: outputs u_x, u_y,
+/// du_x/dx, du_x/dy, du_y/dx, du_y/dy where the displacement is given, then s11, s22, s12
+/// where the stress is.
+struct BodyFields {
+    whole: Program,
+    singular: Option<Program>,
+    displacement: bool,
+    stress: bool,
+}
+
+impl BodyFields {
+    fn new(ex: &Exact, b: usize) -> Self {
+        let displacement = ex.displacement.is_some() && ex.gradient.is_some();
+        let stress = ex.stress.is_some();
+        let outputs = |u: Option<&[Expr; 2]>, g: Option<&[[Expr; 2]; 2]>, s: Option<&[Expr; 3]>| {
+            let mut out: Vec<&Expr> = Vec::new();
+            if let (Some(u), Some(g)) = (u, g) {
+                out.extend(u.iter());
+                out.extend(g.iter().flatten());
+            }
+            out.extend(s.into_iter().flatten());
+            compile(&out).expect("every scene expression compiles (test_compiled_expressions)")
+        };
+        let whole = outputs(
+            ex.displacement.as_ref().map(|u| &u[b]),
+            ex.gradient.as_ref().map(|g| &g[b]),
+            ex.stress.as_ref().map(|s| &s[b]),
+        );
+        let singular = ex.singular.as_ref().map(|sg| {
+            outputs(
+                Some(&sg.displacement[b]).filter(|_| displacement),
+                Some(&sg.gradient[b]).filter(|_| displacement),
+                Some(&sg.stress[b]).filter(|_| stress),
+            )
+        });
+        BodyFields {
+            whole,
+            singular,
+            displacement,
+            stress,
+        }
+    }
+
+    /// Where the stress starts among the outputs.
+    fn stress_at(&self) -> usize {
+        if self.displacement { 6 } else { 0 }
+    }
 }
 
 /// What one field measured against the exact solution at its time.
@@ -119,6 +171,7 @@ impl<'a> ExactComparison<'a> {
             exact,
             triangle: quadrature::triangle(points),
             segment: quadrature::gauss_legendre(2 * points),
+            fields: [0, 1].map(|b| BodyFields::new(exact, b)),
         }
     }
 
@@ -140,6 +193,7 @@ impl<'a> ExactComparison<'a> {
         // The powers of r of SPLIT_PARTS's rules.
         let powers = [0.0, beta - 1.0, beta, 2.0 * beta - 2.0, 2.0 * beta];
         let point = singular.map(|sg| sg.point);
+        let (mut registers, mut values, mut parts) = (Vec::new(), [0.0; 9], [0.0; 9]);
         for (i, el) in m.elements.iter().enumerate() {
             let b = el.body;
             let pos = el.nodes.map(|n| m.position(n));
@@ -161,22 +215,30 @@ impl<'a> ExactComparison<'a> {
                     let x = [0, 1].map(|c| (0..3).map(|a| lam[a] * pos[a][c]).sum::<f64>());
                     let w = w * el.area;
                     let sing = singular.filter(|_| part.is_some());
+                    // The exact fields at x (and their singular parts where this rule
+                    // splits them), one program per body.
+                    let fields = &self.fields[b];
+                    fields
+                        .whole
+                        .eval_point(x[0], x[1], t, &mut registers, &mut values);
+                    match (sing, &fields.singular) {
+                        (Some(_), Some(program)) => {
+                            program.eval_point(x[0], x[1], t, &mut registers, &mut parts)
+                        }
+                        _ => parts.fill(0.0),
+                    }
                     let mut grad_e = None;
-                    if let (Some(u), Some(g)) = (&ex.displacement, &ex.gradient) {
+                    if fields.displacement {
                         let mut ge_all = [[(0.0, 0.0); 2]; 2];
                         for c in 0..2 {
-                            let ue = u[b][c].eval(x[0], x[1], t);
-                            let us =
-                                sing.map_or(0.0, |sg| sg.displacement[b][c].eval(x[0], x[1], t));
+                            let (ue, us) = (values[c], parts[c]);
                             let uhc: f64 = (0..3).map(|a| lam[a] * uh[a][c]).sum();
                             if let Some(p) = u_part {
                                 out.difference.l2_u += w * p.square(uhc - ue, -us);
                                 out.exact.l2_u += p.weighted_square(w, ue, us);
                             }
                             for d in 0..2 {
-                                let ge = g[b][c][d].eval(x[0], x[1], t);
-                                let gs =
-                                    sing.map_or(0.0, |sg| sg.gradient[b][c][d].eval(x[0], x[1], t));
+                                let (ge, gs) = (values[2 + 2 * c + d], parts[2 + 2 * c + d]);
                                 if let Some(p) = g_part {
                                     out.difference.semi_u += w * p.square(grad_h[c][d] - ge, -gs);
                                     out.exact.semi_u += p.weighted_square(w, ge, gs);
@@ -187,10 +249,10 @@ impl<'a> ExactComparison<'a> {
                         grad_e = Some(ge_all);
                     }
                     let Some(p) = g_part else { continue };
-                    if let Some(se) = ex.stress_at(b, x[0], x[1], t) {
-                        let ss = sing.map_or([0.0; 3], |sg| {
-                            [0, 1, 2].map(|k| sg.stress[b][k].eval(x[0], x[1], t))
-                        });
+                    if fields.stress {
+                        let k0 = fields.stress_at();
+                        let se = [0, 1, 2].map(|k| values[k0 + k]);
+                        let ss = [0, 1, 2].map(|k| parts[k0 + k]);
                         if let Some(g) = grad_e {
                             // sigma : eps(u) = s11 e11 + s22 e22 + 2 s12 e12.
                             let eps = [

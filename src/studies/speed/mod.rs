@@ -3,6 +3,7 @@
 //! assembled and factorized once, in f64 or in f32 with conjugate gradients, whichever is
 //! faster; see [`solve::floor`]), and both with the machine's measured limits.
 
+pub mod manufactured;
 pub mod report;
 pub mod results;
 
@@ -93,6 +94,8 @@ pub struct SpeedResult {
     pub threads: usize,
     /// The machine's measured limits the bounds divide by.
     pub limits: Limits,
+    /// The manufactured scenes' solves against their floors ([`manufactured`]).
+    pub manufactured: Vec<manufactured::ManufacturedRecord>,
 }
 
 /// What the machine can do at most, measured on rayon's threads at the start of the
@@ -321,6 +324,7 @@ pub fn run() -> Result<SpeedResult> {
             }
         }
     }
+    let manufactured = manufactured::run()?;
     let family = &FAMILIES[0];
     let rcase = Case::build(
         &Scene::load(family.scene)?,
@@ -339,6 +343,7 @@ pub fn run() -> Result<SpeedResult> {
         machine: machine(),
         threads,
         limits,
+        manufactured,
     })
 }
 
