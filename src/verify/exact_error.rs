@@ -70,6 +70,24 @@ impl BodyFields {
         }
     }
 
+    /// The fields at `x` into `values`, and their singular parts into `parts` where
+    /// `split` (zeros otherwise).
+    fn eval(
+        &self,
+        x: [f64; 2],
+        t: f64,
+        split: bool,
+        registers: &mut Vec<f64>,
+        values: &mut [f64],
+        parts: &mut [f64],
+    ) {
+        self.whole.eval_point(x[0], x[1], t, registers, values);
+        match self.singular.as_ref().filter(|_| split) {
+            Some(program) => program.eval_point(x[0], x[1], t, registers, parts),
+            None => parts.fill(0.0),
+        }
+    }
+
     /// Where the stress starts among the outputs.
     fn stress_at(&self) -> usize {
         if self.displacement { 6 } else { 0 }
@@ -158,6 +176,19 @@ fn p1_gradient(uh: &[[f64; 2]; 3], grads: &[[f64; 2]; 3]) -> [[f64; 2]; 2] {
     grad_h
 }
 
+/// sigma : eps(u) = s11 e11 + s22 e22 + 2 s12 e12 of the exact stress (whole `se`,
+/// singular part `ss`) and gradient `g` (each entry as (whole, singular part)), its part `p`.
+fn energy_density(p: Split, se: [f64; 3], ss: [f64; 3], g: [[(f64, f64); 2]; 2]) -> f64 {
+    let eps = [
+        g[0][0],
+        g[1][1],
+        (g[0][1].0 + g[1][0].0, g[0][1].1 + g[1][0].1),
+    ];
+    (0..3)
+        .map(|k| p.product((se[k], ss[k]), eps[k]))
+        .sum::<f64>()
+}
+
 /// s11^2 + s22^2 + 2 s12^2, its part `p`, each component as (whole, singular part).
 fn tensor_square(p: Split, s: [(f64, f64); 3]) -> f64 {
     p.product(s[0], s[0]) + p.product(s[1], s[1]) + 2.0 * p.product(s[2], s[2])
@@ -218,15 +249,14 @@ impl<'a> ExactComparison<'a> {
                     // The exact fields at x (and their singular parts where this rule
                     // splits them), one program per body.
                     let fields = &self.fields[b];
-                    fields
-                        .whole
-                        .eval_point(x[0], x[1], t, &mut registers, &mut values);
-                    match (sing, &fields.singular) {
-                        (Some(_), Some(program)) => {
-                            program.eval_point(x[0], x[1], t, &mut registers, &mut parts)
-                        }
-                        _ => parts.fill(0.0),
-                    }
+                    fields.eval(
+                        x,
+                        t,
+                        sing.is_some(),
+                        &mut registers,
+                        &mut values,
+                        &mut parts,
+                    );
                     let mut grad_e = None;
                     if fields.displacement {
                         let mut ge_all = [[(0.0, 0.0); 2]; 2];
@@ -254,16 +284,7 @@ impl<'a> ExactComparison<'a> {
                         let se = [0, 1, 2].map(|k| values[k0 + k]);
                         let ss = [0, 1, 2].map(|k| parts[k0 + k]);
                         if let Some(g) = grad_e {
-                            // sigma : eps(u) = s11 e11 + s22 e22 + 2 s12 e12.
-                            let eps = [
-                                g[0][0],
-                                g[1][1],
-                                (g[0][1].0 + g[1][0].0, g[0][1].1 + g[1][0].1),
-                            ];
-                            out.energy += w
-                                * (0..3)
-                                    .map(|k| p.product((se[k], ss[k]), eps[k]))
-                                    .sum::<f64>();
+                            out.energy += w * energy_density(p, se, ss, g);
                         }
                         let dk = [0, 1, 2].map(|k| (sh[k] - se[k], -ss[k]));
                         let (d, n) = (
