@@ -35,8 +35,8 @@ pub struct Expr {
     /// The arguments z_k of the `abs` calls, whose signs are the s_k.
     signs: Vec<Expr>,
     /// Whether `flat`'s text is exmex's own fully parenthesized form (a derivative, or a
-    /// combination of such), which [`compile`] reads directly; a parsed expression's text
-    /// is its source, in the user's precedence, and goes through exmex's deep form first.
+    /// combination of such). Recorded, not yet used: [`compile`] always rebuilds exmex's
+    /// deep form first, whose text the compiler reads.
     raw: bool,
     /// The expression compiled ([`Program`]) at its first evaluation (a derived field's
     /// intermediate steps are never evaluated); None inside if exmex wrote text the
