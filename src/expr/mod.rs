@@ -34,10 +34,6 @@ pub struct Expr {
     slots: Vec<usize>,
     /// The arguments z_k of the `abs` calls, whose signs are the s_k.
     signs: Vec<Expr>,
-    /// Whether `flat`'s text is exmex's own fully parenthesized form (a derivative, or a
-    /// combination of such). Recorded, not yet used: [`compile`] always rebuilds exmex's
-    /// deep form first, whose text the compiler reads.
-    raw: bool,
     /// The expression compiled ([`Program`]) at its first evaluation (a derived field's
     /// intermediate steps are never evaluated); None inside if exmex wrote text the
     /// compiler does not read (then exmex evaluates it).
@@ -72,7 +68,6 @@ impl Expr {
             flat: Box::new(flat),
             slots,
             signs,
-            raw: false,
             program: OnceLock::new(),
         })
     }
@@ -97,6 +92,18 @@ impl Expr {
             return out[0];
         }
         self.eval_interpreted(x, y, t)
+    }
+
+    /// The error for this expression of `field` in `file` not finite at (x, y, t).
+    pub fn not_finite(&self, file: &Path, field: &str, x: f64, y: f64, t: f64) -> Error {
+        Error::input(
+            file,
+            field,
+            format!(
+                "expression '{}' is not finite at x = {x}, y = {y}, t = {t}; fix the expression",
+                self.text
+            ),
+        )
     }
 
     /// Whether [`Expr::eval`] runs a compiled [`Program`].
@@ -152,7 +159,6 @@ impl Expr {
             flat: Box::new(derivative),
             slots,
             signs: self.signs.clone(),
-            raw: true,
             program: OnceLock::new(),
         }
     }
@@ -215,7 +221,6 @@ impl Expr {
             flat: Box::new(flat),
             slots,
             signs,
-            raw: terms.iter().all(|(_, e)| e.raw),
             program: OnceLock::new(),
         }
     }
@@ -421,22 +426,5 @@ impl VectorExpr {
             Expr::parse(&e[0], file, &format!("{field}[0]"))?,
             Expr::parse(&e[1], file, &format!("{field}[1]"))?,
         ]))
-    }
-    /// Evaluate both components; error naming the scene, field and expression if not finite.
-    pub fn eval(&self, x: f64, y: f64, t: f64, file: &Path, field: &str) -> Result<[f64; 2]> {
-        let v = [self.0[0].eval(x, y, t), self.0[1].eval(x, y, t)];
-        for (c, val) in v.iter().enumerate() {
-            if !val.is_finite() {
-                return Err(Error::input(
-                    file,
-                    format!("{field}[{c}]"),
-                    format!(
-                        "expression '{}' is not finite at x = {x}, y = {y}, t = {t}; fix the expression",
-                        self.0[c].text
-                    ),
-                ));
-            }
-        }
-        Ok(v)
     }
 }

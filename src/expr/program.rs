@@ -541,16 +541,6 @@ pub struct Program {
 }
 
 impl Program {
-    /// Number of operations (for reports: the size after sharing).
-    pub fn len(&self) -> usize {
-        self.code.len()
-    }
-
-    /// Whether the program has no operation.
-    pub fn is_empty(&self) -> bool {
-        self.code.is_empty()
-    }
-
     /// Number of square roots it takes (a fourth root is two).
     pub fn square_roots(&self) -> usize {
         self.code

@@ -248,10 +248,9 @@ impl Model {
                         p.eval_point(x, y, t, &mut registers, &mut g);
                         if let Some(c) = g.iter().position(|v| !v.is_finite()) {
                             let expr = &self.scene.tractions[i].g.as_ref().expect("given").0[c];
-                            return Err(not_finite(
+                            return Err(expr.not_finite(
                                 &self.scene.file,
                                 &format!("traction[{i}].g[{c}]"),
-                                expr,
                                 x,
                                 y,
                                 t,
@@ -407,20 +406,8 @@ impl Model {
             "bodies[{}].body_force[{c}]",
             self.scene.bodies[body].file_index
         );
-        not_finite(&self.scene.file, &field, &bf.exprs[c], x, y, t)
+        bf.exprs[c].not_finite(&self.scene.file, &field, x, y, t)
     }
-}
-
-/// A scene's expression not finite at a point: the error naming its field.
-fn not_finite(file: &std::path::Path, field: &str, expr: &Expr, x: f64, y: f64, t: f64) -> Error {
-    Error::input(
-        file,
-        field,
-        format!(
-            "expression '{}' is not finite at x = {x}, y = {y}, t = {t}; fix the expression",
-            expr.text
-        ),
-    )
 }
 
 /// Triangles whose quadrature points are evaluated in one call of a program (about 500
