@@ -1,22 +1,44 @@
-//! Writes the `regularity` family: one scene per beta (scenes/regularity-BETA.toml, the
-//! manufactured solution of `analytical::singular`) and one study file per beta
-//! (studies/regularity/beta-BETA.toml, both cones against the exact solution), which the
-//! built-in study `regularity` runs together.
+//! Writes the regularity families (aligned, unaligned, graded): one scene per family and
+//! beta (scenes/FAMILY-BETA.toml, the manufactured solution of `analytical::singular` with
+//! its transition point placed as the family places it) and one study file per beta
+//! (studies/FAMILY/beta-BETA.toml, both cones against the exact solution), which the
+//! built-in study FAMILY (`regularity`, `regularity-unaligned`, `regularity-graded`) runs
+//! together.
 //!
 //! `cargo run --release --example regularity_scenes`
 
-use contact_rates::analytical::singular::SingularContact;
-use contact_rates::studies::regularity::{BETAS, LEVELS, scene_name, study_path};
+use contact_rates::analytical::singular::{Placement, SingularContact};
+use contact_rates::studies::regularity::{ALIGNED, Family, GRADED, UNALIGNED};
 
 fn main() -> std::io::Result<()> {
+    for family in [&ALIGNED, &UNALIGNED, &GRADED] {
+        write_family(family)?;
+    }
+    Ok(())
+}
+
+/// What a family's study files say of its meshes (nothing for the aligned family's).
+fn meshes(family: &Family) -> &'static str {
+    match family.placement {
+        Placement::Aligned => "",
+        Placement::Unaligned => {
+            " of uniform refinement with the transition point a node of neither trace (1/3 of a segment of both at every level)"
+        }
+        Placement::Graded { .. } => {
+            " of meshes graded toward the transition point, each level meshed by gmsh (not nested)"
+        }
+    }
+}
+
+fn write_family(family: &Family) -> std::io::Result<()> {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    for &beta in BETAS {
-        let member = SingularContact::new(beta);
+    for &beta in family.betas {
+        let member = SingularContact::placed(beta, family.placement);
         let scene = root
             .join("scenes")
-            .join(format!("{}.toml", scene_name(beta)));
+            .join(format!("{}.toml", family.scene_name(beta)));
         std::fs::write(&scene, member.scene_toml(1))?;
-        let study = study_path(beta);
+        let study = family.study_path(beta);
         std::fs::create_dir_all(study.parent().expect("a folder"))?;
         // Theorem 3.1 needs u in H^2 and f in L2: beta > 1. Below, it claims no rate, and
         // the study asks only that the error converge (rate >= 0).
@@ -25,12 +47,12 @@ fn main() -> std::io::Result<()> {
         } else {
             (0.0, 0.0, 0.0)
         };
-        let levels: Vec<String> = LEVELS.iter().map(|l| l.to_string()).collect();
+        let levels: Vec<String> = family.levels.iter().map(|l| l.to_string()).collect();
         std::fs::write(
             &study,
             format!(
                 r#"# Written by `cargo run --release --example regularity_scenes`: do not edit by hand.
-description = "Both cones on the singular manufactured solution with beta = {beta} (u ~ r^beta at the transition point) over {n} levels against the exact solution; part of the study `regularity`"
+description = "Both cones on the singular manufactured solution with beta = {beta} (u ~ r^beta at the transition point) over {n} levels{meshes} against the exact solution; part of the study `{study}`"
 scene = "{scene}"
 methods = ["mortar", "nts"]
 solver = "newton"
@@ -53,8 +75,10 @@ mortar = {mortar}
 nts = {nts}
 tolerance = {tolerance}
 "#,
-                n = LEVELS.len(),
-                scene = scene_name(beta),
+                n = family.levels.len(),
+                meshes = meshes(family),
+                study = family.name,
+                scene = family.scene_name(beta),
                 levels = levels.join(", "),
                 why = if beta > 1.0 {
                     "Theorem 3.1 applies (u in H^2, f in L2): its rates."

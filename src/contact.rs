@@ -177,7 +177,50 @@ fn chains(edges: &[[usize; 2]], what: &str, file: &std::path::Path) -> Result<Ve
     Ok(out)
 }
 
+/// Where a point of Gamma_C sits among the trace nodes: on each trace, its distance to
+/// the nearest node of that trace over the length of the trace segment that holds it (0 at
+/// a node, at most 1/2 at a midpoint).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NodeOffset {
+    /// On body 1's trace.
+    pub slave: f64,
+    /// On body 2's trace.
+    pub master: f64,
+}
+
+impl NodeOffset {
+    /// The smaller of the two.
+    pub fn min(&self) -> f64 {
+        self.slave.min(self.master)
+    }
+}
+
+/// Distance from abscissa `s` to the nearest of the increasing `abscissae`, over the length
+/// of the segment between them that holds `s`.
+fn relative_offset(abscissae: &[f64], s: f64) -> f64 {
+    let k = abscissae
+        .windows(2)
+        .position(|w| s <= w[1])
+        .unwrap_or(abscissae.len().saturating_sub(2));
+    let (a, b) = (abscissae[k], abscissae[k + 1]);
+    ((s - a).min(b - s) / (b - a)).max(0.0)
+}
+
 impl Interface {
+    /// Where the point `c` sits among the trace nodes (None: `c` is on no piece).
+    pub fn node_offset(&self, c: [f64; 2]) -> Option<NodeOffset> {
+        self.pieces.iter().find_map(|p| {
+            let d = [c[0] - p.a[0], c[1] - p.a[1]];
+            let s = d[0] * p.tangent[0] + d[1] * p.tangent[1];
+            let off = (d[0] * p.tangent[1] - d[1] * p.tangent[0]).abs();
+            let tol = 1e-9 * p.length;
+            (off <= tol && s >= -tol && s <= p.length + tol).then(|| NodeOffset {
+                slave: relative_offset(&p.slave_s, s),
+                master: relative_offset(&p.master_s, s),
+            })
+        })
+    }
+
     /// Whether equilibrium fixes the total contact force normal to Gamma_C: Gamma_C is
     /// straight (every piece has the same normal) and one body's rigid translation along
     /// that normal is held by no clamp or roller, so only the contact holds it there and

@@ -157,6 +157,11 @@ pub struct SceneFile {
     /// gmsh parameters (`-setnumber NAME VALUE`).
     #[serde(default)]
     pub parameters: BTreeMap<String, f64>,
+    /// How level L is made: by splitting level L - 1 (default), or by meshing the .geo
+    /// again with `level = L` (a .geo whose sizes are graded: splitting keeps level 0's
+    /// size ratios).
+    #[serde(default)]
+    pub refinement: Refinement,
     /// Final time T (> 0).
     pub final_time: f64,
     /// Default number of uniform time steps (> 0).
@@ -176,6 +181,18 @@ pub struct SceneFile {
     pub contact: ContactSpec,
     /// Exact solution, if known.
     pub exact: Option<ExactSpec>,
+}
+
+/// How a scene's mesh levels are made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Refinement {
+    /// Level L splits every triangle of level L - 1 in four (nested levels).
+    #[default]
+    Split,
+    /// Level L is gmsh's own mesh of the .geo with the parameter `level = L` (the .geo
+    /// scales its sizes by 2^-level itself); levels are not nested.
+    Remesh,
 }
 
 /// A body of a validated scene.
@@ -223,6 +240,8 @@ pub struct Scene {
     pub geo: PathBuf,
     /// gmsh parameters.
     pub parameters: BTreeMap<String, f64>,
+    /// How the levels are made.
+    pub refinement: Refinement,
     /// Final time T.
     pub final_time: f64,
     /// Default number of time steps.
@@ -380,6 +399,7 @@ impl Scene {
             description: sf.description,
             geo,
             parameters: sf.parameters,
+            refinement: sf.refinement,
             final_time: sf.final_time,
             steps: sf.steps,
             bodies: [b0, b1],

@@ -487,12 +487,12 @@ fn a_bad_singular_part_names_its_field_and_fix() {
             vec!["scene.toml", "exact.singular.point"],
         ),
         (
-            text.replace("point = [0.5871, 1.0]", "point = [0.5, 1.0]"),
+            text.replace("point = [0.5871, 1.0]", "point = [0.5871, 1.5]"),
             vec![
                 "scene.toml",
                 "exact.singular.point",
-                "not a node of body 'upper'",
-                ".geo",
+                "not on Gamma_C",
+                "put the point on Gamma_C",
             ],
         ),
     ];

@@ -32,6 +32,68 @@
 /// The transition point's abscissa (the same as contact-mms's).
 pub const TRANSITION: f64 = 0.5871;
 
+/// The unaligned family's transition abscissa, 8/15: 2/3 of the way along the lower trace's
+/// level-0 segment [0.4, 0.6] (meshes/two_blocks.geo with h_lower in (0.2, 0.25]: five
+/// uniform segments) and 1/3 along the upper trace's third segment once that line is graded
+/// by [`unaligned_grading`]. Halving a segment moves a point at 1/3 of it to 2/3 of a half
+/// and back, so c is 1/3 of its segment from the nearest node of both traces at every level.
+pub const UNALIGNED_TRANSITION: f64 = 8.0 / 15.0;
+
+/// The nodes of meshes/two_blocks.geo's upper contact line with `nodes` nodes and total
+/// grading `grading` (gmsh's `Using Progression`: segment lengths in geometric ratio
+/// grading^(1 / (nodes - 2))).
+pub fn graded_line(nodes: usize, grading: f64) -> Vec<f64> {
+    let ratio = grading.powf(1.0 / (nodes as f64 - 2.0));
+    let lengths: Vec<f64> = (0..nodes - 1).map(|k| ratio.powi(k as i32)).collect();
+    let total: f64 = lengths.iter().sum();
+    let mut x = vec![0.0];
+    for l in lengths {
+        x.push(x.last().unwrap() + l / total);
+    }
+    x
+}
+
+/// The upper line's grading (five nodes: h_upper in [0.25, 1/3)) that puts
+/// [`UNALIGNED_TRANSITION`] at 1/3 of its third segment, by bisection (1.3844).
+pub fn unaligned_grading() -> f64 {
+    let miss = |g: f64| {
+        let x = graded_line(5, g);
+        x[2] + (x[3] - x[2]) / 3.0 - UNALIGNED_TRANSITION
+    };
+    // miss falls as the grading rises: 0.05 at 1, negative at 2.
+    let (mut lo, mut hi) = (1.0, 2.0);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if miss(mid) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// How a member's meshes meet its transition point c.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Placement {
+    /// c = ([`TRANSITION`], 1) is a geometry point of both contact lines
+    /// (meshes/two_blocks_point.geo): a node of both traces at every level.
+    Aligned,
+    /// c = ([`UNALIGNED_TRANSITION`], 1), a node of neither trace at any level
+    /// (meshes/two_blocks.geo, the upper line graded by [`unaligned_grading`]).
+    Unaligned,
+    /// c = ([`TRANSITION`], 1) a node of both, every level meshed by gmsh with sizes graded
+    /// toward c with exponent `mu` (meshes/two_blocks_graded.geo).
+    Graded {
+        /// The grading exponent mu (< beta): element size h (r / R)^(1 - mu) near c.
+        mu: f64,
+    },
+}
+
+/// The radius R of the graded meshes' grading zone: element size h (r / R)^(1 - mu) within
+/// R of c, h beyond.
+pub const GRADED_RADIUS: f64 = 0.5;
+
 /// Coefficients (c0, c1, s1, s2) of c0 + c1 cos(theta) + s1 sin(theta) + s2 sin(2 theta).
 pub type Trig = [f64; 4];
 
@@ -48,6 +110,36 @@ pub struct SingularContact {
     pub amplitude: f64,
     /// Phi of each body (upper, lower), per component (x, y).
     pub phi: [[Trig; 2]; 2],
+    /// Where c sits among the mesh nodes (and so c itself).
+    pub placement: Placement,
+}
+
+/// The chosen values of Phi (upper, lower body) on the separated side (theta = 0) and the
+/// contact side (theta = +-pi), and the upper body's Phi_y'(pi), which sets the pressure;
+/// the contact conditions give the other derivatives.
+#[derive(Debug, Clone, Copy)]
+pub struct Ends {
+    /// Phi_x(0) of each body.
+    pub x0: [f64; 2],
+    /// Phi_y(0) of each body (the gap: upper minus lower, > 0).
+    pub y0: [f64; 2],
+    /// Phi_x(pi) of each body.
+    pub xpi: [f64; 2],
+    /// Phi_y(pi) of each body (equal: no normal jump).
+    pub ypi: [f64; 2],
+    /// The upper body's Phi_y'(pi).
+    pub dy1pi: f64,
+}
+
+impl Ends {
+    /// The regularity family's.
+    pub const REGULARITY: Ends = Ends {
+        x0: [0.2, -0.1],
+        y0: [1.0, 0.0],
+        xpi: [-0.3, 0.2],
+        ypi: [-0.5, -0.5],
+        dy1pi: 1.2,
+    };
 }
 
 /// Phi's values and derivatives at 0 and pi: (value 0, value pi, derivative 0, derivative pi).
@@ -64,14 +156,24 @@ fn trig_from_ends(v0: f64, vpi: f64, d0: f64, dpi: f64) -> Trig {
 impl SingularContact {
     /// The family's member for `beta`: E = 100 (upper) and 150 (lower), nu = 0.3, A = 0.05.
     pub fn new(beta: f64) -> Self {
+        // Chosen: the upper body lifts off on the separated side (Phi1_y(0) - Phi2_y(0) = 1)
+        // and both bodies move down together on the contact side.
+        Self::with_ends(beta, &Ends::REGULARITY)
+    }
+
+    /// The member for `beta` whose Phi takes the values `ends` (E = 100 and 150, nu = 0.3,
+    /// A = 0.05).
+    pub fn with_ends(beta: f64, ends: &Ends) -> Self {
         assert!(beta > 0.5, "beta > 1/2");
         let (young, nu) = ([100.0, 150.0], 0.3);
         let k = young.map(|e| e / (1.0 - nu * nu));
-        // Chosen: the upper body lifts off on the separated side (Phi1_y(0) - Phi2_y(0) = 1)
-        // and both bodies move down together on the contact side.
-        let (x0, y0) = ([0.2, -0.1], [1.0, 0.0]);
-        let (xpi, ypi) = ([-0.3, 0.2], [-0.5, -0.5]);
-        let dy1pi = 1.2;
+        let Ends {
+            x0,
+            y0,
+            xpi,
+            ypi,
+            dy1pi,
+        } = *ends;
         let pressure = dy1pi + nu * beta * xpi[0];
         let dypi = [dy1pi, k[0] * pressure / k[1] - nu * beta * xpi[1]];
         let phi = [0, 1].map(|l| {
@@ -88,6 +190,43 @@ impl SingularContact {
             poisson: nu,
             amplitude: 0.05,
             phi,
+            placement: Placement::Aligned,
+        }
+    }
+
+    /// The member for `beta` with c placed by `placement` (the same Phi and amplitudes).
+    pub fn placed(beta: f64, placement: Placement) -> Self {
+        SingularContact {
+            placement,
+            ..Self::new(beta)
+        }
+    }
+
+    /// The transition point's abscissa a: c = (a, 1).
+    pub fn transition(&self) -> f64 {
+        match self.placement {
+            Placement::Aligned | Placement::Graded { .. } => TRANSITION,
+            Placement::Unaligned => UNALIGNED_TRANSITION,
+        }
+    }
+
+    /// The geometry file (relative to scenes/) and its gmsh parameters at level 0, as the
+    /// scene's `geo` and `[parameters]` lines.
+    fn mesh_lines(&self) -> (&'static str, String) {
+        let a = self.transition();
+        match self.placement {
+            Placement::Aligned => (
+                "../meshes/two_blocks_point.geo",
+                format!("h_upper = 0.3\nh_lower = 0.2\ngrading = 1.3\npoint = {a}"),
+            ),
+            Placement::Unaligned => (
+                "../meshes/two_blocks.geo",
+                format!("h_upper = 0.3\nh_lower = 0.2\ngrading = {:?}", unaligned_grading()),
+            ),
+            Placement::Graded { mu } => (
+                "../meshes/two_blocks_graded.geo",
+                format!("h_upper = 0.3\nh_lower = 0.2\npoint = {a}\nmu = {mu}\nradius = {GRADED_RADIUS}"),
+            ),
         }
     }
 
@@ -117,7 +256,7 @@ impl SingularContact {
 
     /// The singular part of body `l`'s displacement as scene expressions (x, y, t).
     pub fn singular_text(&self, l: usize) -> [String; 2] {
-        let a = TRANSITION;
+        let a = self.transition();
         let r2 = format!("((x-{a})^2+(y-1)^2)");
         let b = self.beta;
         let pow = |p: f64| format!("{r2}^({})", p / 2.0);
@@ -149,18 +288,20 @@ impl SingularContact {
     pub fn scene_toml(&self, steps: usize) -> String {
         let [u1, u2] = [0, 1].map(|l| self.singular_text(l));
         let [m1, m2] = [0, 1].map(|l| self.smooth_text(l));
+        let (geo, parameters) = self.mesh_lines();
+        let refinement = match self.placement {
+            Placement::Graded { .. } => "\nrefinement = \"remesh\"",
+            _ => "",
+        };
         format!(
             r#"# Written by `cargo run --release --example regularity_scenes`: do not edit by hand.
-description = "Manufactured contact solution with a singular part r^beta Phi_l(theta) at the transition point c = ({a}, 1), beta = {beta}: pressure ~ dist^(beta-1), gap ~ dist^beta (src/analytical/singular.rs)"
-geo = "../meshes/two_blocks_point.geo"
+description = "Manufactured contact solution with a singular part r^beta Phi_l(theta) at the transition point c = ({a}, 1), beta = {beta}: pressure ~ dist^(beta-1), gap ~ dist^beta (src/analytical/singular.rs){where_c}"
+geo = "{geo}"{refinement}
 final_time = 1.0
 steps = {steps}
 
 [parameters]
-h_upper = 0.3
-h_lower = 0.2
-grading = 1.3
-point = {a}
+{parameters}
 
 [[bodies]]
 surface = "upper"
@@ -215,7 +356,12 @@ displacement = [
    "{u2y}"],
 ]
 "#,
-            a = TRANSITION,
+            a = self.transition(),
+            where_c = match self.placement {
+                Placement::Aligned => String::new(),
+                Placement::Unaligned => "; c at 1/3 of a trace segment of both meshes at every level, a node of neither".into(),
+                Placement::Graded { mu } => format!("; every level meshed by gmsh with sizes graded toward c, h (r/R)^(1-mu), mu = {mu}"),
+            },
             beta = self.beta,
             bm1 = self.beta - 1.0,
             e1 = self.young[0],

@@ -138,6 +138,8 @@ impl LoadPrograms {
         }
         if let Some(s) = model.scene.exact.as_ref().and_then(|e| e.singular.as_ref()) {
             (s.point.map(f64::to_bits), s.exponent.to_bits()).hash(&mut h);
+            // The rules at the point: a load integrated more finely is another load.
+            crate::quadrature::singular::accuracy().hash(&mut h);
         }
         h.finish()
     }

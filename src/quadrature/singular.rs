@@ -19,6 +19,7 @@
 //! Newton on the orthonormal recurrence): thirty lines, no new crate.
 
 use nalgebra::{DMatrix, SymmetricEigen};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Gauss-Jacobi points and weights on [0, 1] for the weight s^b (b > -1) with `n` points:
 /// sum w_i g(s_i) = int_0^1 s^b g(s) ds for polynomials g of degree <= 2n - 1.
@@ -93,6 +94,45 @@ pub fn gauss_jacobi(n: usize, b: f64) -> Vec<(f64, f64)> {
 /// Points per direction of the singular rules (Gauss-Jacobi in r, Gauss-Legendre across):
 /// measured, r^gamma cos(k theta) on the test triangles to <= 1e-14 relative with 12.
 pub const SINGULAR_POINTS: usize = 12;
+
+/// How finely the rules at a singular point resolve it: Gauss-Jacobi points per direction
+/// and the depth of [`near_rule`]'s recursive split.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Accuracy {
+    /// Points per direction of [`vertex_rule`] and [`segment_from`].
+    pub points: usize,
+    /// Times [`near_rule`] may split a triangle near the point.
+    pub near_depth: usize,
+}
+
+impl Accuracy {
+    /// What every study uses: [`SINGULAR_POINTS`] and [`NEAR_DEPTH`].
+    pub const DEFAULT: Accuracy = Accuracy {
+        points: SINGULAR_POINTS,
+        near_depth: NEAR_DEPTH,
+    };
+}
+
+static POINTS: AtomicUsize = AtomicUsize::new(SINGULAR_POINTS);
+static DEPTH: AtomicUsize = AtomicUsize::new(NEAR_DEPTH);
+
+/// The accuracy the load and error integrals use now ([`Accuracy::DEFAULT`] unless
+/// [`set_accuracy`] changed it).
+pub fn accuracy() -> Accuracy {
+    Accuracy {
+        points: POINTS.load(Ordering::Relaxed),
+        near_depth: DEPTH.load(Ordering::Relaxed),
+    }
+}
+
+/// Change the accuracy of every singular rule in this process: for checking that the
+/// integrals do not move when it is raised (the load cache keys on it). Process-wide, so
+/// a test that sets it runs alone in its binary.
+pub fn set_accuracy(a: Accuracy) {
+    assert!((1..=40).contains(&a.points), "1 to 40 points");
+    POINTS.store(a.points, Ordering::Relaxed);
+    DEPTH.store(a.near_depth, Ordering::Relaxed);
+}
 
 /// A rule for the triangle `t` whose vertex `v` (0, 1 or 2) is the singular point, for
 /// integrands r^alpha g (g smooth along rays, alpha > -2): barycentric pairs (l1, l2) of `t`
@@ -232,13 +272,58 @@ pub fn segment_from(alpha: f64, n: usize) -> Vec<(f64, f64)> {
 /// of its size: measured, r^-1.4 on them to 1e-9 relative).
 pub const NEAR_DEPTH: usize = 8;
 
+/// The pieces of `t` that have a vertex at `c` when `c` lies in `t` (on an edge or inside)
+/// but is none of its vertices: the triangles (c, t_i, t_i+1) of non-zero area, as the
+/// barycentric coordinates in `t` of their three vertices (c first) and their area
+/// fractions. None where `c` lies outside `t`.
+pub fn split_at(t: &[[f64; 2]; 3], c: [f64; 2]) -> Option<Vec<([[f64; 3]; 3], f64)>> {
+    let full = super::twice_area(t);
+    // Barycentric coordinates of c: the sub-areas opposite each vertex.
+    let lam: [f64; 3] =
+        [0, 1, 2].map(|i| super::twice_area(&[c, t[(i + 1) % 3], t[(i + 2) % 3]]) / full);
+    const TOL: f64 = 1e-12;
+    if lam.iter().any(|&l| l < -TOL) {
+        return None;
+    }
+    let unit = |i: usize| {
+        let mut e = [0.0; 3];
+        e[i] = 1.0;
+        e
+    };
+    Some(
+        (0..3)
+            .filter(|&i| lam[(i + 2) % 3] > TOL)
+            .map(|i| ([lam, unit(i), unit((i + 1) % 3)], lam[(i + 2) % 3]))
+            .collect(),
+    )
+}
+
+/// [`vertex_rule`] on each piece of [`split_at`], as one rule of `t` (barycentric pairs of
+/// `t`, weights to be multiplied by `t`'s area).
+fn split_rule(pieces: &[([[f64; 3]; 3], f64)], alpha: f64, n: usize) -> Vec<(f64, f64, f64)> {
+    let reference = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+    let mut out = Vec::new();
+    for (vertices, fraction) in pieces {
+        for (l1, l2, w) in vertex_rule(&reference, 0, alpha, n) {
+            let l0 = 1.0 - l1 - l2;
+            let lam = [0, 1, 2].map(|k| l0 * vertices[0][k] + l1 * vertices[1][k] + l2 * vertices[2][k]);
+            out.push((lam[1], lam[2], w * fraction));
+        }
+    }
+    out
+}
+
 /// The rules of the triangle `t` when the integrand is singular at `point` (None: not
 /// singular), each with the index into `powers` of the part it integrates:
 /// - `t` has a vertex at the point: one [`vertex_rule`] per entry of `powers` (each part
 ///   of the split integrand r^power g, the caller's to evaluate);
+/// - the point lies on an edge of `t` (or inside): `t` split there into triangles with a
+///   vertex at the point ([`split_at`]), one rule per power over the pieces;
 /// - `t` is near it ([`is_near`]): `base` on [`near_rule`]'s pieces, for the whole integrand
 ///   (None);
 /// - otherwise `base` split along the `kinks` ([`super::triangle_rule`]), None.
+///
+/// The points per direction and the near split's depth are [`accuracy`]'s.
 pub fn rules<'b, K: Fn([f64; 2]) -> f64>(
     t: [[f64; 2]; 3],
     kinks: &[K],
@@ -247,16 +332,26 @@ pub fn rules<'b, K: Fn([f64; 2]) -> f64>(
     powers: &[f64],
 ) -> Vec<(Option<usize>, std::borrow::Cow<'b, [(f64, f64, f64)]>)> {
     use std::borrow::Cow;
-    match point {
-        Some(c) => match vertex_at(&t, c) {
-            Some(v) => powers
-                .iter()
-                .enumerate()
-                .map(|(i, &a)| (Some(i), Cow::Owned(vertex_rule(&t, v, a, SINGULAR_POINTS))))
-                .collect(),
-            None if is_near(&t, c) => vec![(None, Cow::Owned(near_rule(t, c, base, NEAR_DEPTH)))],
-            None => vec![(None, super::triangle_rule(t, kinks, base))],
-        },
-        None => vec![(None, super::triangle_rule(t, kinks, base))],
+    let Some(c) = point else {
+        return vec![(None, super::triangle_rule(t, kinks, base))];
+    };
+    let accuracy = accuracy();
+    if let Some(v) = vertex_at(&t, c) {
+        return powers
+            .iter()
+            .enumerate()
+            .map(|(i, &a)| (Some(i), Cow::Owned(vertex_rule(&t, v, a, accuracy.points))))
+            .collect();
     }
+    if let Some(pieces) = split_at(&t, c) {
+        return powers
+            .iter()
+            .enumerate()
+            .map(|(i, &a)| (Some(i), Cow::Owned(split_rule(&pieces, a, accuracy.points))))
+            .collect();
+    }
+    if is_near(&t, c) {
+        return vec![(None, Cow::Owned(near_rule(t, c, base, accuracy.near_depth)))];
+    }
+    vec![(None, super::triangle_rule(t, kinks, base))]
 }

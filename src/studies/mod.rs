@@ -18,15 +18,23 @@ use std::path::PathBuf;
 /// Declares each kind's folder as a module and lists its `KIND` in [`KINDS`], so that a
 /// kind is named once.
 macro_rules! kinds {
-    ($($kind:ident),* $(,)?) => {
+    ($($kind:ident $([$($more:ident),*])?),* $(,)?) => {
         $(pub mod $kind;)*
         /// Every study kind, in the order `study NAME` tries them.
-        pub const KINDS: &[&Kind] = &[$(&$kind::KIND),*];
+        pub const KINDS: &[&Kind] = &[$(&$kind::KIND, $($(&$kind::$more,)*)?)*];
     };
 }
 
-// The table of study kinds: one folder under src/studies/ each.
-kinds![convergence, two_size, regularity, paper, speed, stability];
+// The table of study kinds: one folder under src/studies/ each (a folder may hold more
+// than one kind: the regularity studies' mesh families).
+kinds![
+    convergence,
+    two_size,
+    regularity[UNALIGNED_KIND, GRADED_KIND],
+    paper,
+    speed,
+    stability,
+];
 
 /// A study to run: its kind and, for a kind found in files, the study file.
 pub struct Study {

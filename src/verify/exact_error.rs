@@ -317,55 +317,76 @@ impl<'a> ExactComparison<'a> {
         for (piece, profile) in interface.pieces.iter().zip(pressure) {
             for w in profile.windows(2) {
                 let ((xa, pa), (xb, pb)) = (w[0], w[1]);
-                let len = (xb[0] - xa[0]).hypot(xb[1] - xa[1]);
                 let exact_at = |x: [f64; 2]| {
                     self.exact
                         .pressure_at(piece.normal, x[0], x[1], t)
                         .unwrap_or(f64::NAN)
                 };
-                // A segment from the singular point: p = p_rest + p_s with p_s ~ r^(beta-1),
-                // the three parts of (p_h - p)^2 and p^2 each by its own Gauss-Jacobi rule.
-                let from_point = singular.and_then(|sg| {
-                    let at = |x: [f64; 2]| sg.distance(x[0], x[1]) <= 1e-12 * len;
-                    (at(xa) || at(xb)).then_some((sg, at(xb)))
-                });
-                if let Some((sg, reversed)) = from_point {
-                    let n = piece.normal;
-                    let singular_at = |x: [f64; 2]| {
-                        let st = sg.stress[0].each_ref().map(|e| e.eval(x[0], x[1], t));
-                        -(n[0] * n[0] * st[0] + n[1] * n[1] * st[1] + 2.0 * n[0] * n[1] * st[2])
-                    };
-                    let beta = sg.exponent;
-                    for (alpha, part) in [
-                        (0.0, Split::Smooth),
-                        (beta - 1.0, Split::Cross),
-                        (2.0 * beta - 2.0, Split::Singular),
-                    ] {
-                        for (r, wq) in quadrature::singular::segment_from(
-                            alpha,
-                            quadrature::singular::SINGULAR_POINTS,
-                        ) {
-                            let q = if reversed { 1.0 - r } else { r };
-                            let x = [xa[0] + q * (xb[0] - xa[0]), xa[1] + q * (xb[1] - xa[1])];
-                            let (exact, ps) = (exact_at(x), singular_at(x));
-                            let ph = pa + q * (pb - pa);
-                            diff += wq * len * part.square(ph - exact, -ps);
-                            norm += wq * len * part.square(exact, ps);
-                        }
+                // A segment with the singular point inside is split there (p_h linear).
+                let split = singular.and_then(|sg| interior_fraction(xa, xb, sg.point));
+                let parts = match split {
+                    Some(q) => {
+                        let c = singular.expect("split at the singular point").point;
+                        vec![((xa, pa), (c, pa + q * (pb - pa))), ((c, pa + q * (pb - pa)), (xb, pb))]
                     }
-                    continue;
-                }
-                for &(q, wq) in quadrature::segment_rule(xa, xb, &kinks, &self.segment).iter() {
-                    let x = [xa[0] + q * (xb[0] - xa[0]), xa[1] + q * (xb[1] - xa[1])];
-                    let exact = exact_at(x);
-                    let ph = pa + q * (pb - pa);
-                    diff += wq * len * (ph - exact).powi(2);
-                    norm += wq * len * exact * exact;
+                    None => vec![((xa, pa), (xb, pb))],
+                };
+                for ((xa, pa), (xb, pb)) in parts {
+                    let len = (xb[0] - xa[0]).hypot(xb[1] - xa[1]);
+                    // A segment from the singular point: p = p_rest + p_s with p_s ~
+                    // r^(beta-1), the three parts of (p_h - p)^2 and p^2 each by its own
+                    // Gauss-Jacobi rule.
+                    let from_point = singular.and_then(|sg| {
+                        let at = |x: [f64; 2]| sg.distance(x[0], x[1]) <= 1e-12 * len;
+                        (at(xa) || at(xb)).then_some((sg, at(xb)))
+                    });
+                    if let Some((sg, reversed)) = from_point {
+                        let n = piece.normal;
+                        let singular_at = |x: [f64; 2]| {
+                            let st = sg.stress[0].each_ref().map(|e| e.eval(x[0], x[1], t));
+                            -(n[0] * n[0] * st[0] + n[1] * n[1] * st[1] + 2.0 * n[0] * n[1] * st[2])
+                        };
+                        let beta = sg.exponent;
+                        for (alpha, part) in [
+                            (0.0, Split::Smooth),
+                            (beta - 1.0, Split::Cross),
+                            (2.0 * beta - 2.0, Split::Singular),
+                        ] {
+                            let points = quadrature::singular::accuracy().points;
+                            for (r, wq) in quadrature::singular::segment_from(alpha, points) {
+                                let q = if reversed { 1.0 - r } else { r };
+                                let x = [xa[0] + q * (xb[0] - xa[0]), xa[1] + q * (xb[1] - xa[1])];
+                                let (exact, ps) = (exact_at(x), singular_at(x));
+                                let ph = pa + q * (pb - pa);
+                                diff += wq * len * part.square(ph - exact, -ps);
+                                norm += wq * len * part.square(exact, ps);
+                            }
+                        }
+                        continue;
+                    }
+                    for &(q, wq) in quadrature::segment_rule(xa, xb, &kinks, &self.segment).iter() {
+                        let x = [xa[0] + q * (xb[0] - xa[0]), xa[1] + q * (xb[1] - xa[1])];
+                        let exact = exact_at(x);
+                        let ph = pa + q * (pb - pa);
+                        diff += wq * len * (ph - exact).powi(2);
+                        norm += wq * len * exact * exact;
+                    }
                 }
             }
         }
         (diff, norm)
     }
+}
+
+/// Where `c` lies strictly inside the segment a -> b (within 1e-12 of its length of the
+/// segment, more than that from both ends): its fraction along the segment.
+fn interior_fraction(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> Option<f64> {
+    let ab = [b[0] - a[0], b[1] - a[1]];
+    let len2 = ab[0] * ab[0] + ab[1] * ab[1];
+    let q = ((c[0] - a[0]) * ab[0] + (c[1] - a[1]) * ab[1]) / len2;
+    let off = (a[0] + q * ab[0] - c[0]).hypot(a[1] + q * ab[1] - c[1]);
+    let tol = 1e-12;
+    (off <= tol * len2.sqrt() && q > tol && q < 1.0 - tol).then_some(q)
 }
 
 /// The exact pressure and gap along Gamma_C at time `t`, at 401 points per piece:

@@ -1,26 +1,87 @@
-//! The `regularity` study: how each cone's rates follow the regularity of the solution at
-//! the transition point between contact and separation.
+//! The `regularity` studies: how each cone's rates follow the regularity of the solution at
+//! the transition point c between contact and separation, in three mesh families:
+//! - `regularity` ([`ALIGNED`]): c a node of both meshes at every level;
+//! - `regularity-unaligned` ([`UNALIGNED`]): c a node of neither trace, 1/3 of its segment
+//!   from the nearest node on both at every level (its position alternates between 1/3 and
+//!   2/3 under halving, so each parity of levels is judged as well as the whole);
+//! - `regularity-graded` ([`GRADED`]): each level meshed by gmsh with sizes graded toward c
+//!   (beta < 1), rates in h and in dofs beside the uniform family's.
 //!
 //! [`run`] reads like the description of the study:
-//! 1. for each beta in [`BETAS`], the manufactured solution with a singular part
-//!    r^beta Phi_l(theta) at the transition point (`analytical::singular`; the scenes and
-//!    study files are written by `examples/regularity_scenes.rs`) is solved by both cones
-//!    on [`LEVELS`] of uniform refinement and measured against itself (the convergence
-//!    study of studies/regularity/beta-BETA.toml);
-//! 2. each quantity's rate is set beside the best a uniform P1 mesh can give
+//! 1. for each beta of the family, the manufactured solution with a singular part
+//!    r^beta Phi_l(theta) at c (`analytical::singular`; the scenes and study files are
+//!    written by `examples/regularity_scenes.rs`) is solved by both cones on the family's
+//!    levels and measured against itself (the convergence study of
+//!    studies/FAMILY/beta-BETA.toml);
+//! 2. where c sits among the trace nodes is measured at every level ([`placement`]);
+//! 3. each quantity's rate is set beside the best a uniform P1 mesh can give
 //!    ([`best_rate`]): min(1, beta) for the H1 and theorem norms, min(beta, 3/2) for the
 //!    stress along Gamma_C, min(beta - 1/2, 2) for the pressure in L2(Gamma_C);
-//! 3. the report leads with where the cones differ, and marks where Theorem 3.1's
+//! 4. the report leads with where the cones differ, and marks where Theorem 3.1's
 //!    hypotheses (u in H^2, f in L2: beta > 1) fail.
 
+pub mod families;
 pub mod report;
 pub mod results;
 
+use crate::analytical::singular::Placement;
+use crate::contact::Interface;
 use crate::error::Result;
+use crate::scene::Scene;
 use crate::studies::convergence::{self, StudyResult};
 use crate::verify::kind::{Found, Kind};
 use crate::verify::quantity::Quantity;
-use std::path::PathBuf;
+use crate::verify::study_file::StudyFile;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// One mesh family of the regularity studies.
+#[derive(Debug)]
+pub struct Family {
+    /// The study's name, its report folder and the prefix of its scenes.
+    pub name: &'static str,
+    /// The betas of the study.
+    pub betas: &'static [f64],
+    /// The levels of each beta's study.
+    pub levels: &'static [usize],
+    /// Where c sits among the nodes.
+    pub placement: Placement,
+    /// Whether each parity of levels is judged on its own (c's position alternates).
+    pub parity: bool,
+}
+
+/// c a node of both meshes, levels 0-5 of uniform splitting.
+pub const ALIGNED: Family = Family {
+    name: "regularity",
+    betas: BETAS,
+    levels: LEVELS,
+    placement: Placement::Aligned,
+    parity: false,
+};
+
+/// c at 1/3 of a segment of both traces at every level, levels 0-7 of uniform splitting.
+pub const UNALIGNED: Family = Family {
+    name: "regularity-unaligned",
+    betas: &[0.75, 1.25, 1.5, 2.0],
+    levels: &[0, 1, 2, 3, 4, 5, 6, 7],
+    placement: Placement::Unaligned,
+    parity: true,
+};
+
+/// The grading exponent of [`GRADED`]: element size h (r / R)^(1 - mu) near c. Any
+/// mu < beta gives the H1 error h on graded meshes for r^beta (Babuska's grading); 1/2 is
+/// below every graded beta (0.6 and up), keeps the smallest elements at h^2 / R and the
+/// element count O(h^-2).
+pub const GRADED_MU: f64 = 0.5;
+
+/// c a node of both meshes, each level meshed by gmsh graded toward c, levels 0-5.
+pub const GRADED: Family = Family {
+    name: "regularity-graded",
+    betas: &[0.6, 0.75, 0.9],
+    levels: LEVELS,
+    placement: Placement::Graded { mu: GRADED_MU },
+    parity: false,
+};
 
 /// The kind: built in (`study regularity`).
 pub const KIND: Kind = Kind {
@@ -28,27 +89,61 @@ pub const KIND: Kind = Kind {
     description: "Rates of both cones against the regularity beta of the contact transition (u ~ r^beta there), beta from 0.6 to 2",
     found: Found::BuiltIn,
     shards: false,
-    run: |_, _| Ok(Some(Box::new(run(BETAS)?))),
-    rejudge: Some(|_, dir| Ok(Box::new(rejudge(BETAS, dir)?))),
+    run: |_, _| Ok(Some(Box::new(run(&ALIGNED)?))),
+    rejudge: Some(|_, dir| Ok(Box::new(rejudge(&ALIGNED, dir)?))),
     results: Some(results::section),
 };
 
-/// The betas of the study.
+/// The kind `study regularity-unaligned`.
+pub const UNALIGNED_KIND: Kind = Kind {
+    name: "regularity-unaligned",
+    description: "The regularity study with the transition point off the nodes of both meshes (1/3 of a segment at every level), levels 0-7, each parity judged",
+    found: Found::BuiltIn,
+    shards: false,
+    run: |_, _| Ok(Some(Box::new(run(&UNALIGNED)?))),
+    rejudge: Some(|_, dir| Ok(Box::new(rejudge(&UNALIGNED, dir)?))),
+    results: None,
+};
+
+/// The kind `study regularity-graded`.
+pub const GRADED_KIND: Kind = Kind {
+    name: "regularity-graded",
+    description: "The regularity study for beta < 1 on meshes graded toward the transition point (each level meshed by gmsh), rates in h and in dofs beside the uniform family's",
+    found: Found::BuiltIn,
+    shards: false,
+    run: |_, _| Ok(Some(Box::new(run(&GRADED)?))),
+    rejudge: Some(|_, dir| Ok(Box::new(rejudge(&GRADED, dir)?))),
+    results: None,
+};
+
+/// The betas of the aligned study.
 pub const BETAS: &[f64] = &[0.6, 0.75, 0.9, 1.25, 1.5, 2.0];
 
-/// The refinement levels of each beta's study (h = 0.3 / 1.4142^level).
+/// The refinement levels of each beta's aligned study (h = 0.3 / 2^level).
 pub const LEVELS: &[usize] = &[0, 1, 2, 3, 4, 5];
 
-/// The scene of one beta.
-pub fn scene_name(beta: f64) -> String {
-    format!("regularity-{beta:.2}")
+impl Family {
+    /// The scene of one beta.
+    pub fn scene_name(&self, beta: f64) -> String {
+        format!("{}-{beta:.2}", self.name)
+    }
+
+    /// The study file of one beta.
+    pub fn study_path(&self, beta: f64) -> PathBuf {
+        crate::verify::study_file::builtin_dir()
+            .join(self.name)
+            .join(format!("beta-{beta:.2}.toml"))
+    }
 }
 
-/// The study file of one beta.
+/// The aligned family's scene of one beta.
+pub fn scene_name(beta: f64) -> String {
+    ALIGNED.scene_name(beta)
+}
+
+/// The aligned family's study file of one beta.
 pub fn study_path(beta: f64) -> PathBuf {
-    crate::verify::study_file::builtin_dir()
-        .join("regularity")
-        .join(format!("beta-{beta:.2}.toml"))
+    ALIGNED.study_path(beta)
 }
 
 /// The best rate in h a uniform P1 mesh can give for `quantity` when u ~ r^beta at one
@@ -72,30 +167,120 @@ pub fn theorem_applies(beta: f64) -> bool {
     beta > 1.0
 }
 
+
+/// Where a transition point sits at one level: one row of placement.csv.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct PlacementRow {
+    /// The scene.
+    pub scene: String,
+    /// The mesh level.
+    pub level: usize,
+    /// The transition point's abscissa.
+    pub transition: f64,
+    /// Its distance to the nearest node of the slave trace, over the length of the slave
+    /// segment that holds it (0 at a node, 1/2 at a midpoint).
+    pub slave_offset: f64,
+    /// The same on the master trace.
+    pub master_offset: f64,
+}
+
+/// Where the transition point `c` of `scene` sits among the trace nodes at each of
+/// `levels`, on the meshes of the gmsh parameters `params` (from the cache).
+pub fn placement(
+    scene: &Scene,
+    c: [f64; 2],
+    params: &[(String, f64)],
+    levels: &[usize],
+) -> Result<Vec<PlacementRow>> {
+    levels
+        .iter()
+        .map(|&level| {
+            let (generated, raw) = crate::case::Case::mesh(scene, level, params)?;
+            let model = crate::fe::Model::new(scene, &raw, &generated.path)?;
+            let offset = Interface::new(&model, &raw)?.node_offset(c).ok_or_else(|| {
+                crate::error::Error::input(
+                    &scene.file,
+                    "exact",
+                    format!("the transition point ({}, {}) is not on Gamma_C", c[0], c[1]),
+                )
+            })?;
+            Ok(PlacementRow {
+                scene: scene.name.clone(),
+                level,
+                transition: c[0],
+                slave_offset: offset.slave,
+                master_offset: offset.master,
+            })
+        })
+        .collect()
+}
+
 /// What the study measured: one convergence study per beta.
 pub struct Regularity {
-    /// (beta, its convergence study), in the order of [`BETAS`].
+    /// The family.
+    pub family: &'static Family,
+    /// (beta, its convergence study), in the order of the family's betas.
     pub members: Vec<(f64, StudyResult)>,
+    /// Where c sits at every level of every beta, and where contact-mms's transition sits.
+    pub placement: Vec<PlacementRow>,
+}
+
+/// contact-mms's transition abscissa (scenes/contact-mms.toml: contact on [0, a)).
+pub const CONTACT_MMS_TRANSITION: f64 = 0.5871;
+
+/// Where c sits in each member of `family` (its study file's meshes), and, for comparison,
+/// where contact-mms's transition sits on rates-exact's meshes.
+fn family_placement(family: &Family) -> Result<Vec<PlacementRow>> {
+    let mut rows = Vec::new();
+    for &beta in family.betas {
+        let file = StudyFile::load(&family.study_path(beta))?;
+        let scene = Scene::load(&family.scene_name(beta))?;
+        let c = scene
+            .exact
+            .as_ref()
+            .and_then(|e| e.singular.as_ref())
+            .map_or([CONTACT_MMS_TRANSITION, 1.0], |s| s.point);
+        rows.extend(placement(&scene, c, &file.family_parameters(), family.levels)?);
+    }
+    let path = crate::verify::study_file::builtin_dir().join("rates-exact.toml");
+    let file = StudyFile::load(&path)?;
+    let scene = Scene::load(&file.scene)?;
+    rows.extend(placement(
+        &scene,
+        [CONTACT_MMS_TRANSITION, 1.0],
+        &file.family_parameters(),
+        &file.mesh.levels,
+    )?);
+    Ok(rows)
 }
 
 /// The report `dir` judged again from each beta's CSVs (its `beta-BETA/` folders),
 /// without solving.
-pub fn rejudge(betas: &[f64], dir: &std::path::Path) -> Result<Regularity> {
+pub fn rejudge(family: &'static Family, dir: &Path) -> Result<Regularity> {
     let mut members = Vec::new();
-    for &beta in betas {
-        let path = study_path(beta);
+    for &beta in family.betas {
+        let path = family.study_path(beta);
         let member = dir.join(format!("beta-{beta:.2}"));
         members.push((beta, convergence::rejudge(&path.display().to_string(), &member)?));
     }
-    Ok(Regularity { members })
+    let placement = crate::verify::table::read(&dir.join("placement.csv"))?;
+    Ok(Regularity {
+        family,
+        members,
+        placement,
+    })
 }
 
-/// Run the study on `betas`.
-pub fn run(betas: &[f64]) -> Result<Regularity> {
+/// Run the study of `family`.
+pub fn run(family: &'static Family) -> Result<Regularity> {
     let mut members = Vec::new();
-    for &beta in betas {
-        let path = study_path(beta);
+    for &beta in family.betas {
+        let path = family.study_path(beta);
         members.push((beta, convergence::run(&path.display().to_string())?));
     }
-    Ok(Regularity { members })
+    Ok(Regularity {
+        family,
+        members,
+        placement: family_placement(family)?,
+    })
 }

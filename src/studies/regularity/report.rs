@@ -3,6 +3,7 @@
 //! leading with where the cones differ, and each beta's convergence report in `beta-BETA/`.
 
 use super::{Regularity, best_rate, theorem_applies};
+use crate::analytical::singular::Placement;
 use crate::contact::Method;
 use crate::error::Result;
 use crate::io::csv_bytes;
@@ -232,15 +233,49 @@ impl Regularity {
         )
     }
 
-    fn readme(&self) -> String {
+    /// The title and the lead paragraph of the family's report.
+    fn lead(&self) -> (String, String) {
+        let family = self.family;
+        let common = "Both cones on a manufactured contact solution whose displacement has a singular part r^beta Phi_l(theta) at the point c where contact ends (src/analytical/singular.rs; the pressure ~ dist^(beta-1), the gap ~ dist^beta), for each beta, measured against the exact solution. The load and the error integrals on the triangles at c split each integrand by power of r, one Gauss-Jacobi rule per power (src/quadrature/singular.rs)";
+        let n = family.levels.len();
+        match family.placement {
+            Placement::Aligned => (
+                "regularity: rates against the regularity of the contact transition".into(),
+                format!("{common}; c = (0.5871, 1), on {n} levels of uniform refinement with c a node of both meshes."),
+            ),
+            Placement::Unaligned => (
+                "regularity-unaligned: the transition off the mesh nodes".into(),
+                format!("{common}; c = (8/15, 1) is a node of neither mesh: at 2/3 of a lower and 1/3 of an upper level-0 trace segment (meshes/two_blocks.geo, the upper line graded by 1.3844 to put it there), so that under halving it sits at 1/3 or 2/3 of its segment on both traces at every level. The triangles with c on an edge and the trace segments holding c are split at c for the load and the error integrals. {n} levels of uniform refinement."),
+            ),
+            Placement::Graded { mu } => (
+                "regularity-graded: meshes graded toward the transition".into(),
+                format!("{common}; c = (0.5871, 1), a node of both meshes. Each level is meshed by gmsh with element sizes h_L min(1, (r/R)^(1-mu)) within R = {} of c (floored at h_L^(1/mu) R^(1-1/mu), the size of the elements at c), mu = {mu}: any mu < beta gives the best approximation of r^beta at rate 1 in H1, and 1/2 is below every beta here (meshes/two_blocks_graded.geo; h_L halves from level to level). {n} levels.", crate::analytical::singular::GRADED_RADIUS),
+            ),
+        }
+    }
+
+    fn readme(&self) -> Result<String> {
         let mut doc = Doc::new();
-        doc.heading(1, "regularity: rates against the regularity of the contact transition");
-        doc.paragraph(
-            "Both cones on a manufactured contact solution whose displacement has a singular part r^beta Phi_l(theta) at the point c = (0.5871, 1) where contact ends (src/analytical/singular.rs; the pressure ~ dist^(beta-1), the gap ~ dist^beta), for each beta, on 6 levels of uniform refinement with c a node of both meshes, measured against the exact solution. The load and the error integrals on the triangles at c split each integrand by power of r, one Gauss-Jacobi rule per power (src/quadrature/singular.rs).",
-        );
+        let (title, lead) = self.lead();
+        doc.heading(1, &title);
+        doc.paragraph(lead);
         doc.heading(2, "What differs between the cones (Theorem 3.1's norm)");
         doc.list(self.differences());
         doc.paragraph(self.deficit());
+        let reports = crate::report::folder::reports_dir();
+        match self.family.placement {
+            Placement::Aligned => {}
+            Placement::Unaligned => {
+                super::families::against_aligned(&mut doc, self, &reports, &[Quantity::Theorem, Quantity::L2Pressure, Quantity::ConeDistance])?;
+                super::families::parity_section(&mut doc, self, &QUANTITIES);
+            }
+            Placement::Graded { .. } => {
+                super::families::against_uniform(&mut doc, self, &reports, &[Quantity::Theorem, Quantity::H1U, Quantity::ConeDistance])?;
+            }
+        }
+        if self.family.placement != Placement::Aligned {
+            super::families::placement_section(&mut doc, self);
+        }
         doc.paragraph("D is the distance between the two cones' solutions on the same meshes (`cone_distance`); D - e_mortar <= e_nts <= D + e_mortar, so nts's error follows D's rate once D overtakes e_mortar. Each beta's report reads nts against D (its decomposition.csv and \"nts read against its distance to mortar\"); `decomposition.csv` here holds every beta's.");
         doc.paragraph("† Theorem 3.1 does not apply: for beta <= 1 the solution is not in H^2 and the body force ~ r^(beta-2) is not in L2 (it lies in V' only). Its rates 3/4 and 1/2 are claimed only for beta > 1; below, the study requires only convergence (rate >= 0).");
         doc.heading(2, "Rates in h, mortar / nts, beside the best uniform-mesh rate");
@@ -316,8 +351,8 @@ impl Regularity {
                 res.wall_s
             )
         }));
-        doc.paragraph("Reproduce: `cargo run --release -- study regularity` (the scenes and the per-beta study files are written by `cargo run --release --example regularity_scenes`).");
-        doc.finish()
+        doc.paragraph(format!("Reproduce: `cargo run --release -- study {}` (the scenes and the per-beta study files are written by `cargo run --release --example regularity_scenes`).", self.family.name));
+        Ok(doc.finish())
     }
 
     fn plots(&self, d: &Path) -> Result<()> {
@@ -414,11 +449,16 @@ impl KindOutcome for Regularity {
                 })
                 .collect();
             write(d, "decomposition.csv", &csv_bytes(&decomposition)?)?;
+            write(d, "placement.csv", &csv_bytes(&self.placement)?)?;
             self.plots(d)?;
             for (beta, res) in &self.members {
                 crate::studies::convergence::report::write_study(res, &d.join(format!("beta-{beta:.2}")))?;
             }
-            write(d, "README.md", self.readme().as_bytes())
+            if self.family.parity {
+                let rows = super::families::parity_rows(self, &QUANTITIES);
+                write(d, "parity.csv", &csv_bytes(&rows)?)?;
+            }
+            write(d, "README.md", self.readme()?.as_bytes())
         })
     }
 
