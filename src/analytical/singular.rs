@@ -112,6 +112,9 @@ pub struct SingularContact {
     pub phi: [[Trig; 2]; 2],
     /// Where c sits among the mesh nodes (and so c itself).
     pub placement: Placement,
+    /// The aligned placement's upper-line grading (meshes/two_blocks_point.geo's `grading`:
+    /// the ratio of the last to the first segment on each side of c).
+    pub grading: f64,
 }
 
 /// The chosen values of Phi (upper, lower body) on the separated side (theta = 0) and the
@@ -132,6 +135,18 @@ pub struct Ends {
 }
 
 impl Ends {
+    /// The crossover-transition family's: every value 0 but the gap's (0.1) and the
+    /// pressure's derivative (5), so that the singular part carries as much pressure as it
+    /// can for its curvature (measured at beta = 1.25, levels 0-4: D / e_mortar 0.40, 0.34,
+    /// 0.72, 0.91, 1.25 against the regularity family's 0.32, 0.26, 0.55, 0.70, 0.96).
+    pub const CROSSOVER_TRANSITION: Ends = Ends {
+        x0: [0.0, 0.0],
+        y0: [0.1, 0.0],
+        xpi: [0.0, 0.0],
+        ypi: [0.0, 0.0],
+        dy1pi: 5.0,
+    };
+
     /// The regularity family's.
     pub const REGULARITY: Ends = Ends {
         x0: [0.2, -0.1],
@@ -191,6 +206,7 @@ impl SingularContact {
             amplitude: 0.05,
             phi,
             placement: Placement::Aligned,
+            grading: 1.3,
         }
     }
 
@@ -217,7 +233,10 @@ impl SingularContact {
         match self.placement {
             Placement::Aligned => (
                 "../meshes/two_blocks_point.geo",
-                format!("h_upper = 0.3\nh_lower = 0.2\ngrading = 1.3\npoint = {a}"),
+                format!(
+                    "h_upper = 0.3\nh_lower = 0.2\ngrading = {:?}\npoint = {a}",
+                    self.grading
+                ),
             ),
             Placement::Unaligned => (
                 "../meshes/two_blocks.geo",
@@ -286,6 +305,21 @@ impl SingularContact {
     /// The scene file of this member (the `regularity` scenes are written by
     /// `examples/regularity_scenes.rs`).
     pub fn scene_toml(&self, steps: usize) -> String {
+        let where_c = match self.placement {
+            Placement::Aligned => String::new(),
+            Placement::Unaligned => "; c at 1/3 of a trace segment of both meshes at every level, a node of neither".into(),
+            Placement::Graded { mu } => format!("; every level meshed by gmsh with sizes graded toward c, h (r/R)^(1-mu), mu = {mu}"),
+        };
+        let description = format!(
+            "Manufactured contact solution with a singular part r^beta Phi_l(theta) at the transition point c = ({}, 1), beta = {}: pressure ~ dist^(beta-1), gap ~ dist^beta (src/analytical/singular.rs){where_c}",
+            self.transition(),
+            self.beta
+        );
+        self.scene_toml_as(steps, "regularity_scenes", &description)
+    }
+
+    /// The scene file of this member, written by `examples/WRITER.rs`, with `description`.
+    pub fn scene_toml_as(&self, steps: usize, writer: &str, description: &str) -> String {
         let [u1, u2] = [0, 1].map(|l| self.singular_text(l));
         let [m1, m2] = [0, 1].map(|l| self.smooth_text(l));
         let (geo, parameters) = self.mesh_lines();
@@ -294,8 +328,8 @@ impl SingularContact {
             _ => "",
         };
         format!(
-            r#"# Written by `cargo run --release --example regularity_scenes`: do not edit by hand.
-description = "Manufactured contact solution with a singular part r^beta Phi_l(theta) at the transition point c = ({a}, 1), beta = {beta}: pressure ~ dist^(beta-1), gap ~ dist^beta (src/analytical/singular.rs){where_c}"
+            r#"# Written by `cargo run --release --example {writer}`: do not edit by hand.
+description = "{description}"
 geo = "{geo}"{refinement}
 final_time = 1.0
 steps = {steps}
@@ -357,11 +391,6 @@ displacement = [
 ]
 "#,
             a = self.transition(),
-            where_c = match self.placement {
-                Placement::Aligned => String::new(),
-                Placement::Unaligned => "; c at 1/3 of a trace segment of both meshes at every level, a node of neither".into(),
-                Placement::Graded { mu } => format!("; every level meshed by gmsh with sizes graded toward c, h (r/R)^(1-mu), mu = {mu}"),
-            },
             beta = self.beta,
             bm1 = self.beta - 1.0,
             e1 = self.young[0],

@@ -167,6 +167,10 @@ pub struct StudyFile {
     pub time: Option<TimeSpec>,
     /// A two-size study: `mesh.levels` are each body's grid levels.
     pub two_size: Option<TwoSizeSpec>,
+    /// Another built-in study whose committed report's distance between the cones the
+    /// report sets beside this one's, at the levels both measure (reports/COMPARE).
+    #[serde(default)]
+    pub compare: Option<String>,
 }
 
 fn default_solver() -> SolverKind {

@@ -9,7 +9,7 @@ use crate::report::markdown::{Doc, Table};
 use crate::report::plot::{self, Series};
 use crate::verify::quantity::Quantity;
 use crate::verify::judge;
-use crate::verify::rates::Fit;
+use crate::verify::rates::{Fit, LevelError, Verdict, assess};
 use std::path::Path;
 
 /// The fit of a row whose verdict supports a rate.
@@ -87,6 +87,85 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
     }
     doc.table(&rates);
     decomposition(doc, res);
+    compared(doc, res);
+}
+
+/// nts's distance to mortar in the theorem norm of `errors`, by level.
+fn distances(errors: &[crate::verify::table::ErrorRecord]) -> Vec<LevelError> {
+    let mut out: Vec<LevelError> = errors
+        .iter()
+        .filter(|e| e.method == Method::Nts && e.quantity == Quantity::ConeDistance)
+        .map(|e| LevelError {
+            level: e.level,
+            h: e.h,
+            dofs: e.dofs as f64,
+            error: e.error,
+        })
+        .collect();
+    out.sort_by_key(|e| e.level);
+    out
+}
+
+/// D judged on `levels`, with its constant: "rate ± se (fitted), D ~ C h^rate with C = ..."
+/// where fitted, else the verdict.
+fn judged_with_constant(levels: &[LevelError]) -> String {
+    match assess(levels, 0.0) {
+        Ok(a) => match a.fit.filter(|_| a.verdict == Verdict::Fitted) {
+            Some(f) => format!(
+                "{:.3} ± {:.3} over levels {}, D ~ C h^rate with C = {:.3e}",
+                f.rate,
+                f.stderr,
+                crate::verify::table::join(&a.used),
+                f.intercept.exp()
+            ),
+            None => a.describe(),
+        },
+        Err(e) => e.to_string(),
+    }
+}
+
+/// The study file's `compare`: nts's distance to mortar beside the other study's (its
+/// committed report) at the levels both measure, judged on those levels alone.
+fn compared(doc: &mut Doc, res: &StudyResult) {
+    let Some(other) = &res.file.compare else {
+        return;
+    };
+    doc.heading(3, &format!("The distance beside {other}'s"));
+    let path = crate::report::folder::reports_dir().join(other).join("errors.csv");
+    let theirs = match crate::verify::table::read(&path) {
+        Ok(rows) => distances(&rows),
+        Err(e) => {
+            doc.paragraph(format!("Not compared: {e} (`cargo run --release -- study {other}` writes it)."));
+            return;
+        }
+    };
+    let ours = distances(&res.errors);
+    let common = |a: &[LevelError], b: &[LevelError]| -> Vec<LevelError> {
+        a.iter().filter(|x| b.iter().any(|y| y.level == x.level)).cloned().collect()
+    };
+    let (mine, yours) = (common(&ours, &theirs), common(&theirs, &ours));
+    let mut table = Table::new(
+        ["level", "h here", "D here", "h there", &format!("D in {other}"), "here / there", "D / h^(1/2) here", "D / h^(1/2) there"]
+            .map(String::from),
+    );
+    for (a, b) in mine.iter().zip(&yours) {
+        table.row([
+            a.level.to_string(),
+            format!("{:.5}", a.h),
+            format!("{:.4e}", a.error),
+            format!("{:.5}", b.h),
+            format!("{:.4e}", b.error),
+            format!("{:.3}", a.error / b.error),
+            format!("{:.4}", a.error / a.h.sqrt()),
+            format!("{:.4}", b.error / b.h.sqrt()),
+        ]);
+    }
+    doc.paragraph(format!(
+        "nts's distance to mortar in the theorem norm here and in reports/{other} (its committed errors.csv), relative to each problem's own exact solution, at the levels both measure, each judged by the same rules on those levels only: here {}; in {other} {}.",
+        judged_with_constant(&mine),
+        judged_with_constant(&yours)
+    ))
+    .table(&table);
 }
 
 /// Each method read against its distance to mortar: for the theorem norm, h1_u and

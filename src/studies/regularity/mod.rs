@@ -136,6 +136,22 @@ impl Family {
     }
 }
 
+impl Family {
+    /// The best rate in h the family's meshes can give for `quantity` at `beta`: on uniform
+    /// meshes [`best_rate`]; on meshes graded toward c with mu < beta, 1 for the H1 and
+    /// theorem norms and the stress in L2 (the graded best approximation of r^beta), None
+    /// for the others (the study does not say).
+    pub fn best_rate(&self, quantity: Quantity, beta: f64) -> Option<f64> {
+        match self.placement {
+            Placement::Graded { .. } => match quantity {
+                Quantity::Theorem | Quantity::H1U | Quantity::L2Stress => Some(1.0),
+                _ => None,
+            },
+            _ => best_rate(quantity, beta),
+        }
+    }
+}
+
 /// The aligned family's scene of one beta.
 pub fn scene_name(beta: f64) -> String {
     ALIGNED.scene_name(beta)

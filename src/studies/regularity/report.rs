@@ -2,7 +2,7 @@
 //! one rate-against-beta plot per quantity with its best uniform-mesh rate, README.md
 //! leading with where the cones differ, and each beta's convergence report in `beta-BETA/`.
 
-use super::{Regularity, best_rate, theorem_applies};
+use super::{Regularity, theorem_applies};
 use crate::analytical::singular::Placement;
 use crate::contact::Method;
 use crate::error::Result;
@@ -110,12 +110,12 @@ fn follows(rate: (f64, f64), best: f64) -> bool {
     rate.0 >= best - FOLLOW_TOLERANCE.max(2.0 * rate.1)
 }
 
-fn rate_rows(beta: f64, res: &StudyResult) -> Vec<RateCsv> {
+fn rate_rows(family: &super::Family, beta: f64, res: &StudyResult) -> Vec<RateCsv> {
     res.rates
         .iter()
         .map(|r| {
             let rate = supported(r);
-            let best = best_rate(r.quantity, beta);
+            let best = family.best_rate(r.quantity, beta);
             RateCsv {
                 beta,
                 method: r.method.clone(),
@@ -148,6 +148,11 @@ fn cell(r: Option<&RateRow>) -> String {
 }
 
 impl Regularity {
+    /// Whether the family's meshes are graded toward c.
+    fn graded(&self) -> bool {
+        matches!(self.family.placement, Placement::Graded { .. })
+    }
+
     fn row(&self, beta: f64, m: Method, q: Quantity) -> Option<&RateRow> {
         self.members
             .iter()
@@ -161,7 +166,7 @@ impl Regularity {
         self.members
             .iter()
             .map(|(beta, res)| {
-                let best = best_rate(Quantity::Theorem, *beta).expect("a best rate");
+                let best = self.family.best_rate(Quantity::Theorem, *beta).expect("a best rate");
                 let say = |m: Method| match self.row(*beta, m, Quantity::Theorem) {
                     Some(r) => match supported(r) {
                         Some(x) if follows(x, best) => format!("{m} {:.2} (follows)", x.0),
@@ -175,8 +180,9 @@ impl Regularity {
                 };
                 let dagger = if theorem_applies(*beta) { "" } else { " †" };
                 let ratio = finest_ratio(res).map_or(String::new(), |r| format!("; D / e_mortar at the finest level {r:.2}"));
+                let which = if self.graded() { "best on graded meshes" } else { "best min(1, beta)" };
                 format!(
-                    "beta = {beta}{dagger}: best min(1, beta) = {best:.2}; {}, {}{ratio}",
+                    "beta = {beta}{dagger}: {which} = {best:.2}; {}, {}{ratio}",
                     say(Method::Mortar),
                     say(Method::Nts),
                 )
@@ -192,7 +198,7 @@ impl Regularity {
             .members
             .iter()
             .filter_map(|(beta, res)| {
-                let best = best_rate(Quantity::Theorem, *beta)?;
+                let best = self.family.best_rate(Quantity::Theorem, *beta)?;
                 let follows_best = self
                     .row(*beta, Method::Nts, Quantity::Theorem)
                     .and_then(supported)
@@ -278,7 +284,7 @@ impl Regularity {
         }
         doc.paragraph("D is the distance between the two cones' solutions on the same meshes (`cone_distance`); D - e_mortar <= e_nts <= D + e_mortar, so nts's error follows D's rate once D overtakes e_mortar. Each beta's report reads nts against D (its decomposition.csv and \"nts read against its distance to mortar\"); `decomposition.csv` here holds every beta's.");
         doc.paragraph("† Theorem 3.1 does not apply: for beta <= 1 the solution is not in H^2 and the body force ~ r^(beta-2) is not in L2 (it lies in V' only). Its rates 3/4 and 1/2 are claimed only for beta > 1; below, the study requires only convergence (rate >= 0).");
-        doc.heading(2, "Rates in h, mortar / nts, beside the best uniform-mesh rate");
+        doc.heading(2, if self.graded() { "Rates in h, mortar / nts, beside the best graded-mesh rate" } else { "Rates in h, mortar / nts, beside the best uniform-mesh rate" });
         let mut t = Table::new(
             ["beta"]
                 .into_iter()
@@ -288,7 +294,7 @@ impl Regularity {
         for (beta, _) in &self.members {
             let dagger = if theorem_applies(*beta) { "" } else { " †" };
             t.row(std::iter::once(format!("{beta}{dagger}")).chain(QUANTITIES.iter().map(|&q| {
-                let best = best_rate(q, *beta).map_or(String::new(), |b| format!(" (best {b:.2})"));
+                let best = self.family.best_rate(q, *beta).map_or(String::new(), |b| format!(" (best {b:.2})"));
                 format!(
                     "{} / {}{best}",
                     cell(self.row(*beta, Method::Mortar, q)),
@@ -297,7 +303,10 @@ impl Regularity {
             })));
         }
         doc.table(&t);
-        doc.paragraph("Best rates: min(1, beta) for the H1 and theorem norms; min(beta, 3/2) for the stress in the band of triangles along Gamma_C (pointwise h on a band of area O(h), h^(beta-1) on the triangles at c); min(beta - 1/2, 2) for the pressure in L2(Gamma_C), since p ~ dist^(beta-1). `cone_distance` is the distance between the two cones' solutions on the same meshes (docs/studies.md). A rate is printed only where the verdict supports one (fitted); otherwise the verdict (falling or rising: in transition, with the last successive rate).");
+        if self.graded() {
+            doc.paragraph("Best rates on meshes graded with mu < beta: 1 for the H1 and theorem norms and the stress in L2 (the best approximation of r^beta on such meshes); none claimed for the others.");
+        }
+        doc.paragraph("Best rates on uniform meshes: min(1, beta) for the H1 and theorem norms; min(beta, 3/2) for the stress in the band of triangles along Gamma_C (pointwise h on a band of area O(h), h^(beta-1) on the triangles at c); min(beta - 1/2, 2) for the pressure in L2(Gamma_C), since p ~ dist^(beta-1). `cone_distance` is the distance between the two cones' solutions on the same meshes (docs/studies.md). A rate is printed only where the verdict supports one (fitted); otherwise the verdict (falling or rising: in transition, with the last successive rate).");
         let stalled: Vec<String> = self
             .members
             .iter()
@@ -321,7 +330,7 @@ impl Regularity {
             .iter()
             .flat_map(|(beta, res)| {
                 QUANTITIES.iter().filter_map(move |&q| {
-                    let best = best_rate(q, *beta).filter(|b| *b < crate::verify::rates::STALLED)?;
+                    let best = self.family.best_rate(q, *beta).filter(|b| *b < crate::verify::rates::STALLED)?;
                     let successive = |m: Method| {
                         res.rate(m, q).map_or("-".into(), |r| r.assessment.successive_text())
                     };
@@ -377,13 +386,13 @@ impl Regularity {
                     });
                 }
             }
-            if best_rate(q, 1.0).is_some() {
+            if self.family.best_rate(q, 1.0).is_some() {
                 let points = (0..=30)
                     .map(|k| 0.5 + 1.5 * k as f64 / 30.0)
-                    .filter_map(|b| best_rate(q, b).map(|r| (b, r)))
+                    .filter_map(|b| self.family.best_rate(q, b).map(|r| (b, r)))
                     .collect();
                 series.push(Series {
-                    label: "best uniform-mesh rate".into(),
+                    label: if self.graded() { "best graded-mesh rate".into() } else { "best uniform-mesh rate".into() },
                     points,
                     markers: false,
                     line: true,
@@ -426,7 +435,7 @@ impl KindOutcome for Regularity {
             let rates: Vec<RateCsv> = self
                 .members
                 .iter()
-                .flat_map(|(beta, res)| rate_rows(*beta, res))
+                .flat_map(|(beta, res)| rate_rows(self.family, *beta, res))
                 .collect();
             write(d, "rates.csv", &csv_bytes(&rates)?)?;
             let decomposition: Vec<DecompositionCsv> = self
