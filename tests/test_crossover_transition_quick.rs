@@ -18,23 +18,39 @@ use contact_rates::verify::quantity::Quantity;
 #[test]
 fn nts_distance_dominates_from_level_0_and_its_rate_is_nts_s() {
     contact_rates::init();
-    let path = contact_rates::verify::study_file::builtin_dir().join("crossover-transition-quick.toml");
+    let path =
+        contact_rates::verify::study_file::builtin_dir().join("crossover-transition-quick.toml");
     let res = convergence::run(&path.display().to_string()).unwrap();
     for level in [0, 1, 2] {
         let em = res.error(Method::Mortar, level, Quantity::Theorem).unwrap();
-        let d = res.error(Method::Nts, level, Quantity::ConeDistance).unwrap();
-        println!("level {level}: e_mortar {em:.4e}, D {d:.4e}, D / e_mortar {:.2}", d / em);
+        let d = res
+            .error(Method::Nts, level, Quantity::ConeDistance)
+            .unwrap();
+        println!(
+            "level {level}: e_mortar {em:.4e}, D {d:.4e}, D / e_mortar {:.2}",
+            d / em
+        );
         assert!(d >= 2.0 * em, "level {level}: D / e_mortar = {}", d / em);
     }
     let rate = |m: Method| {
         let r = res.rate(m, Quantity::Theorem).unwrap();
-        println!("{m}: theorem rate {:.3} ({})", r.rate(), r.assessment.verdict.name());
+        println!(
+            "{m}: theorem rate {:.3} ({})",
+            r.rate(),
+            r.assessment.verdict.name()
+        );
         r.rate()
     };
     let (mortar, nts) = (rate(Method::Mortar), rate(Method::Nts));
     assert!(mortar > 0.85, "mortar's rate {mortar}");
-    assert!(nts < 0.75, "nts's rate {nts}: its h^(1/2) distance to mortar does not show");
-    assert!(nts >= 0.45, "nts's rate {nts} is below Theorem 3.1's h^(1/2)");
+    assert!(
+        nts < 0.75,
+        "nts's rate {nts}: its h^(1/2) distance to mortar does not show"
+    );
+    assert!(
+        nts >= 0.45,
+        "nts's rate {nts} is below Theorem 3.1's h^(1/2)"
+    );
     // The interface separates at every level: the exact contact set is 0.5871 of Gamma_C;
     // the coarse slave trace (4 segments at level 0) holds contact on 0.90 of it there.
     for l in &res.levels {

@@ -32,7 +32,14 @@ fn c_stays_at_least_h_over_8_from_every_trace_node_at_every_level() {
         let file = StudyFile::load(&UNALIGNED.study_path(beta)).unwrap();
         assert_eq!(file.mesh.levels, UNALIGNED.levels, "the study's levels");
         let scene = Scene::load(&UNALIGNED.scene_name(beta)).unwrap();
-        let c = scene.exact.as_ref().unwrap().singular.as_ref().unwrap().point;
+        let c = scene
+            .exact
+            .as_ref()
+            .unwrap()
+            .singular
+            .as_ref()
+            .unwrap()
+            .point;
         assert_eq!(c, [UNALIGNED_TRANSITION, 1.0]);
         let rows = placement(&scene, c, &file.family_parameters(), &file.mesh.levels).unwrap();
         for r in &rows {
@@ -49,7 +56,11 @@ fn c_stays_at_least_h_over_8_from_every_trace_node_at_every_level() {
                 // 1/3 up to where gmsh puts a progression's nodes (measured: 1.2e-9 of a
                 // segment at level 0; each halving doubles the deviation relative to the
                 // segment, 2^7 of it at level 7).
-                assert!((offset - 1.0 / 3.0).abs() < 1e-6, "level {}: {offset}", r.level);
+                assert!(
+                    (offset - 1.0 / 3.0).abs() < 1e-6,
+                    "level {}: {offset}",
+                    r.level
+                );
             }
         }
         assert_eq!(rows.len(), 8);

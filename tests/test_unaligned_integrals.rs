@@ -88,7 +88,10 @@ fn load_and_error_integrals_do_not_move_when_the_rules_are_refined() {
             println!(
                 "beta {beta}, level {level}: load moved {load_moved:.1e} of its largest entry, error integrals {error_moved:.1e} relative"
             );
-            assert!(load_moved <= 1e-8, "beta {beta} level {level}: load {load_moved:e}");
+            assert!(
+                load_moved <= 1e-8,
+                "beta {beta} level {level}: load {load_moved:e}"
+            );
             assert!(
                 error_moved <= 1e-8,
                 "beta {beta} level {level}: errors {error_moved:e} ({errors:?} vs {errors_raised:?})"

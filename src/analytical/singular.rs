@@ -240,11 +240,16 @@ impl SingularContact {
             ),
             Placement::Unaligned => (
                 "../meshes/two_blocks.geo",
-                format!("h_upper = 0.3\nh_lower = 0.2\ngrading = {:?}", unaligned_grading()),
+                format!(
+                    "h_upper = 0.3\nh_lower = 0.2\ngrading = {:?}",
+                    unaligned_grading()
+                ),
             ),
             Placement::Graded { mu } => (
                 "../meshes/two_blocks_graded.geo",
-                format!("h_upper = 0.3\nh_lower = 0.2\npoint = {a}\nmu = {mu}\nradius = {GRADED_RADIUS}"),
+                format!(
+                    "h_upper = 0.3\nh_lower = 0.2\npoint = {a}\nmu = {mu}\nradius = {GRADED_RADIUS}"
+                ),
             ),
         }
     }
@@ -307,8 +312,13 @@ impl SingularContact {
     pub fn scene_toml(&self, steps: usize) -> String {
         let where_c = match self.placement {
             Placement::Aligned => String::new(),
-            Placement::Unaligned => "; c at 1/3 of a trace segment of both meshes at every level, a node of neither".into(),
-            Placement::Graded { mu } => format!("; every level meshed by gmsh with sizes graded toward c, h (r/R)^(1-mu), mu = {mu}"),
+            Placement::Unaligned => {
+                "; c at 1/3 of a trace segment of both meshes at every level, a node of neither"
+                    .into()
+            }
+            Placement::Graded { mu } => format!(
+                "; every level meshed by gmsh with sizes graded toward c, h (r/R)^(1-mu), mu = {mu}"
+            ),
         };
         let description = format!(
             "Manufactured contact solution with a singular part r^beta Phi_l(theta) at the transition point c = ({}, 1), beta = {}: pressure ~ dist^(beta-1), gap ~ dist^beta (src/analytical/singular.rs){where_c}",

@@ -306,7 +306,8 @@ fn split_rule(pieces: &[([[f64; 3]; 3], f64)], alpha: f64, n: usize) -> Vec<(f64
     for (vertices, fraction) in pieces {
         for (l1, l2, w) in vertex_rule(&reference, 0, alpha, n) {
             let l0 = 1.0 - l1 - l2;
-            let lam = [0, 1, 2].map(|k| l0 * vertices[0][k] + l1 * vertices[1][k] + l2 * vertices[2][k]);
+            let lam =
+                [0, 1, 2].map(|k| l0 * vertices[0][k] + l1 * vertices[1][k] + l2 * vertices[2][k]);
             out.push((lam[1], lam[2], w * fraction));
         }
     }

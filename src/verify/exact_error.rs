@@ -327,7 +327,10 @@ impl<'a> ExactComparison<'a> {
                 let parts = match split {
                     Some(q) => {
                         let c = singular.expect("split at the singular point").point;
-                        vec![((xa, pa), (c, pa + q * (pb - pa))), ((c, pa + q * (pb - pa)), (xb, pb))]
+                        vec![
+                            ((xa, pa), (c, pa + q * (pb - pa))),
+                            ((c, pa + q * (pb - pa)), (xb, pb)),
+                        ]
                     }
                     None => vec![((xa, pa), (xb, pb))],
                 };

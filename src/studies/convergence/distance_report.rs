@@ -124,6 +124,78 @@ fn judged_with_constant(levels: &[LevelError]) -> String {
     }
 }
 
+/// The lead of a study with `compare`: what it learned, in a few sentences of numbers:
+/// D's verdict, D / e_mortar on the two finest levels, each cone's theorem-norm verdict, the
+/// contact fraction, and D's rate and D / h^(1/2) beside the other study's.
+pub fn lead(doc: &mut Doc, res: &StudyResult) {
+    let Some(other) = &res.file.compare else {
+        return;
+    };
+    let levels = &res.file.mesh.levels;
+    let ratio = |l: usize| {
+        Some(res.error(Method::Nts, l, Quantity::ConeDistance)? / res.error(Method::Mortar, l, Quantity::Theorem)?)
+    };
+    let finest: Vec<String> = levels
+        .iter()
+        .rev()
+        .take(2)
+        .rev()
+        .map(|&l| ratio(l).map_or(format!("- (level {l})"), |r| format!("{r:.2} (level {l})")))
+        .collect();
+    let describe = |m: Method, q: Quantity| res.rate(m, q).map_or("-".into(), |r| r.assessment.describe());
+    let fraction = |m: Method| {
+        res.levels
+            .iter()
+            .filter(|l| l.method == m)
+            .max_by_key(|l| l.level)
+            .map_or("-".into(), |l| format!("{:.4}", l.contact_fraction))
+    };
+    let mut lines = vec![
+        format!(
+            "nts's distance to mortar D (theorem norm): {}; D / e_mortar on the two finest levels {}: where D is the larger, nts's error is D's.",
+            describe(Method::Nts, Quantity::ConeDistance),
+            finest.join(", ")
+        ),
+        format!(
+            "Theorem norm: mortar {}; nts {}.",
+            describe(Method::Mortar, Quantity::Theorem),
+            describe(Method::Nts, Quantity::Theorem)
+        ),
+        format!(
+            "The interface separates: contact on a fraction {} (mortar) and {} (nts) of Gamma_C at the finest level (levels.csv).",
+            fraction(Method::Mortar),
+            fraction(Method::Nts)
+        ),
+    ];
+    let path = crate::report::folder::reports_dir().join(other).join("errors.csv");
+    if let Ok(rows) = crate::verify::table::read(&path) {
+        let (ours, theirs) = (distances(&res.errors), distances(&rows));
+        let common: Vec<usize> = ours
+            .iter()
+            .filter(|a| theirs.iter().any(|b| b.level == a.level))
+            .map(|a| a.level)
+            .collect();
+        let pick = |v: &[LevelError]| -> Vec<LevelError> {
+            v.iter().filter(|e| common.contains(&e.level)).cloned().collect()
+        };
+        let (mine, yours) = (pick(&ours), pick(&theirs));
+        if let (Some(a), Some(b)) = (mine.last(), yours.last()) {
+            lines.push(format!(
+                "Against {other} at its levels {}-{} (each D relative to its own problem's norm): D's rate here {}, there {}; D / h^(1/2) at level {} {:.4} here, {:.4} there ({:.2}x).",
+                common.first().unwrap_or(&0),
+                a.level,
+                judged_with_constant(&mine),
+                judged_with_constant(&yours),
+                a.level,
+                a.error / a.h.sqrt(),
+                b.error / b.h.sqrt(),
+                (a.error / a.h.sqrt()) / (b.error / b.h.sqrt())
+            ));
+        }
+    }
+    doc.heading(2, "What the study learned").list(lines);
+}
+
 /// The study file's `compare`: nts's distance to mortar beside the other study's (its
 /// committed report) at the levels both measure, judged on those levels alone.
 fn compared(doc: &mut Doc, res: &StudyResult) {

@@ -428,6 +428,7 @@ fn von_mises(res: &StudyResult, d: &Path) -> Result<()> {
 fn readme(res: &StudyResult) -> String {
     let mut doc = Doc::new();
     title(&mut doc, res);
+    super::distance_report::lead(&mut doc, res);
     cones_compared(&mut doc, res);
     super::distance_report::section(&mut doc, res);
     doc.image("error against h", "error_vs_h.png");

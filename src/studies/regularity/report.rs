@@ -20,7 +20,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// The quantities the report tabulates and plots, in order.
-const QUANTITIES: [Quantity; 5] = [
+pub(super) const QUANTITIES: [Quantity; 5] = [
     Quantity::Theorem,
     Quantity::H1U,
     Quantity::BandStress,
@@ -265,10 +265,19 @@ impl Regularity {
         let (title, lead) = self.lead();
         doc.heading(1, &title);
         doc.paragraph(lead);
+        let reports = crate::report::folder::reports_dir();
+        let findings = match self.family.placement {
+            Placement::Aligned => Vec::new(),
+            Placement::Unaligned => super::families::unaligned_findings(self, &reports)?,
+            Placement::Graded { .. } => super::families::graded_findings(self, &reports)?,
+        };
+        if !findings.is_empty() {
+            doc.heading(2, "What the study learned");
+            doc.list(findings);
+        }
         doc.heading(2, "What differs between the cones (Theorem 3.1's norm)");
         doc.list(self.differences());
         doc.paragraph(self.deficit());
-        let reports = crate::report::folder::reports_dir();
         match self.family.placement {
             Placement::Aligned => {}
             Placement::Unaligned => {
@@ -384,6 +393,31 @@ impl Regularity {
                         color: i,
                         thin: false,
                     });
+                }
+            }
+            // The aligned family's supported rates beside this family's (thin lines).
+            if self.family.placement != Placement::Aligned {
+                let path = crate::report::folder::reports_dir()
+                    .join(super::ALIGNED.name)
+                    .join("rates.csv");
+                if let Ok(rows) = crate::verify::table::read::<RateCsv>(&path) {
+                    for (i, m) in [Method::Mortar, Method::Nts].into_iter().enumerate() {
+                        let points: Vec<(f64, f64)> = rows
+                            .iter()
+                            .filter(|r| r.method == m && r.quantity == q)
+                            .filter_map(|r| Some((r.beta, r.rate?)))
+                            .collect();
+                        if !points.is_empty() {
+                            series.push(Series {
+                                label: format!("{m}, uniform meshes, c a node (regularity)"),
+                                points,
+                                markers: true,
+                                line: true,
+                                color: i,
+                                thin: true,
+                            });
+                        }
+                    }
                 }
             }
             if self.family.best_rate(q, 1.0).is_some() {
