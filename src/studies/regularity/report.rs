@@ -412,7 +412,8 @@ impl Regularity {
                                 label: format!("{m}, uniform meshes, c a node (regularity)"),
                                 points,
                                 markers: true,
-                                line: true,
+                                // Markers only: betas without a supported rate are missing.
+                                line: false,
                                 color: i,
                                 thin: true,
                             });
