@@ -3,8 +3,9 @@
 //   on an edge split there first, triangles near c split recursively).
 // Goal: on the unaligned family, where c lies on an edge of two boundary triangles and
 //   inside a trace segment of both meshes at every level, the load and the error integrals
-//   do not move (1e-8 relative) when both the Gauss-Jacobi order (12 -> 20 points per
-//   direction) and the near split's depth (8 -> 11) are raised.
+//   do not move (1e-8 relative) when the Gauss-Jacobi order (12 -> 20 points per
+//   direction), the near split's depth (8 -> 11) and the distance it splits to (6 -> 16
+//   diameters) are all raised.
 // Geometry: the stacked unit blocks, c = (8/15, 1) at 2/3 of a lower and 1/3 of an upper
 //   trace segment (levels 1 and 2: c at 1/3 and 2/3 of its segments in turn).
 // Data: beta = 0.75 (body force ~ r^-1.25, pressure ~ r^-0.25: the strongest of the
@@ -65,6 +66,7 @@ fn load_and_error_integrals_do_not_move_when_the_rules_are_refined() {
     let raised = Accuracy {
         points: 20,
         near_depth: 11,
+        near_ratio: 16,
     };
     for beta in [0.75, 1.5] {
         let scene = UNALIGNED.scene_name(beta);

@@ -92,16 +92,11 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
 
 /// nts's distance to mortar in the theorem norm of `errors`, by level.
 fn distances(errors: &[crate::verify::table::ErrorRecord]) -> Vec<LevelError> {
-    let mut out: Vec<LevelError> = errors
+    let rows: Vec<&crate::verify::table::ErrorRecord> = errors
         .iter()
         .filter(|e| e.method == Method::Nts && e.quantity == Quantity::ConeDistance)
-        .map(|e| LevelError {
-            level: e.level,
-            h: e.h,
-            dofs: e.dofs as f64,
-            error: e.error,
-        })
         .collect();
+    let mut out = judge::levels_of_errors(&rows);
     out.sort_by_key(|e| e.level);
     out
 }

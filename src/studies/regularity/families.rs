@@ -8,6 +8,7 @@ use crate::error::Result;
 use crate::report::markdown::{Doc, Table};
 use crate::studies::convergence::StudyResult;
 use crate::verify::quantity::Quantity;
+use crate::verify::judge::{levels_of, levels_of_errors};
 use crate::verify::rates::{Assessment, LevelError, Verdict, assess, short_text};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -67,17 +68,17 @@ pub fn judge_levels(
     q: Quantity,
     keep: impl Fn(usize) -> bool,
 ) -> Option<Assessment> {
-    let mut levels: Vec<LevelError> = res
+    let rows: Vec<&crate::verify::table::ErrorRecord> = res
         .errors
         .iter()
         .filter(|e| e.method == m && e.quantity == q && keep(e.level))
-        .map(|e| LevelError {
-            level: e.level,
-            h: e.h,
-            dofs: e.dofs as f64,
-            error: e.error,
-        })
         .collect();
+    judge_sorted(levels_of_errors(&rows))
+}
+
+/// `levels` in level order judged against the exact solution (truth error 0); None for
+/// none.
+fn judge_sorted(mut levels: Vec<LevelError>) -> Option<Assessment> {
     levels.sort_by_key(|e| e.level);
     (!levels.is_empty()).then(|| assess(&levels, 0.0).ok()).flatten()
 }
@@ -267,19 +268,14 @@ fn judge_aligned(
     m: Method,
     q: Quantity,
 ) -> Option<(Assessment, Vec<(usize, f64)>)> {
-    let mut levels: Vec<LevelError> = rows
-        .iter()
-        .filter(|e| e.beta == beta && e.method == m && e.quantity == q)
-        .map(|e| LevelError {
-            level: e.level,
-            h: e.h,
-            dofs: e.dofs as f64,
-            error: e.error,
-        })
-        .collect();
-    levels.sort_by_key(|e| e.level);
-    let errors = levels.iter().map(|e| (e.level, e.error)).collect();
-    (!levels.is_empty()).then(|| assess(&levels, 0.0).ok().map(|a| (a, errors))).flatten()
+    let levels = levels_of(
+        rows.iter()
+            .filter(|e| e.beta == beta && e.method == m && e.quantity == q)
+            .map(|e| (e.level, e.h, e.dofs as f64, e.error)),
+    );
+    let mut errors: Vec<(usize, f64)> = levels.iter().map(|e| (e.level, e.error)).collect();
+    errors.sort_by_key(|e| e.0);
+    Some((judge_sorted(levels)?, errors))
 }
 
 /// The aligned report's errors, if it is there.
