@@ -211,7 +211,7 @@ pub fn placement_section(doc: &mut Doc, reg: &Regularity) {
         reg.members.len(),
         match reg.family.placement {
             crate::analytical::singular::Placement::Unaligned if least >= LEAST_OFFSET => {
-                format!(" (at least {LEAST_OFFSET}: c never comes within h/8 of a node)")
+                format!(" (at least {LEAST_OFFSET}: on each trace, c's distance to the nearest node never falls below 1/8 of the segment that holds it, the trace's local h)")
             }
             crate::analytical::singular::Placement::Unaligned => {
                 format!(" (**below {LEAST_OFFSET}**)")
