@@ -193,15 +193,7 @@ fn the_h1_error_of_the_nodal_interpolant_matches_an_independent_integration() {
     let ex = scene.exact.as_deref().unwrap();
     let c = ex.singular.as_ref().unwrap().point;
     // The nodal interpolant (the singular part is 0 at c).
-    let mut u = vec![0.0; 2 * m.n_nodes];
-    for b in 0..2 {
-        for (i, x) in m.meshes[b].nodes.iter().enumerate() {
-            let d = ex.displacement_at(b, x[0], x[1], 1.0).unwrap();
-            let n = m.node_offset[b] + i;
-            u[2 * n] = d[0];
-            u[2 * n + 1] = d[1];
-        }
-    }
+    let u = common::nodal_interpolant(m, ex, 1.0);
     let field = P1Field::from_nodal(m, interface, 1.0, u.clone(), None, None).unwrap();
     // 8 x 8 points away from c: the 4 x 4 default leaves 1e-8 there at this coarse level
     // (measured: 1.6451859757e-4 with 4, 1.6451859922e-4 with 6, 8 and 10).

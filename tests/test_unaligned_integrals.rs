@@ -27,15 +27,7 @@ fn integrals(scene: &str, level: usize) -> (Vec<f64>, Vec<f64>) {
     let case = common::case(scene, level, Method::Mortar, &[]);
     let (m, interface) = (&case.problem.model, &case.problem.interface);
     let ex = m.scene.exact.as_deref().unwrap();
-    let mut u = vec![0.0; 2 * m.n_nodes];
-    for b in 0..2 {
-        for (i, x) in m.meshes[b].nodes.iter().enumerate() {
-            let d = ex.displacement_at(b, x[0], x[1], 1.0).unwrap();
-            let n = m.node_offset[b] + i;
-            u[2 * n] = d[0];
-            u[2 * n + 1] = d[1];
-        }
-    }
+    let u = common::nodal_interpolant(m, ex, 1.0);
     // The exact pressure at the slave nodes (0 elsewhere), linear between them.
     let mut p = vec![0.0; m.n_nodes];
     for piece in &interface.pieces {

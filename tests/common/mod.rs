@@ -108,3 +108,22 @@ pub fn closed_form_difference(
     }
     worst
 }
+
+/// The nodal interpolant of the exact displacement of `ex` at time `t` on the model's nodes
+/// (two components per node, in the model's node order).
+pub fn nodal_interpolant(
+    m: &contact_rates::fe::Model,
+    ex: &contact_rates::analytical::Exact,
+    t: f64,
+) -> Vec<f64> {
+    let mut u = vec![0.0; 2 * m.n_nodes];
+    for b in 0..2 {
+        for (i, x) in m.meshes[b].nodes.iter().enumerate() {
+            let d = ex.displacement_at(b, x[0], x[1], t).unwrap();
+            let n = m.node_offset[b] + i;
+            u[2 * n] = d[0];
+            u[2 * n + 1] = d[1];
+        }
+    }
+    u
+}
