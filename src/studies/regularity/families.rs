@@ -412,7 +412,11 @@ fn aligned_theorem(rows: &[AlignedError], beta: f64, m: Method) -> String {
 /// What the unaligned study learned, in a few sentences of numbers: the cones' theorem-norm
 /// verdicts beside the aligned family's, mortar's error against the aligned one at its
 /// finest level, D / e_mortar, where the parities disagree with the whole, and where c sat.
-pub fn unaligned_findings(reg: &Regularity, reports: &Path) -> Result<Vec<String>> {
+pub fn unaligned_findings(
+    reg: &Regularity,
+    reports: &Path,
+    quantities: &[Quantity],
+) -> Result<Vec<String>> {
     let aligned = aligned_errors(reports)?.unwrap_or_default();
     let finest = super::LEVELS.last().copied().unwrap_or(0);
     let mut out = Vec::new();
@@ -463,14 +467,14 @@ pub fn unaligned_findings(reg: &Regularity, reports: &Path) -> Result<Vec<String
         "nts's distance to mortar over mortar's error at the finest level: {}; D's own verdicts are in the table below.",
         ratio.join(", ")
     ));
-    let rows = parity_rows(reg, &super::report::QUANTITIES);
+    let rows = parity_rows(reg, quantities);
     let alternating: Vec<String> = reg
         .members
         .iter()
         .flat_map(|(beta, _)| {
             let rows = &rows;
             [Method::Mortar, Method::Nts].into_iter().flat_map(move |m| {
-                super::report::QUANTITIES.iter().filter_map(move |&q| {
+                quantities.iter().filter_map(move |&q| {
                     let find = |l: Levels| {
                         rows.iter()
                             .find(|r| r.beta == *beta && r.method == m && r.quantity == q && r.levels == l)

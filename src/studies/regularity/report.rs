@@ -20,7 +20,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// The quantities the report tabulates and plots, in order.
-pub(super) const QUANTITIES: [Quantity; 5] = [
+const QUANTITIES: [Quantity; 5] = [
     Quantity::Theorem,
     Quantity::H1U,
     Quantity::BandStress,
@@ -268,7 +268,9 @@ impl Regularity {
         let reports = crate::report::folder::reports_dir();
         let findings = match self.family.placement {
             Placement::Aligned => Vec::new(),
-            Placement::Unaligned => super::families::unaligned_findings(self, &reports)?,
+            Placement::Unaligned => {
+                super::families::unaligned_findings(self, &reports, &QUANTITIES)?
+            }
             Placement::Graded { .. } => super::families::graded_findings(self, &reports)?,
         };
         if !findings.is_empty() {
