@@ -260,6 +260,33 @@ impl Regularity {
         }
     }
 
+    /// The table of rates in h, mortar / nts, beside the family's best rates.
+    fn rates_table(&self, doc: &mut Doc) {
+        doc.heading(2, if self.graded() { "Rates in h, mortar / nts, beside the best graded-mesh rate" } else { "Rates in h, mortar / nts, beside the best uniform-mesh rate" });
+        let mut t = Table::new(
+            ["beta"]
+                .into_iter()
+                .map(String::from)
+                .chain(QUANTITIES.iter().map(|q| format!("`{q}`"))),
+        );
+        for (beta, _) in &self.members {
+            let dagger = if theorem_applies(*beta) { "" } else { " †" };
+            t.row(std::iter::once(format!("{beta}{dagger}")).chain(QUANTITIES.iter().map(|&q| {
+                let best = self.family.best_rate(q, *beta).map_or(String::new(), |b| format!(" (best {b:.2})"));
+                format!(
+                    "{} / {}{best}",
+                    cell(self.row(*beta, Method::Mortar, q)),
+                    cell(self.row(*beta, Method::Nts, q))
+                )
+            })));
+        }
+        doc.table(&t);
+        if self.graded() {
+            doc.paragraph("Best rates on meshes graded with mu < beta: 1 for the H1 and theorem norms and the stress in L2 (the best approximation of r^beta on such meshes); none claimed for the others.");
+        }
+        doc.paragraph("Best rates on uniform meshes: min(1, beta) for the H1 and theorem norms; min(beta, 3/2) for the stress in the band of triangles along Gamma_C (pointwise h on a band of area O(h), h^(beta-1) on the triangles at c); min(beta - 1/2, 2) for the pressure in L2(Gamma_C), since p ~ dist^(beta-1). `cone_distance` is the distance between the two cones' solutions on the same meshes (docs/studies.md). A rate is printed only where the verdict supports one (fitted); otherwise the verdict (falling or rising: in transition, with the last successive rate).");
+    }
+
     fn readme(&self) -> Result<String> {
         let mut doc = Doc::new();
         let (title, lead) = self.lead();
@@ -295,29 +322,7 @@ impl Regularity {
         }
         doc.paragraph("D is the distance between the two cones' solutions on the same meshes (`cone_distance`); D - e_mortar <= e_nts <= D + e_mortar, so nts's error follows D's rate once D overtakes e_mortar. Each beta's report reads nts against D (its decomposition.csv and \"nts read against its distance to mortar\"); `decomposition.csv` here holds every beta's.");
         doc.paragraph("† Theorem 3.1 does not apply: for beta <= 1 the solution is not in H^2 and the body force ~ r^(beta-2) is not in L2 (it lies in V' only). Its rates 3/4 and 1/2 are claimed only for beta > 1; below, the study requires only convergence (rate >= 0).");
-        doc.heading(2, if self.graded() { "Rates in h, mortar / nts, beside the best graded-mesh rate" } else { "Rates in h, mortar / nts, beside the best uniform-mesh rate" });
-        let mut t = Table::new(
-            ["beta"]
-                .into_iter()
-                .map(String::from)
-                .chain(QUANTITIES.iter().map(|q| format!("`{q}`"))),
-        );
-        for (beta, _) in &self.members {
-            let dagger = if theorem_applies(*beta) { "" } else { " †" };
-            t.row(std::iter::once(format!("{beta}{dagger}")).chain(QUANTITIES.iter().map(|&q| {
-                let best = self.family.best_rate(q, *beta).map_or(String::new(), |b| format!(" (best {b:.2})"));
-                format!(
-                    "{} / {}{best}",
-                    cell(self.row(*beta, Method::Mortar, q)),
-                    cell(self.row(*beta, Method::Nts, q))
-                )
-            })));
-        }
-        doc.table(&t);
-        if self.graded() {
-            doc.paragraph("Best rates on meshes graded with mu < beta: 1 for the H1 and theorem norms and the stress in L2 (the best approximation of r^beta on such meshes); none claimed for the others.");
-        }
-        doc.paragraph("Best rates on uniform meshes: min(1, beta) for the H1 and theorem norms; min(beta, 3/2) for the stress in the band of triangles along Gamma_C (pointwise h on a band of area O(h), h^(beta-1) on the triangles at c); min(beta - 1/2, 2) for the pressure in L2(Gamma_C), since p ~ dist^(beta-1). `cone_distance` is the distance between the two cones' solutions on the same meshes (docs/studies.md). A rate is printed only where the verdict supports one (fitted); otherwise the verdict (falling or rising: in transition, with the last successive rate).");
+        self.rates_table(&mut doc);
         let stalled: Vec<String> = self
             .members
             .iter()
