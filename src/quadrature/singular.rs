@@ -225,13 +225,8 @@ fn distance(t: &[[f64; 2]; 3], c: [f64; 2]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-/// Whether the triangle `t` (not touching c) is close enough to `c` for [`near_rule`] to
-/// split it: closer than [`NEAR_RATIO`] of its diameters.
-pub fn is_near(t: &[[f64; 2]; 3], c: [f64; 2]) -> bool {
-    is_within(t, c, NEAR_RATIO)
-}
-
-/// Whether the triangle `t` is closer to `c` than `ratio` of its diameters.
+/// Whether the triangle `t` is closer to `c` than `ratio` of its diameters: near enough for
+/// [`near_rule`] to split it.
 fn is_within(t: &[[f64; 2]; 3], c: [f64; 2], ratio: usize) -> bool {
     distance(t, c) < ratio as f64 * diameter(t)
 }
@@ -357,11 +352,12 @@ fn split_rule(
 ///   of the split integrand r^power g, the caller's to evaluate);
 /// - the point lies on an edge of `t` (or inside): `t` split there into triangles with a
 ///   vertex at the point ([`split_at`]), one rule per power over the pieces;
-/// - `t` is near it ([`is_near`]): `base` on [`near_rule`]'s pieces, for the whole integrand
+/// - `t` is near it (closer than the accuracy's `near_ratio` of its diameters): `base` on
+///   [`near_rule`]'s pieces, for the whole integrand
 ///   (None);
 /// - otherwise `base` split along the `kinks` ([`super::triangle_rule`]), None.
 ///
-/// The points per direction and the near split's depth are [`accuracy`]'s.
+/// The points per direction and the near split's depth and distance are [`accuracy`]'s.
 pub fn rules<'b, K: Fn([f64; 2]) -> f64>(
     t: [[f64; 2]; 3],
     kinks: &[K],

@@ -317,67 +317,73 @@ impl<'a> ExactComparison<'a> {
         for (piece, profile) in interface.pieces.iter().zip(pressure) {
             for w in profile.windows(2) {
                 let ((xa, pa), (xb, pb)) = (w[0], w[1]);
-                let exact_at = |x: [f64; 2]| {
-                    self.exact
-                        .pressure_at(piece.normal, x[0], x[1], t)
-                        .unwrap_or(f64::NAN)
-                };
                 // A segment with the singular point inside is split there (p_h linear).
-                let split = singular.and_then(|sg| interior_fraction(xa, xb, sg.point));
+                let split = singular
+                    .and_then(|sg| interior_fraction(xa, xb, sg.point).map(|q| (sg.point, q)));
                 let parts = match split {
-                    Some(q) => {
-                        let c = singular.expect("split at the singular point").point;
-                        vec![
-                            ((xa, pa), (c, pa + q * (pb - pa))),
-                            ((c, pa + q * (pb - pa)), (xb, pb)),
-                        ]
+                    Some((c, q)) => {
+                        let pc = pa + q * (pb - pa);
+                        vec![((xa, pa), (c, pc)), ((c, pc), (xb, pb))]
                     }
                     None => vec![((xa, pa), (xb, pb))],
                 };
-                for ((xa, pa), (xb, pb)) in parts {
-                    let len = (xb[0] - xa[0]).hypot(xb[1] - xa[1]);
-                    // A segment from the singular point: p = p_rest + p_s with p_s ~
-                    // r^(beta-1), the three parts of (p_h - p)^2 and p^2 each by its own
-                    // Gauss-Jacobi rule.
-                    let from_point = singular.and_then(|sg| {
-                        let at = |x: [f64; 2]| sg.distance(x[0], x[1]) <= 1e-12 * len;
-                        (at(xa) || at(xb)).then_some((sg, at(xb)))
-                    });
-                    if let Some((sg, reversed)) = from_point {
-                        let n = piece.normal;
-                        let singular_at = |x: [f64; 2]| {
-                            let st = sg.stress[0].each_ref().map(|e| e.eval(x[0], x[1], t));
-                            -(n[0] * n[0] * st[0] + n[1] * n[1] * st[1] + 2.0 * n[0] * n[1] * st[2])
-                        };
-                        let beta = sg.exponent;
-                        for (alpha, part) in [
-                            (0.0, Split::Smooth),
-                            (beta - 1.0, Split::Cross),
-                            (2.0 * beta - 2.0, Split::Singular),
-                        ] {
-                            let points = quadrature::singular::accuracy().points;
-                            for (r, wq) in quadrature::singular::segment_from(alpha, points) {
-                                let q = if reversed { 1.0 - r } else { r };
-                                let x = [xa[0] + q * (xb[0] - xa[0]), xa[1] + q * (xb[1] - xa[1])];
-                                let (exact, ps) = (exact_at(x), singular_at(x));
-                                let ph = pa + q * (pb - pa);
-                                diff += wq * len * part.square(ph - exact, -ps);
-                                norm += wq * len * part.square(exact, ps);
-                            }
-                        }
-                        continue;
-                    }
-                    for &(q, wq) in quadrature::segment_rule(xa, xb, &kinks, &self.segment).iter() {
-                        let x = [xa[0] + q * (xb[0] - xa[0]), xa[1] + q * (xb[1] - xa[1])];
-                        let exact = exact_at(x);
-                        let ph = pa + q * (pb - pa);
-                        diff += wq * len * (ph - exact).powi(2);
-                        norm += wq * len * exact * exact;
-                    }
+                for (a, b) in parts {
+                    self.segment_pressure(piece.normal, a, b, &kinks, t, (&mut diff, &mut norm));
                 }
             }
         }
         (diff, norm)
+    }
+
+    /// Add (int (p_h - p)^2, int p^2) over one segment a -> b of Gamma_C with outward normal
+    /// `n` to `sums` (point by point, as one running sum over Gamma_C), p_h linear between
+    /// its ends' values; a segment from the singular point splits
+    /// p = p_rest + p_s (p_s ~ r^(beta-1)) and integrates the three parts of each square by
+    /// their own Gauss-Jacobi rules.
+    fn segment_pressure(
+        &self,
+        n: [f64; 2],
+        (xa, pa): ([f64; 2], f64),
+        (xb, pb): ([f64; 2], f64),
+        kinks: &[crate::expr::KinkFunction],
+        t: f64,
+        (diff, norm): (&mut f64, &mut f64),
+    ) {
+        let len = (xb[0] - xa[0]).hypot(xb[1] - xa[1]);
+        let at = |q: f64| [xa[0] + q * (xb[0] - xa[0]), xa[1] + q * (xb[1] - xa[1])];
+        let exact_at = |x: [f64; 2]| self.exact.pressure_at(n, x[0], x[1], t).unwrap_or(f64::NAN);
+        let from_point = self.exact.singular.as_ref().and_then(|sg| {
+            let is_c = |x: [f64; 2]| sg.distance(x[0], x[1]) <= 1e-12 * len;
+            (is_c(xa) || is_c(xb)).then_some((sg, is_c(xb)))
+        });
+        let Some((sg, reversed)) = from_point else {
+            for &(q, wq) in quadrature::segment_rule(xa, xb, kinks, &self.segment).iter() {
+                let exact = exact_at(at(q));
+                let ph = pa + q * (pb - pa);
+                *diff += wq * len * (ph - exact).powi(2);
+                *norm += wq * len * exact * exact;
+            }
+            return;
+        };
+        let singular_at = |x: [f64; 2]| {
+            let st = sg.stress[0].each_ref().map(|e| e.eval(x[0], x[1], t));
+            -(n[0] * n[0] * st[0] + n[1] * n[1] * st[1] + 2.0 * n[0] * n[1] * st[2])
+        };
+        let (beta, points) = (sg.exponent, quadrature::singular::accuracy().points);
+        for (alpha, part) in [
+            (0.0, Split::Smooth),
+            (beta - 1.0, Split::Cross),
+            (2.0 * beta - 2.0, Split::Singular),
+        ] {
+            for (r, wq) in quadrature::singular::segment_from(alpha, points) {
+                let q = if reversed { 1.0 - r } else { r };
+                let x = at(q);
+                let (exact, ps) = (exact_at(x), singular_at(x));
+                let ph = pa + q * (pb - pa);
+                *diff += wq * len * part.square(ph - exact, -ps);
+                *norm += wq * len * part.square(exact, ps);
+            }
+        }
     }
 }
 

@@ -101,6 +101,17 @@ fn distances(errors: &[crate::verify::table::ErrorRecord]) -> Vec<LevelError> {
     out
 }
 
+/// nts's distance to mortar here and in the committed report reports/`other`, on the
+/// levels both measure, in level order: (here, there).
+fn beside(res: &StudyResult, other: &str) -> Result<(Vec<LevelError>, Vec<LevelError>)> {
+    let path = crate::report::folder::reports_dir().join(other).join("errors.csv");
+    let (ours, theirs) = (distances(&res.errors), distances(&crate::verify::table::read(&path)?));
+    let common = |a: &[LevelError], b: &[LevelError]| -> Vec<LevelError> {
+        a.iter().filter(|x| b.iter().any(|y| y.level == x.level)).cloned().collect()
+    };
+    Ok((common(&ours, &theirs), common(&theirs, &ours)))
+}
+
 /// D judged on `levels`, with its constant: "rate ± se (fitted), D ~ C h^rate with C = ..."
 /// where fitted, else the verdict.
 fn judged_with_constant(levels: &[LevelError]) -> String {
@@ -162,22 +173,11 @@ pub fn lead(doc: &mut Doc, res: &StudyResult) {
             fraction(Method::Nts)
         ),
     ];
-    let path = crate::report::folder::reports_dir().join(other).join("errors.csv");
-    if let Ok(rows) = crate::verify::table::read(&path) {
-        let (ours, theirs) = (distances(&res.errors), distances(&rows));
-        let common: Vec<usize> = ours
-            .iter()
-            .filter(|a| theirs.iter().any(|b| b.level == a.level))
-            .map(|a| a.level)
-            .collect();
-        let pick = |v: &[LevelError]| -> Vec<LevelError> {
-            v.iter().filter(|e| common.contains(&e.level)).cloned().collect()
-        };
-        let (mine, yours) = (pick(&ours), pick(&theirs));
-        if let (Some(a), Some(b)) = (mine.last(), yours.last()) {
+    if let Ok((mine, yours)) = beside(res, other) {
+        if let (Some(first), Some(a), Some(b)) = (mine.first(), mine.last(), yours.last()) {
             lines.push(format!(
                 "Against {other} at its levels {}-{} (each D relative to its own problem's norm): D's rate here {}, there {}; D / h^(1/2) at level {} {:.4} here, {:.4} there ({:.2}x).",
-                common.first().unwrap_or(&0),
+                first.level,
                 a.level,
                 judged_with_constant(&mine),
                 judged_with_constant(&yours),
@@ -198,19 +198,13 @@ fn compared(doc: &mut Doc, res: &StudyResult) {
         return;
     };
     doc.heading(3, &format!("The distance beside {other}'s"));
-    let path = crate::report::folder::reports_dir().join(other).join("errors.csv");
-    let theirs = match crate::verify::table::read(&path) {
-        Ok(rows) => distances(&rows),
+    let (mine, yours) = match beside(res, other) {
+        Ok(pair) => pair,
         Err(e) => {
             doc.paragraph(format!("Not compared: {e} (`cargo run --release -- study {other}` writes it)."));
             return;
         }
     };
-    let ours = distances(&res.errors);
-    let common = |a: &[LevelError], b: &[LevelError]| -> Vec<LevelError> {
-        a.iter().filter(|x| b.iter().any(|y| y.level == x.level)).cloned().collect()
-    };
-    let (mine, yours) = (common(&ours, &theirs), common(&theirs, &ours));
     let mut table = Table::new(
         ["level", "h here", "D here", "h there", &format!("D in {other}"), "here / there", "D / h^(1/2) here", "D / h^(1/2) there"]
             .map(String::from),

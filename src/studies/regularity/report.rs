@@ -138,13 +138,7 @@ fn rate_rows(family: &super::Family, beta: f64, res: &StudyResult) -> Vec<RateCs
 
 /// A rate cell: the rate and its standard error where supported, else the verdict.
 fn cell(r: Option<&RateRow>) -> String {
-    match r {
-        Some(r) => match supported(r) {
-            Some((rate, se)) => format!("{rate:.3} ± {se:.3}"),
-            None => r.short_text(),
-        },
-        None => "-".into(),
-    }
+    super::families::cell(r.map(|r| &r.assessment))
 }
 
 impl Regularity {
