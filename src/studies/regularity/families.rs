@@ -84,14 +84,25 @@ fn judge_sorted(mut levels: Vec<LevelError>) -> Option<Assessment> {
 }
 
 /// An assessment as a table cell: "rate ± se" where fitted, else the verdict.
-fn cell(a: Option<&Assessment>) -> String {
+pub(super) fn cell(a: Option<&Assessment>) -> String {
     match a {
-        Some(a) if a.verdict == Verdict::Fitted => match a.fit {
+        Some(a) if a.verdict.supports_rate() => match a.fit {
             Some(f) => format!("{:.3} ± {:.3}", f.rate, f.stderr),
             None => a.verdict.name().into(),
         },
         Some(a) => short_text(a.verdict, a.fit.map(|f| f.rate), a.last_rate()),
         None => "-".into(),
+    }
+}
+
+/// [`cell`], with the last judged rate beside a fitted one: on meshes remeshed at every
+/// level the window's rates scatter, and the fit may lie above the last of them.
+fn with_last(a: Option<&Assessment>) -> String {
+    match (a, a.and_then(Assessment::last_rate)) {
+        (Some(x), Some(last)) if x.verdict.supports_rate() => {
+            format!("{} (last {last:.3})", cell(a))
+        }
+        _ => cell(a),
     }
 }
 
@@ -382,9 +393,9 @@ pub fn against_uniform(doc: &mut Doc, reg: &Regularity, reports: &Path, quantiti
                     format!("{beta}"),
                     format!("`{q}`"),
                     m.to_string(),
-                    cell(Some(&graded)),
+                    with_last(Some(&graded)),
                     dofs_rate(&graded),
-                    cell(Some(&flat)),
+                    with_last(Some(&flat)),
                     dofs_rate(&flat),
                     dofs(
                         res.errors
@@ -531,9 +542,9 @@ pub fn graded_findings(reg: &Regularity, reports: &Path) -> Result<Vec<String>> 
                 let flat = judge_aligned(&uniform, *beta, m, Quantity::Theorem).map(|x| x.0);
                 format!(
                     "beta = {beta}: {}{} (uniform {}{})",
-                    cell(graded.as_ref()),
+                    with_last(graded.as_ref()),
                     graded.as_ref().map_or(String::new(), dofs_rate),
-                    cell(flat.as_ref()),
+                    with_last(flat.as_ref()),
                     flat.as_ref().map_or(String::new(), dofs_rate)
                 )
             })
