@@ -180,7 +180,7 @@ struct SolveArgs {
     /// Built-in scene name (`scene list` lists them) or path to a scene .toml.
     #[arg(long)]
     scene: String,
-    /// Contact condition: mortar (K_h^pi) or nts (K_h^I).
+    /// Contact condition: mortar (K_h^pi), nts (K_h^I) or lac (local average contact)
     #[arg(long, default_value = "mortar")]
     method: String,
     /// Solver: newton, paper or qp.
@@ -419,7 +419,7 @@ impl SolveArgs {
     fn request(self) -> anyhow::Result<SolveRequest> {
         let method = Method::parse(&self.method).with_context(|| {
             format!(
-                "--method: unknown cone '{}'; use mortar (K_h^pi) or nts (K_h^I)",
+                "--method: unknown cone '{}'; use mortar (K_h^pi), nts (K_h^I) or lac (local average contact)",
                 self.method
             )
         })?;

@@ -80,7 +80,9 @@ pub struct ContactNode {
 }
 
 /// The contact result at every slave node of Gamma_C, in row order (piece by piece, along
-/// each piece).
+/// each piece). LAC's rows are macro-elements: each body-1 node of a macro-element M gets
+/// M's pressure and activity, a node shared by two macro-elements the mean of their
+/// pressures and the activity of either.
 pub fn contact_nodes(p: &Problem, s: &State) -> Vec<ContactNode> {
     // normal_jumps lists each piece's slave nodes, then its master nodes.
     let jumps = contact::normal_jumps(&p.interface, &s.u);
@@ -92,23 +94,36 @@ pub fn contact_nodes(p: &Problem, s: &State) -> Vec<ContactNode> {
     }
     let rows_u = contact::apply_rows(&p.rows, &s.u);
     let u_max = crate::solve::inf_norm(&s.u).max(f64::MIN_POSITIVE);
-    p.rows
-        .iter()
-        .zip(&s.lambda)
-        .zip(&rows_u)
-        .map(|((row, &lambda), &cu)| {
-            let piece = &p.interface.pieces[row.piece];
-            let arc = piece.slave_s[row.i];
-            let size: f64 = row.entries.iter().map(|(_, v)| v.abs()).sum();
+    let mut out: Vec<ContactNode> = Vec::new();
+    for ((row, &lambda), &cu) in p.rows.iter().zip(&s.lambda).zip(&rows_u) {
+        let piece = &p.interface.pieces[row.piece];
+        let size: f64 = row.entries.iter().map(|(_, v)| v.abs()).sum();
+        let active = cu.abs() <= 1e-8 * size * u_max;
+        let node_at = |i: usize| {
+            let arc = piece.slave_s[i];
             ContactNode {
                 piece: row.piece,
-                node: piece.slave_nodes[row.i],
+                node: piece.slave_nodes[i],
                 arc_length: arc,
                 position: piece.point(arc),
                 pressure: row.pressure(lambda),
-                normal_jump: jumps[first_of_piece[row.piece] + row.i].2,
-                active: cu.abs() <= 1e-8 * size * u_max,
+                normal_jump: jumps[first_of_piece[row.piece] + i].2,
+                active,
             }
-        })
-        .collect()
+        };
+        for i in row.span[0]..=row.span[1] {
+            let node = node_at(i);
+            match out.last_mut() {
+                // The end a macro-element shares with the one before it.
+                Some(last)
+                    if row.is_macro() && last.piece == node.piece && last.node == node.node =>
+                {
+                    last.pressure = 0.5 * (last.pressure + node.pressure);
+                    last.active |= node.active;
+                }
+                _ => out.push(node),
+            }
+        }
+    }
+    out
 }

@@ -1,7 +1,9 @@
 //! Reference: Fernandez-Garcia, Hild, Viano, "Numerical approximation of the
 //! elastic-viscoplastic contact problem with non-matching meshes", section 5.2 (Test 2).
 //! Goal: K_h^pi reproduces the homogeneous solution exactly on non-matching meshes;
-//! K_h^I does not (interpenetration and spurious stresses).
+//! K_h^I does not (interpenetration and spurious stresses). LAC (Drouet and Hild 2017)
+//! reproduces it too: the exact P1 solution meets each macro-element's average with
+//! equality and its constant pressure is piecewise constant.
 //! Geometry: two stacked unit blocks, upper [0,1]x[1,2] (body 1), lower [0,1]x[0,1];
 //! symmetry on the right sides and the bottom; meshes non-matching on y = 1.
 //! Data: E = 3e5, nu = 0.3, lambda = 100, sigma_Y = sqrt(10), g = (0, -10 t) on top, T = 1,
@@ -139,4 +141,35 @@ fn mortar_reproduces_the_homogeneous_solution_and_nts_does_not() {
         assert!(pen > 1e-3, "nts must show interpenetration, got {pen:e}");
     }
     let _ = contact::Method::Mortar;
+}
+
+#[test]
+fn lac_reproduces_the_homogeneous_solution_stress_and_pressure() {
+    let steps = 10;
+    for level in 0..3 {
+        let case = common::case("patch", level, Method::Lac, &[]);
+        let p = &case.problem;
+        let sol = solve::solve(p, &Settings::default(), steps, false).unwrap();
+        let (mut stress, mut pressure) = (0.0f64, 0.0f64);
+        for st in sol.states.iter().skip(1) {
+            let exact = Vector3::new(0.0, -10.0 * st.time, 0.0);
+            for s in &st.sigma {
+                stress = stress.max((s - exact).amax() / exact.amax());
+            }
+            for (row, l) in p.rows.iter().zip(&st.lambda) {
+                pressure =
+                    pressure.max((row.pressure(*l) - 10.0 * st.time).abs() / (10.0 * st.time));
+            }
+        }
+        println!("level {level}: lac stress {stress:.2e}, pressure {pressure:.2e} (relative)");
+        // Round-off of a solve at the default tolerance (1e-10 relative).
+        assert!(
+            stress <= 1e-10,
+            "level {level}: lac stress error {stress:e}"
+        );
+        assert!(
+            pressure <= 1e-10,
+            "level {level}: lac pressure error {pressure:e}"
+        );
+    }
 }

@@ -12,7 +12,9 @@ use crate::solve::{Problem, Solution, State};
 use std::borrow::Cow;
 
 /// A contact pressure along Gamma_C: per piece of the interface, (position, pressure) at the
-/// body-1 trace nodes in order along the piece (force per length), linear in between.
+/// body-1 trace nodes in order along the piece (force per length), linear in between. Two
+/// consecutive points at one position make a jump there (LAC's pressure, constant on each
+/// macro-element, is its two ends' values per macro-element).
 pub type PressureProfile = Vec<Vec<([f64; 2], f64)>>;
 
 /// One time step of a discrete solution.
@@ -165,12 +167,20 @@ fn elastic_stress(model: &Model, u: &[f64]) -> Result<Vec<Stress>, FieldError> {
 }
 
 /// The pressure of a discrete solution of this project's solver: the nodal multiplier over
-/// its lumped weight at the body-1 trace nodes (force per length), per piece.
+/// its lumped weight at the body-1 trace nodes (force per length), per piece; for LAC the
+/// multiplier over |M|, constant on each macro-element M (written at M's two ends).
 pub fn pressure_profile(p: &Problem, s: &State) -> PressureProfile {
     let mut out: PressureProfile = vec![Vec::new(); p.interface.pieces.len()];
     for (row, l) in p.rows.iter().zip(&s.lambda) {
         let piece = &p.interface.pieces[row.piece];
-        out[row.piece].push((piece.point(piece.slave_s[row.i]), row.pressure(*l)));
+        let value = row.pressure(*l);
+        if row.is_macro() {
+            for end in row.span {
+                out[row.piece].push((piece.point(piece.slave_s[end]), value));
+            }
+        } else {
+            out[row.piece].push((piece.point(piece.slave_s[row.i]), value));
+        }
     }
     out
 }

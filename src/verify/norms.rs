@@ -199,6 +199,25 @@ pub fn eval_pl(f: &[(f64, f64)], x: f64) -> f64 {
     a.1 + t * (b.1 - a.1)
 }
 
+/// The piecewise-linear function through sorted points `f` at `x`, on the segment of `f`
+/// that holds `inside` (a point strictly inside a sub-interval that has `x` at an end): the
+/// one-sided value at a jump of `f` (two points at one abscissa). Without a jump it is
+/// [`eval_pl`]'s value to the last bit (a node's own value at either end).
+pub fn eval_pl_within(f: &[(f64, f64)], x: f64, inside: f64) -> f64 {
+    if f.len() == 1 {
+        return f[0].1;
+    }
+    let k = f.partition_point(|p| p.0 <= inside).clamp(1, f.len() - 1);
+    let (a, b) = (f[k - 1], f[k]);
+    if x == a.0 {
+        return a.1;
+    }
+    if x == b.0 {
+        return b.1;
+    }
+    eval_pl(&f[k - 1..=k], x)
+}
+
 /// The abscissa of `x` along `piece` and its distance off the piece's line.
 pub fn on_piece(piece: &Piece, x: [f64; 2]) -> (f64, f64) {
     let d = [x[0] - piece.a[0], x[1] - piece.a[1]];
@@ -224,7 +243,12 @@ pub fn project(study: &Interface, points: &[([f64; 2], f64)]) -> Vec<Vec<(f64, f
                 })
                 .collect();
             f.sort_by(|a, b| a.0.total_cmp(&b.0));
-            f.dedup_by(|a, b| (a.0 - b.0).abs() <= 1e-12 * piece.length);
+            // Points at one abscissa are one point, but for a jump inside the piece (two
+            // values at one position: a piecewise-constant pressure).
+            let interior = |s: f64| s > tol && s < piece.length - tol;
+            f.dedup_by(|a, b| {
+                (a.0 - b.0).abs() <= 1e-12 * piece.length && !(interior(b.0) && a.1 != b.1)
+            });
             f
         })
         .collect()
@@ -253,9 +277,10 @@ pub fn pressure_difference(
         for w in br.windows(2) {
             let (a, b) = (w[0], w[1]);
             let m = 0.5 * (a + b);
-            let d = |x: f64| eval_pl(&fs, x) - eval_pl(&fr, x);
+            // Each profile's piece that holds the sub-interval (one-sided at a jump).
+            let d = |x: f64| eval_pl_within(&fs, x, m) - eval_pl_within(&fr, x, m);
             diff += (b - a) / 6.0 * (d(a).powi(2) + 4.0 * d(m).powi(2) + d(b).powi(2));
-            let q = |x: f64| eval_pl(&fr, x);
+            let q = |x: f64| eval_pl_within(&fr, x, m);
             norm += (b - a) / 6.0 * (q(a).powi(2) + 4.0 * q(m).powi(2) + q(b).powi(2));
         }
     }
