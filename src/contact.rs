@@ -53,6 +53,17 @@ impl Method {
             Method::Nts => 0.5,
         }
     }
+    /// Where the rate the studies hold the method to comes from, for reports: "Theorem 3.1:
+    /// r", or for lac mortar's rate, which Theorem 3.1 does not give it.
+    pub fn rate_claim(self) -> String {
+        match self {
+            Method::Lac => format!(
+                "not in Theorem 3.1; held to mortar's {}",
+                Method::Mortar.theorem_rate()
+            ),
+            _ => format!("Theorem 3.1: {}", self.theorem_rate()),
+        }
+    }
     /// Whether the pressure is constant on each row's support (LAC's macro-elements)
     /// rather than linear between body-1 nodes.
     pub fn piecewise_constant_pressure(self) -> bool {

@@ -67,7 +67,7 @@ enum Command {
     /// and summary.csv into --out, all or nothing.
     Solve(SolveArgs),
     /// Grade another code's solutions of an exported problem against the exact solution:
-    /// errors, rates and verdicts beside this project's mortar and nts (reports/grade-NAME).
+    /// errors, rates and verdicts beside this project's mortar, nts and lac (reports/grade-NAME).
     Grade(GradeArgs),
     /// Assemble the report of what real contact codes converge at (reports/codes) from grade
     /// reports GRADES/PROBLEM/CODE/ (examples/codes/run.sh writes them).
@@ -126,7 +126,7 @@ struct GradeArgs {
     /// Levels to grade, A-B (default: every level with a file).
     #[arg(long, value_name = "A-B")]
     levels: Option<String>,
-    /// The graded code's label in the report (not mortar or nts).
+    /// The graded code's label in the report (not mortar, nts or lac).
     #[arg(long, default_value = "graded")]
     name: String,
     /// A required rate R for the graded code's theorem norm (l2_stress where the exact
@@ -138,7 +138,7 @@ struct GradeArgs {
     /// Report folder (default: reports/grade-NAME).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Do not solve this project's mortar and nts beside it.
+    /// Do not solve this project's mortar, nts and lac beside it.
     #[arg(long)]
     no_compare: bool,
     /// The name of the displacement point data.

@@ -91,6 +91,7 @@ pub fn headline(reports: &Path) -> Result<String> {
         "does not converge".to_string(),
         format!("rate, mortar (Theorem 3.1: {})", Method::Mortar.theorem_rate()),
         format!("rate, nts (Theorem 3.1: {})", Method::Nts.theorem_rate()),
+        format!("rate, lac ({})", Method::Lac.rate_claim()),
     ]);
     for (name, what, report) in &studies {
         table.row(headline_row(name, what, report));
@@ -172,7 +173,7 @@ fn theorem_rates(studies: &[(&str, &str, Report)], m: Method) -> String {
     } else {
         format!(", {}", others.join(", "))
     };
-    format!("{m} {range}{more} (Theorem 3.1: {})", m.theorem_rate())
+    format!("{m} {range}{more} ({})", m.rate_claim())
 }
 
 /// Each (method, quantity) that does not converge, with the studies where it stalls.
@@ -194,7 +195,7 @@ fn stalled_anywhere(studies: &[(&str, &str, Report)]) -> Vec<String> {
 }
 
 /// One study's row of the headline table.
-fn headline_row(name: &str, what: &str, report: &Report) -> [String; 5] {
+fn headline_row(name: &str, what: &str, report: &Report) -> [String; 6] {
     let mut comparison = report.compare_cones();
     // The widest gap first; an exact cone (an infinite or zero ratio) leads.
     comparison
@@ -220,6 +221,7 @@ fn headline_row(name: &str, what: &str, report: &Report) -> [String; 5] {
         listed(&stalled, ", ", "nothing"),
         judged_rate(report, Method::Mortar),
         judged_rate(report, Method::Nts),
+        judged_rate(report, Method::Lac),
     ]
 }
 

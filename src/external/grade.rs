@@ -1,6 +1,6 @@
 //! `grade`: the solutions of a contact code this project did not write, one per mesh level,
 //! measured against the scene's exact solution with the studies' error integrals, judged by
-//! the studies' rate verdicts, beside this project's mortar and nts on the family's meshes.
+//! the studies' rate verdicts, beside this project's mortar, nts and lac on the family's meshes.
 
 use super::checks::{self, CheckRecord, LevelCheck};
 use super::family::{Family, Source};
@@ -39,7 +39,7 @@ pub struct GradeRequest {
     pub threshold: Option<f64>,
     /// The field names.
     pub names: FieldNames,
-    /// Solve mortar and nts on the family's meshes beside it.
+    /// Solve mortar, nts and lac on the family's meshes beside it.
     pub compare: bool,
 }
 
@@ -501,14 +501,14 @@ fn level_checks(
     (records, flagged)
 }
 
-/// Mortar and nts on every graded level (none without `compare`), in parallel.
+/// Mortar, nts and lac on every graded level (none without `compare`), in parallel.
 fn solve_cones(
     family: &Family,
     files: &BTreeMap<usize, (Storage, PathBuf)>,
     compare: bool,
 ) -> Result<Cones> {
     let jobs: Vec<(Method, usize)> = match compare {
-        true => [Method::Mortar, Method::Nts]
+        true => Method::ALL
             .into_iter()
             .flat_map(|m| files.keys().map(move |&l| (m, l)))
             .collect(),
@@ -609,7 +609,7 @@ fn cone_rows(
     let mut errors = Vec::new();
     for (method, level, case, solution) in cones {
         let (mut errors_here, scale) = truth.measure_solved(case, solution);
-        if *method == Method::Nts
+        if *method != Method::Mortar
             && let Some((mc, ms)) = mortar_at(cones, *level)
         {
             let (a, b) = (

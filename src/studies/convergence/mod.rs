@@ -13,6 +13,7 @@
 //! 6. the provenance.
 
 mod distance_report;
+mod lac_report;
 pub mod report;
 pub mod results;
 
@@ -531,8 +532,9 @@ fn measure_levels(
         let (method, level) = (*method, *level);
         out.errors
             .extend(error_rows(sf, method, case, sol, errors)?);
-        if method == Method::Nts {
-            out.errors.extend(distance_rows(sf, &runs, level, &measured)?);
+        if method != Method::Mortar {
+            out.errors
+                .extend(distance_rows(sf, &runs, method, level, &measured)?);
         }
         let flagged = errors[&Quantity::Theorem] < 5.0 * truth.error();
         out.levels.push(level_info(case, sol, method, flagged));
@@ -545,18 +547,19 @@ fn measure_levels(
     Ok(out)
 }
 
-/// The rows of errors.csv of the cone distance on `level` (listed under nts), where the
-/// study measures it: both cones' solutions on that level's mesh, relative to the truth's
-/// sizes there.
+/// The rows of errors.csv of the distance of `method`'s solution to mortar's on `level`
+/// (listed under `method`: nts or lac), where the study measures it: both solutions on
+/// that level's mesh, relative to the truth's sizes there.
 fn distance_rows(
     sf: &StudyFile,
     runs: &[(Method, usize, Case, Solution)],
+    method: Method,
     level: usize,
     measured: &[(BTreeMap<Quantity, f64>, Scale)],
 ) -> Result<Vec<ErrorRecord>> {
     let wanted: Vec<Quantity> = sf.quantities.iter().copied().filter(|q| q.is_distance()).collect();
     let find = |m: Method| runs.iter().position(|r| r.0 == m && r.1 == level);
-    let (Some(a), Some(b)) = (find(Method::Mortar), find(Method::Nts)) else {
+    let (Some(a), Some(b)) = (find(Method::Mortar), find(method)) else {
         return Ok(Vec::new());
     };
     if wanted.is_empty() {
@@ -580,7 +583,7 @@ fn distance_rows(
                 )));
             }
             Ok(ErrorRecord {
-                method: Method::Nts.into(),
+                method: method.into(),
                 level,
                 h: cb.h,
                 dofs: cb.problem.model.n_free,

@@ -64,7 +64,7 @@ pub const HEADLINE: [(&str, &str); 5] = [
 ];
 
 /// The cones, in the order the pages name them.
-pub(crate) const CONES: [Method; 2] = [Method::Mortar, Method::Nts];
+pub(crate) const CONES: [Method; 3] = Method::ALL;
 
 /// A ratio of the cones' errors at the finest level beyond this (either way) separates them.
 pub(crate) const SEPARATES: f64 = 1.5;
@@ -308,7 +308,7 @@ pub(crate) fn study_section(doc: &mut Doc, dir: &Path, name: &str, what: &str) -
         .filter_map(|&m| {
             report
                 .rate(m, Quantity::Theorem)
-                .map(|r| format!("{m} {}, Theorem 3.1: {}", rate_text(r), m.theorem_rate()))
+                .map(|r| format!("{m} {}, {}", rate_text(r), m.rate_claim()))
         })
         .collect();
     if !theorem.is_empty() {

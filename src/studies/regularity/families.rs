@@ -97,7 +97,7 @@ pub(super) fn cell(a: Option<&Assessment>) -> String {
 
 /// [`cell`], with the last judged rate beside a fitted one: on meshes remeshed at every
 /// level the window's rates scatter, and the fit may lie above the last of them.
-fn with_last(a: Option<&Assessment>) -> String {
+pub(super) fn with_last(a: Option<&Assessment>) -> String {
     match (a, a.and_then(Assessment::last_rate)) {
         (Some(x), Some(last)) if x.verdict.supports_rate() => {
             format!("{} (last {last:.3})", cell(a))

@@ -281,6 +281,62 @@ impl Regularity {
         doc.paragraph("Best rates on uniform meshes: min(1, beta) for the H1 and theorem norms; min(beta, 3/2) for the stress in the band of triangles along Gamma_C (pointwise h on a band of area O(h), h^(beta-1) on the triangles at c); min(beta - 1/2, 2) for the pressure in L2(Gamma_C), since p ~ dist^(beta-1). `cone_distance` is the distance between the two cones' solutions on the same meshes (docs/studies.md). A rate is printed only where the verdict supports one (fitted); otherwise the verdict (falling or rising: in transition, with the last successive rate).");
     }
 
+    /// The third method beside the cones, per beta: lac's theorem-norm rate beside
+    /// mortar's and nts's, lac's error over mortar's at the finest level, lac's distance to
+    /// mortar (rate, and over mortar's error), and lac's pressure rate beside the best a
+    /// piecewise-constant profile can reach.
+    fn lac_table(&self, doc: &mut Doc) {
+        if !self.members.iter().any(|(_, res)| res.file.methods.contains(&Method::Lac)) {
+            return;
+        }
+        let mut t = Table::new([
+            "beta",
+            "`theorem`: lac / mortar / nts",
+            "lac / mortar error, finest level",
+            "lac's distance to mortar: rate",
+            "over e_mortar, finest level",
+            "`l2_pressure`: lac (best piecewise constant) / mortar",
+        ]);
+        // On remeshed (graded) levels a fitted rate is shown with the last judged one.
+        let cell = |r: Option<&RateRow>| match self.graded() {
+            true => super::families::with_last(r.map(|r| &r.assessment)),
+            false => cell(r),
+        };
+        for (beta, res) in &self.members {
+            let finest = res.errors.iter().map(|e| e.level).max().unwrap_or(0);
+            let theorem = |m: Method| res.error(m, finest, Quantity::Theorem);
+            let ratio = |a: Option<f64>, b: Option<f64>| match (a, b) {
+                (Some(a), Some(b)) if b > 0.0 => format!("{:.3}", a / b),
+                _ => "-".into(),
+            };
+            let best_p0 = if self.graded() {
+                "none claimed".to_string()
+            } else {
+                format!("{:.2}", (beta - 0.5).min(1.0))
+            };
+            t.row([
+                beta.to_string(),
+                format!(
+                    "{} / {} / {}",
+                    cell(self.row(*beta, Method::Lac, Quantity::Theorem)),
+                    cell(self.row(*beta, Method::Mortar, Quantity::Theorem)),
+                    cell(self.row(*beta, Method::Nts, Quantity::Theorem))
+                ),
+                ratio(theorem(Method::Lac), theorem(Method::Mortar)),
+                cell(self.row(*beta, Method::Lac, Quantity::ConeDistance)),
+                ratio(res.error(Method::Lac, finest, Quantity::ConeDistance), theorem(Method::Mortar)),
+                format!(
+                    "{} (best {best_p0}) / {}",
+                    cell(self.row(*beta, Method::Lac, Quantity::L2Pressure)),
+                    cell(self.row(*beta, Method::Mortar, Quantity::L2Pressure))
+                ),
+            ]);
+        }
+        doc.heading(2, "The third method: lac beside the cones")
+            .paragraph("LAC (Drouet and Hild 2017; docs/methods.md): non-penetration on average over macro-elements of two body-1 segments, the pressure constant on each. Its rates in the theorem norm beside mortar's and nts's, its error over mortar's and its distance to mortar's solution on the same meshes, and its pressure rate beside the best a piecewise-constant profile reaches on uniform meshes, min(1, beta - 1/2) (p ~ dist^(beta-1)), where mortar's piecewise-linear profile can reach min(2, beta - 1/2).")
+            .table(&t);
+    }
+
     fn readme(&self) -> Result<String> {
         let mut doc = Doc::new();
         let (title, lead) = self.lead();
@@ -317,6 +373,7 @@ impl Regularity {
         doc.paragraph("D is the distance between the two cones' solutions on the same meshes (`cone_distance`); D - e_mortar <= e_nts <= D + e_mortar, so nts's error follows D's rate once D overtakes e_mortar. Each beta's report reads nts against D (its decomposition.csv and \"nts read against its distance to mortar\"); `decomposition.csv` here holds every beta's.");
         doc.paragraph("† Theorem 3.1 does not apply: for beta <= 1 the solution is not in H^2 and the body force ~ r^(beta-2) is not in L2 (it lies in V' only). Its rates 3/4 and 1/2 are claimed only for beta > 1; below, the study requires only convergence (rate >= 0).");
         self.rates_table(&mut doc);
+        self.lac_table(&mut doc);
         let stalled: Vec<String> = self
             .members
             .iter()

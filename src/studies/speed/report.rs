@@ -217,9 +217,10 @@ fn exponent_label(name: &str, points: &[(f64, f64)]) -> String {
 }
 
 /// The solver and cone pairs plotted, with their colours.
-const COMBOS: [(Method, SolverKind, usize); 4] = [
+const COMBOS: [(Method, SolverKind, usize); 5] = [
     (Method::Mortar, SolverKind::Newton, 0),
     (Method::Nts, SolverKind::Newton, 1),
+    (Method::Lac, SolverKind::Newton, 4),
     (Method::Mortar, SolverKind::Paper, 3),
     (Method::Nts, SolverKind::Paper, 2),
 ];
@@ -271,7 +272,7 @@ fn work_precision(res: &SpeedResult, d: &Path) -> Result<()> {
 fn time_vs_dofs(res: &SpeedResult, d: &Path) -> Result<()> {
     let mut series = Vec::new();
     for (f, family) in FAMILIES.iter().enumerate() {
-        for (k, m) in [Method::Mortar, Method::Nts].into_iter().enumerate() {
+        for (k, m) in Method::ALL.into_iter().enumerate() {
             let points: Vec<(f64, f64)> = family_runs(res, family, m, SolverKind::Newton)
                 .map(|r| (r.run.dofs as f64, r.run.time_loop_s + r.run.timings.setup_s))
                 .collect();
@@ -280,7 +281,7 @@ fn time_vs_dofs(res: &SpeedResult, d: &Path) -> Result<()> {
                 points,
                 markers: true,
                 line: true,
-                color: 2 * f + k,
+                color: 3 * f + k,
                 thin: false,
             });
         }
@@ -292,7 +293,7 @@ fn time_vs_dofs(res: &SpeedResult, d: &Path) -> Result<()> {
             points: floor,
             markers: false,
             line: true,
-            color: 2 * f,
+            color: 3 * f,
             thin: true,
         });
     }
@@ -388,7 +389,7 @@ fn ratios_table(res: &SpeedResult) -> Table {
         "fill at the largest run, entries of L: newton / floor",
     ]);
     for family in &FAMILIES {
-        for m in [Method::Mortar, Method::Nts] {
+        for m in Method::ALL {
             let runs: Vec<&SpeedRun> = family_runs(res, family, m, SolverKind::Newton)
                 .filter(|r| r.run.dofs >= 10_000)
                 .collect();
@@ -481,7 +482,7 @@ fn machine_and_threads(doc: &mut Doc, res: &SpeedResult) {
 /// The smallest and largest number of preconditioner applications of newton's
 /// viscoplastic runs from 1e4 dofs, as text.
 fn applications_range(res: &SpeedResult) -> String {
-    let solves: Vec<usize> = [Method::Mortar, Method::Nts]
+    let solves: Vec<usize> = Method::ALL
         .into_iter()
         .flat_map(|m| family_runs(res, &FAMILIES[0], m, SolverKind::Newton))
         .filter(|r| r.run.dofs >= 10_000)

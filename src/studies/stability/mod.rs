@@ -523,12 +523,12 @@ fn rel_diff_scaled(a: &Solution, b: &Solution, factor: f64) -> f64 {
         / m
 }
 
-/// Run every case with every solver and both cones.
+/// Run every case with every solver and every method (mortar, nts, lac).
 pub fn run() -> Result<StabilityResult> {
     let t0 = std::time::Instant::now();
     let mut rows = Vec::new();
     for var in plan()? {
-        for method in [Method::Mortar, Method::Nts] {
+        for method in Method::ALL {
             rows.extend(run_variant(&var, method)?);
         }
     }

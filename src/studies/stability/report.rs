@@ -96,9 +96,10 @@ fn sweep_plots(res: &StabilityResult, d: &Path) -> Result<()> {
 fn readme(res: &StabilityResult, d: &Path) -> String {
     let mut doc = Doc::new();
     doc.heading(1, "Study `stability`").paragraph(format!(
-        "Hard cases, each run with every solver and both cones (level 1 of the `rates` scene with 4 steps unless stated). A failure is a result: `converged = no` with the solver's reason. `error` is the largest nodal difference to newton's solution of the same discrete problem, relative to the largest displacement. Regenerate with `cargo run --release -- study stability` ({:.0} s).",
+        "Hard cases, each run with every solver and every method: mortar, nts and lac (level 1 of the `rates` scene with 4 steps unless stated). A failure is a result: `converged = no` with the solver's reason. `error` is the largest nodal difference to newton's solution of the same discrete problem, relative to the largest displacement. Regenerate with `cargo run --release -- study stability` ({:.0} s).",
         res.wall_s
     ));
+    newton_by_method(&mut doc, res);
     let mut cases: Vec<HardCase> = Vec::new();
     for r in &res.rows {
         if !cases.contains(&r.case) {
@@ -109,6 +110,44 @@ fn readme(res: &StabilityResult, d: &Path) -> String {
         hard_case(&mut doc, res, case, d);
     }
     doc.finish()
+}
+
+/// The lead: newton on every hard case, method by method: runs, failures (named) and the
+/// most iterations in a step.
+fn newton_by_method(doc: &mut Doc, res: &StabilityResult) {
+    let mut table = Table::new([
+        "method",
+        "newton runs",
+        "converged",
+        "most iterations in a step",
+        "mean iterations per step (largest over the runs)",
+        "did not converge",
+    ]);
+    for m in Method::ALL {
+        let runs: Vec<_> = res
+            .rows
+            .iter()
+            .filter(|r| r.method == m && r.solver == SolverKind::Newton)
+            .collect();
+        if runs.is_empty() {
+            continue;
+        }
+        let ok: Vec<_> = runs.iter().filter(|r| r.converged).collect();
+        let failed: Vec<String> = runs
+            .iter()
+            .filter(|r| !r.converged)
+            .map(|r| format!("{} ({})", r.case.name(), r.parameter))
+            .collect();
+        table.row([
+            m.to_string(),
+            runs.len().to_string(),
+            ok.len().to_string(),
+            ok.iter().map(|r| r.max_step_iterations).max().unwrap_or(0).to_string(),
+            format!("{:.1}", ok.iter().map(|r| r.mean_step_iterations).fold(0.0, f64::max)),
+            if failed.is_empty() { "none".into() } else { failed.join(", ") },
+        ]);
+    }
+    doc.heading(2, "Newton on every hard case, by method").table(&table);
 }
 
 /// ## One hard case: its note, its sweep's plots (those written into `d`) and its runs.

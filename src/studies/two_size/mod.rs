@@ -134,8 +134,9 @@ pub struct TwoSizeResult {
     pub steps: usize,
     /// The quantity the thresholds apply to.
     pub threshold_quantity: Quantity,
-    /// The required a1 of mortar and nts (rate threshold minus tolerance).
-    pub thresholds: [f64; 2],
+    /// The required a1 of mortar, nts and lac, in [`Method::ALL`]'s order (rate threshold
+    /// minus tolerance).
+    pub thresholds: [f64; 3],
     /// Every measured pair.
     pub points: Vec<SizePoint>,
     /// Every fit.
@@ -166,7 +167,7 @@ impl TwoSizeResult {
                 let x = f
                     .fit
                     .filter(|x| rates::fit_identifies(x.se[0], x.rms_log_residual))?;
-                let need = self.thresholds[usize::from(f.method == Method::Nts)];
+                let need = self.thresholds[Method::ALL.iter().position(|&m| m == f.method).expect("a method")];
                 (x.a[0] < need).then(|| {
                     format!(
                         "slave {} {} {}: a1 = {:.3} < {need:.3}",
@@ -361,7 +362,7 @@ pub fn run(name: &str) -> Result<TwoSizeResult> {
         quantities: sf.quantities.clone(),
         steps: sf.steps,
         threshold_quantity: sf.thresholds.quantity,
-        thresholds: [Method::Mortar, Method::Nts].map(|m| sf.thresholds.of(m).value()),
+        thresholds: Method::ALL.map(|m| sf.thresholds.of(m).value()),
         diagonal: spec.diagonal.clone(),
         slaves,
         points,

@@ -9,7 +9,7 @@ use crate::error::Result;
 use crate::report::markdown::{DOCS_REPORTS, Doc};
 
 /// The cones, in the order the page names them.
-const CONES: [Method; 2] = [Method::Mortar, Method::Nts];
+const CONES: [Method; 3] = Method::ALL;
 use crate::verify::table::read;
 use std::path::Path;
 

@@ -1,0 +1,123 @@
+//! What the third method, LAC, changes in a convergence report: at the finest level, lac's
+//! error beside mortar's and nts's in each quantity and the method it is nearer, lac's and
+//! nts's distances to mortar, and lac's pressure rate beside the best rate a
+//! piecewise-constant profile can reach.
+
+use super::StudyResult;
+use crate::contact::Method;
+use crate::report::markdown::{Doc, Table};
+use crate::verify::quantity::Quantity;
+
+/// Errors at or below this are round-off of the solvers (their relative tolerance).
+const ROUND_OFF: f64 = 1e-10;
+
+/// The best rate in h of the L2(Gamma_C) pressure error a profile of the given kind can
+/// reach on uniform meshes: piecewise constant min(1, beta - 1/2), piecewise linear
+/// min(2, beta - 1/2) where the pressure is ~ r^(beta - 1) at a point (best approximation
+/// of r^a in L2 on the O(1) segments at the point: h^(a + 1/2)); 1 and 2 for a smooth one.
+pub fn best_pressure_rate(res: &StudyResult, piecewise_constant: bool) -> f64 {
+    let order = if piecewise_constant { 1.0 } else { 2.0 };
+    let singular = res.scene.exact.as_ref().and_then(|e| e.singular.as_ref());
+    singular.map_or(order, |s| (s.exponent - 0.5).min(order))
+}
+
+/// Which of mortar and nts lac's error `lac` is nearer to (in the ratio of errors).
+fn nearer(lac: f64, mortar: f64, nts: f64) -> &'static str {
+    let off = |x: f64| x <= ROUND_OFF;
+    match (off(lac), off(mortar), off(nts)) {
+        (true, true, false) => return "mortar (both at round-off)",
+        (true, false, true) => return "nts (both at round-off)",
+        (true, true, true) => return "all at round-off",
+        _ => {}
+    }
+    let (a, b) = ((lac / mortar).ln().abs(), (lac / nts).ln().abs());
+    if (mortar / nts).ln().abs() < 0.05 {
+        "both (mortar and nts within 5%)"
+    } else if a.min(b) > 2f64.ln() {
+        "neither (more than 2x from both)"
+    } else if a < b {
+        "mortar"
+    } else {
+        "nts"
+    }
+}
+
+/// The section, where the study solves lac beside mortar and nts.
+pub fn section(doc: &mut Doc, res: &StudyResult) {
+    let methods = &res.file.methods;
+    if !(methods.contains(&Method::Lac) && methods.contains(&Method::Mortar) && methods.contains(&Method::Nts)) {
+        return;
+    }
+    let finest = *res.file.mesh.levels.last().expect("levels");
+    let rate = |m: Method, q: Quantity| res.rate(m, q).map_or("n/a".into(), |r| r.assessment.describe());
+    let mut table = Table::new([
+        "quantity".to_string(),
+        format!("lac: error at level {finest}"),
+        "lac / mortar".into(),
+        "lac / nts".into(),
+        "nearer".into(),
+        "lac: rate".into(),
+        "mortar: rate".into(),
+        "nts: rate".into(),
+    ]);
+    let quantities: Vec<Quantity> = res.file.solution_quantities().collect();
+    let ordered = quantities
+        .iter()
+        .filter(|q| **q == Quantity::Theorem)
+        .chain(quantities.iter().filter(|q| q.is_contact()))
+        .chain(quantities.iter().filter(|q| !q.is_contact() && **q != Quantity::Theorem));
+    for &q in ordered {
+        let error = |m: Method| res.error(m, finest, q);
+        let (Some(l), Some(m), Some(n)) = (error(Method::Lac), error(Method::Mortar), error(Method::Nts)) else {
+            continue;
+        };
+        let ratio = |x: f64| if x > ROUND_OFF { format!("{:.3}", l / x) } else { "-".into() };
+        table.row([
+            format!("`{q}`"),
+            format!("{l:.3e}"),
+            ratio(m),
+            ratio(n),
+            nearer(l, m, n).to_string(),
+            rate(Method::Lac, q),
+            rate(Method::Mortar, q),
+            rate(Method::Nts, q),
+        ]);
+    }
+    doc.heading(2, "What the third method changes")
+        .paragraph(format!(
+            "LAC (Drouet and Hild, Numer. Math. 136 (2017) 467-502) asks non-penetration on average over macro-elements of two body-1 segments (docs/methods.md), with a pressure constant on each: local like nts, proven of mortar's order. At level {finest}: lac's error over mortar's and over nts's in each quantity, the method whose error it is nearer (by the ratio; `neither` where it is more than 2x from both), and the three rates. A ratio is `-` where the other's error is at round-off (<= 1e-10)."
+        ))
+        .table(&table);
+    let mut lines = Vec::new();
+    for m in [Method::Lac, Method::Nts] {
+        let (Some(d), Some(e)) = (
+            res.error(m, finest, Quantity::ConeDistance),
+            res.error(Method::Mortar, finest, Quantity::Theorem),
+        ) else {
+            continue;
+        };
+        let ratio = if e > ROUND_OFF { format!("{:.3}", d / e) } else { "-".into() };
+        lines.push(format!(
+            "{m}'s distance to mortar in the theorem norm at level {finest}: {d:.3e}, {ratio} of mortar's error; its rate {}.",
+            rate(m, Quantity::ConeDistance)
+        ));
+    }
+    if quantities.contains(&Quantity::L2Pressure) {
+        lines.push(format!(
+            "`l2_pressure`: lac's pressure is constant on each macro-element, so the best rate in h a profile like it can reach here is {:.3} (mortar's and nts's piecewise-linear profiles: {:.3}); lac's rate {}, mortar's {}.",
+            best_pressure_rate(res, true),
+            best_pressure_rate(res, false),
+            rate(Method::Lac, Quantity::L2Pressure),
+            rate(Method::Mortar, Quantity::L2Pressure)
+        ));
+    }
+    let edge = res.rate(Method::Lac, Quantity::ContactEdge);
+    if let (Some(r), Some(e)) = (edge, res.error(Method::Lac, finest, Quantity::ContactEdge))
+        && r.assessment.verdict == crate::verify::rates::Verdict::NotConverging
+    {
+        lines.push(format!(
+            "`contact_edge` of lac does not converge: a pressure constant on macro-elements places the edge of contact at a macro-element end, so the error stays at the distance from the exact edge to the nearest such end ({e:.3e} at level {finest}) until a finer level puts one nearer (docs/methods.md)."
+        ));
+    }
+    doc.list(lines);
+}
