@@ -21,6 +21,7 @@ fn body() -> contact_rates::error::Result<()> {
     ];
     let method = match args.get(3).map(String::as_str) {
         Some("nts") => Method::Nts,
+        Some("lac") => Method::Lac,
         _ => Method::Mortar,
     };
     let case = Case::build(&scene, level, method, &fam)?;

@@ -19,6 +19,7 @@ fn body() -> contact_rates::error::Result<()> {
     let level: usize = args.get(1).map_or(5, |s| s.parse().expect("level"));
     let method = match args.get(2).map(String::as_str) {
         Some("nts") => Method::Nts,
+        Some("lac") => Method::Lac,
         _ => Method::Mortar,
     };
     let repeats: usize = args.get(3).map_or(30, |s| s.parse().expect("repeats"));

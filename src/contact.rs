@@ -488,7 +488,21 @@ impl Piece {
     /// the midpoint rule is exact), with |M|.
     pub fn macro_averages(&self) -> Vec<MacroAverage> {
         let (ss, ms) = (&self.slave_s, &self.master_s);
-        macro_elements(ss.len() - 1)
+        // Pairs start at the piece's end first in (x, y) order, whichever way the piece runs
+        // (its direction follows the mesh's node numbers): the macro-elements, a triple's
+        // place among them, do not depend on how gmsh numbered the nodes.
+        let n = ss.len() - 1;
+        let end = self.point(self.length);
+        let reversed = (end[0], end[1]) < (self.a[0], self.a[1]);
+        let spans: Vec<[usize; 2]> = match reversed {
+            false => macro_elements(n),
+            true => macro_elements(n)
+                .iter()
+                .rev()
+                .map(|s| [n - s[1], n - s[0]])
+                .collect(),
+        };
+        spans
             .into_iter()
             .map(|span| {
                 let (a, b) = (ss[span[0]], ss[span[1]]);
@@ -620,8 +634,8 @@ impl Piece {
 }
 
 /// The macro-elements of LAC on a piece of `segments` body-1 segments, as body-1 node
-/// indices `[first, last]` along the piece: pairs of consecutive segments from the piece's
-/// start, the last three segments one macro-element where the count is odd, and the single
+/// indices `[first, last]` counted from the piece's end where pairing starts (the end first
+/// in (x, y) order, see [`Piece::macro_averages`]): pairs of consecutive segments from it, the last three segments one macro-element where the count is odd, and the single
 /// segment where the piece has only one (then no body-1 node lies inside it). Every
 /// macro-element of two or three segments holds a body-1 node in its interior, the
 /// condition Drouet and Hild's inf-sup argument asks of macro-elements. The pieces end at

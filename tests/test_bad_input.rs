@@ -344,8 +344,18 @@ fn study_file_errors_through_the_binary() {
             vec!["no built-in scene named 'nosuch'"],
         ),
         (
-            Box::new(|t| t.replace("methods = [\"mortar\", \"nts\"]", "methods = [\"penalty\"]")),
+            Box::new(|t| {
+                t.replace(
+                    "methods = [\"mortar\", \"nts\", \"lac\"]",
+                    "methods = [\"penalty\"]",
+                )
+            }),
             vec!["study.toml", "methods", "unknown method 'penalty'"],
+        ),
+        (
+            // lac listed, its required rate not given: Theorem 3.1 does not give one.
+            Box::new(|t| t.replace("lac = 0.75\n", "")),
+            vec!["study.toml", "thresholds.lac", "lac = 0.75"],
         ),
         (
             // Found while planning, before the first solve.

@@ -147,3 +147,69 @@ fn lac_rows_on_split_levels_are_the_parent_segments() {
         }
     }
 }
+
+/// The macro-elements do not depend on which way a piece runs (its direction follows gmsh's
+/// node numbers): a piece and its mirror image give the same intervals of Gamma_C, the
+/// triple of an odd count at the end last in (x, y) order.
+#[test]
+fn macro_elements_do_not_depend_on_the_direction_of_a_piece() {
+    let s = vec![0.0, 0.15, 0.35, 0.5, 0.7, 1.0];
+    let m = vec![0.0, 0.3, 0.55, 1.0];
+    let forward = Piece {
+        a: [0.0, 1.0],
+        tangent: [1.0, 0.0],
+        length: 1.0,
+        normal: [0.0, 1.0],
+        slave_nodes: (0..6).collect(),
+        slave_s: s.clone(),
+        master_nodes: (0..4).collect(),
+        master_s: m.clone(),
+    };
+    let mirror = |v: &Vec<f64>| v.iter().rev().map(|x| 1.0 - x).collect::<Vec<f64>>();
+    let backward = Piece {
+        a: [1.0, 1.0],
+        tangent: [-1.0, 0.0],
+        slave_s: mirror(&s),
+        master_s: mirror(&m),
+        ..forward.clone()
+    };
+    let intervals = |p: &Piece| {
+        let mut v: Vec<(f64, f64, f64)> = p
+            .macro_averages()
+            .iter()
+            .map(|a| {
+                let (x0, x1) = (
+                    p.point(p.slave_s[a.span[0]])[0],
+                    p.point(p.slave_s[a.span[1]])[0],
+                );
+                (x0.min(x1), x0.max(x1), a.size)
+            })
+            .collect();
+        v.sort_by(|a, b| a.0.total_cmp(&b.0));
+        v
+    };
+    let (f, b) = (intervals(&forward), intervals(&backward));
+    assert_eq!(f.len(), 2);
+    assert!(
+        (f[1].0 - 0.35).abs() < 1e-15 && (f[1].1 - 1.0).abs() < 1e-15,
+        "triple at x = 1: {f:?}"
+    );
+    for (x, y) in f.iter().zip(&b) {
+        assert!(
+            (x.0 - y.0).abs() < 1e-14 && (x.1 - y.1).abs() < 1e-14 && (x.2 - y.2).abs() < 1e-14,
+            "{f:?} vs {b:?}"
+        );
+    }
+    // Each macro-element's averages are the same numbers, node for node.
+    for (ma, mb) in forward
+        .macro_averages()
+        .iter()
+        .zip(backward.macro_averages().iter().rev())
+    {
+        let mut sa: Vec<f64> = ma.slave.iter().map(|e| e.1).collect();
+        let mut sb: Vec<f64> = mb.slave.iter().map(|e| e.1).rev().collect();
+        sa.iter_mut()
+            .zip(sb.iter_mut())
+            .for_each(|(x, y)| assert!((*x - *y).abs() < 1e-14));
+    }
+}

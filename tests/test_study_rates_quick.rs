@@ -147,7 +147,10 @@ fn study_file_errors_name_the_file_and_key() {
             "thresholds.tolerance",
         ),
         (
-            base.replace("methods = [\"mortar\", \"nts\"]", "methods = [\"penalty\"]"),
+            base.replace(
+                "methods = [\"mortar\", \"nts\", \"lac\"]",
+                "methods = [\"penalty\"]",
+            ),
             "unknown method 'penalty'",
         ),
         (

@@ -44,11 +44,7 @@ fn quick_two_size_study_meets_the_lemma_and_reproduces_the_diagonal() {
         let c: Vec<&str> = line.split(',').collect();
         let (method, level, quantity, error): (&str, usize, &str, f64) =
             (c[0], c[1].parse().unwrap(), c[5], c[6].parse().unwrap());
-        let m = if method == "mortar" {
-            Method::Mortar
-        } else {
-            Method::Nts
-        };
+        let m = Method::parse(method).expect("a method");
         let Some(q) = res.quantities.iter().find(|q| q.name() == quantity) else {
             continue;
         };
@@ -62,10 +58,10 @@ fn quick_two_size_study_meets_the_lemma_and_reproduces_the_diagonal() {
         }
     }
     println!("{checked} diagonal errors equal to the committed rates-exact ones");
-    // Both cones at levels 0, 1, 2 and the fixed level 4, every quantity.
-    assert_eq!(checked, 2 * 4 * res.quantities.len());
+    // The three methods at levels 0, 1, 2 and the fixed level 4, every quantity.
+    assert_eq!(checked, 3 * 4 * res.quantities.len());
     // Refining the slave from (2, 2) to (4, 2) reduces the theorem error.
-    for m in [Method::Mortar, Method::Nts] {
+    for m in Method::ALL {
         let base = res.error("upper", m, Quantity::Theorem, [2, 2]).unwrap();
         let finer = res.error("upper", m, Quantity::Theorem, [4, 2]).unwrap();
         println!("{m}: theorem error {base:.3e} at (2, 2), {finer:.3e} at (4, 2)");

@@ -250,6 +250,11 @@ fn pressure_step(
             .map(|&(x, v)| (on_piece(piece, x).0, v))
             .collect();
         let nodes: Vec<f64> = ph.iter().map(|q| q.0).collect();
+        // The weights h_e are the body-1 segments': a profile's points are its nodes, but
+        // for one with jumps (lac: constant on macro-elements) they are the macro-elements'
+        // ends, so the piece's own body-1 abscissae give the segments.
+        let has_jump = ph.windows(2).any(|w| w[0].0 == w[1].0);
+        let segments: &[f64] = if has_jump { &piece.slave_s } else { &nodes };
         let mut br: Vec<f64> = nodes
             .iter()
             .copied()
@@ -263,9 +268,9 @@ fn pressure_step(
                 continue;
             }
             let mid = 0.5 * (w[0] + w[1]);
-            let e = (nodes.partition_point(|&v| v <= mid).max(1) - 1)
-                .min(nodes.len().saturating_sub(2));
-            let h_e = nodes.get(e + 1).map_or(len, |b| b - nodes[e]);
+            let e = (segments.partition_point(|&v| v <= mid).max(1) - 1)
+                .min(segments.len().saturating_sub(2));
+            let h_e = segments.get(e + 1).map_or(len, |b| b - segments[e]);
             for &(q, wq) in &gauss {
                 let sq = w[0] + q * len;
                 let (a, b) = (eval_pl(&ph, sq), truth.at(i, piece, sq));

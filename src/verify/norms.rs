@@ -202,12 +202,17 @@ pub fn eval_pl(f: &[(f64, f64)], x: f64) -> f64 {
 /// The piecewise-linear function through sorted points `f` at `x`, on the segment of `f`
 /// that holds `inside` (a point strictly inside a sub-interval that has `x` at an end): the
 /// one-sided value at a jump of `f` (two points at one abscissa). Without a jump it is
-/// [`eval_pl`]'s value to the last bit (a node's own value at either end).
+/// [`eval_pl`]'s value to the last bit: eval_pl's own where it picks the same segment, else
+/// x is a node of `f` and eval_pl gives that node's value (t = 0 on the next segment).
 pub fn eval_pl_within(f: &[(f64, f64)], x: f64, inside: f64) -> f64 {
     if f.len() == 1 {
         return f[0].1;
     }
     let k = f.partition_point(|p| p.0 <= inside).clamp(1, f.len() - 1);
+    // The segment eval_pl picks for x itself: the same one, eval_pl's value.
+    if f.partition_point(|p| p.0 <= x).clamp(1, f.len() - 1) == k {
+        return eval_pl(f, x);
+    }
     let (a, b) = (f[k - 1], f[k]);
     if x == a.0 {
         return a.1;

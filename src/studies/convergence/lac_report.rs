@@ -31,10 +31,10 @@ fn nearer(lac: f64, mortar: f64, nts: f64) -> &'static str {
         _ => {}
     }
     let (a, b) = ((lac / mortar).ln().abs(), (lac / nts).ln().abs());
-    if (mortar / nts).ln().abs() < 0.05 {
-        "both (mortar and nts within 5%)"
-    } else if a.min(b) > 2f64.ln() {
+    if a.min(b) > 2f64.ln() {
         "neither (more than 2x from both)"
+    } else if (mortar / nts).ln().abs() < 0.05 {
+        "both (mortar and nts within 5%)"
     } else if a < b {
         "mortar"
     } else {
@@ -71,7 +71,11 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
         let (Some(l), Some(m), Some(n)) = (error(Method::Lac), error(Method::Mortar), error(Method::Nts)) else {
             continue;
         };
-        let ratio = |x: f64| if x > ROUND_OFF { format!("{:.3}", l / x) } else { "-".into() };
+        let ratio = |x: f64| match l / x {
+            _ if x <= ROUND_OFF => "-".into(),
+            r if r < 1e-2 => format!("{r:.1e}"),
+            r => format!("{r:.3}"),
+        };
         table.row([
             format!("`{q}`"),
             format!("{l:.3e}"),
@@ -85,7 +89,7 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
     }
     doc.heading(2, "What the third method changes")
         .paragraph(format!(
-            "LAC (Drouet and Hild, Numer. Math. 136 (2017) 467-502) asks non-penetration on average over macro-elements of two body-1 segments (docs/methods.md), with a pressure constant on each: local like nts, proven of mortar's order. At level {finest}: lac's error over mortar's and over nts's in each quantity, the method whose error it is nearer (by the ratio; `neither` where it is more than 2x from both), and the three rates. A ratio is `-` where the other's error is at round-off (<= 1e-10)."
+            "LAC (Drouet and Hild, Numer. Math. 136 (2017) 467-502) asks non-penetration on average over macro-elements of two body-1 segments (three at the end of a piece with an odd count; docs/methods.md), with a pressure constant on each: local like nts, proven of mortar's order. At level {finest}: lac's error over mortar's and over nts's in each quantity, the method whose error it is nearer (by the ratio; `neither` where it is more than 2x from both), and the three rates. A ratio is `-` where the other's error is at round-off (<= 1e-10)."
         ))
         .table(&table);
     let mut lines = Vec::new();
@@ -116,7 +120,7 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
         && r.assessment.verdict == crate::verify::rates::Verdict::NotConverging
     {
         lines.push(format!(
-            "`contact_edge` of lac does not converge: a pressure constant on macro-elements places the edge of contact at a macro-element end, so the error stays at the distance from the exact edge to the nearest such end ({e:.3e} at level {finest}) until a finer level puts one nearer (docs/methods.md)."
+            "`contact_edge` of lac does not converge: a pressure constant on macro-elements places the edge of contact at a macro-element end, so the error stays at about the distance from the exact edge to the nearest such end ({e:.3e} at level {finest}) until a finer level puts one nearer (docs/methods.md)."
         ));
     }
     doc.list(lines);

@@ -353,9 +353,12 @@ fn profiles(res: &StudyResult, d: &Path) -> Result<()> {
                     .map(|p| (p.x, p.value))
                     .collect();
                 pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-                pts.dedup_by(|a, b| a.0 == b.0);
-                let reference =
-                    source != Source::Cone(Method::Mortar) && source != Source::Cone(Method::Nts);
+                // A pressure constant on macro-elements (lac) keeps its jumps: two points at
+                // one position, in order.
+                let steps = name == "pressure"
+                    && matches!(source, Source::Cone(m) if m.piecewise_constant_pressure());
+                pts.dedup_by(|a, b| a.0 == b.0 && !(steps && a.1 != b.1));
+                let reference = matches!(source, Source::Reference | Source::Exact);
                 Series {
                     label: match (source, res.reference) {
                         (Source::Reference, Some(r)) => {
@@ -367,7 +370,8 @@ fn profiles(res: &StudyResult, d: &Path) -> Result<()> {
                     points: pts,
                     markers: !reference,
                     line: true,
-                    color: if reference { 2 } else { i },
+                    // The reference's colour follows the methods' (2 beside two of them).
+                    color: if reference { res.file.methods.len().max(2) } else { i },
                     thin: reference,
                 }
             })

@@ -333,7 +333,7 @@ impl Regularity {
             ]);
         }
         doc.heading(2, "The third method: lac beside the cones")
-            .paragraph("LAC (Drouet and Hild 2017; docs/methods.md): non-penetration on average over macro-elements of two body-1 segments, the pressure constant on each. Its rates in the theorem norm beside mortar's and nts's, its error over mortar's and its distance to mortar's solution on the same meshes, and its pressure rate beside the best a piecewise-constant profile reaches on uniform meshes, min(1, beta - 1/2) (p ~ dist^(beta-1)), where mortar's piecewise-linear profile can reach min(2, beta - 1/2).")
+            .paragraph("LAC (Drouet and Hild 2017; docs/methods.md): non-penetration on average over macro-elements of two body-1 segments (three at the end of a piece with an odd count), the pressure constant on each. Its rates in the theorem norm beside mortar's and nts's, its error over mortar's and its distance to mortar's solution on the same meshes, and its pressure rate beside the best a piecewise-constant profile reaches on uniform meshes, min(1, beta - 1/2) (p ~ dist^(beta-1)), where mortar's piecewise-linear profile can reach min(2, beta - 1/2).")
             .table(&t);
     }
 

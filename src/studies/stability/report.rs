@@ -120,6 +120,7 @@ fn newton_by_method(doc: &mut Doc, res: &StabilityResult) {
         "newton runs",
         "converged",
         "most iterations in a step",
+        "in",
         "mean iterations per step (largest over the runs)",
         "did not converge",
     ]);
@@ -143,6 +144,9 @@ fn newton_by_method(doc: &mut Doc, res: &StabilityResult) {
             runs.len().to_string(),
             ok.len().to_string(),
             ok.iter().map(|r| r.max_step_iterations).max().unwrap_or(0).to_string(),
+            ok.iter()
+                .max_by_key(|r| r.max_step_iterations)
+                .map_or(String::new(), |r| format!("{} ({})", r.case.name(), r.parameter)),
             format!("{:.1}", ok.iter().map(|r| r.mean_step_iterations).fold(0.0, f64::max)),
             if failed.is_empty() { "none".into() } else { failed.join(", ") },
         ]);
