@@ -12,14 +12,7 @@ mod common;
 #[path = "common/graded_series.rs"]
 mod graded_series;
 
-use contact_rates::case::Case;
 use contact_rates::contact::Method;
-use contact_rates::external::export::Source;
-use contact_rates::external::grade::{GradeRequest, grade};
-use contact_rates::io::solution::FieldNames;
-use contact_rates::solve::SolverKind;
-use contact_rates::verify::solve_case;
-use contact_rates::verify::study_file::LoadedStudy;
 
 const STUDIES: [&str; 3] = [
     "regularity-unaligned/beta-1.50",
@@ -72,24 +65,7 @@ fn the_transition_families_export_every_level() {
 fn this_projects_mortar_is_graded_as_grades_own() {
     for study in STUDIES {
         common::case("contact-mms", 0, Method::Mortar, &[]);
-        let loaded = LoadedStudy::load(study).unwrap();
-        let params = loaded.file.family_parameters();
-        let dir = tempfile::tempdir().unwrap();
-        for level in 0..=2 {
-            let case = Case::build(&loaded.scene, level, Method::Mortar, &params).unwrap();
-            let (sol, _) = solve_case(&case, SolverKind::Newton, loaded.file.steps).unwrap();
-            graded_series::write_states(dir.path(), level, &case, &sol.states, |_| ());
-        }
-        let g = grade(&GradeRequest {
-            source: Source::Study(study.into()),
-            solutions: dir.path().to_path_buf(),
-            levels: None,
-            name: "outside".into(),
-            threshold: None,
-            names: FieldNames::default(),
-            compare: true,
-        })
-        .unwrap();
+        let g = graded_series::grade_own_solves(study, Method::Mortar, 2);
         let mut worst = 0.0f64;
         let mut distance = 0.0f64;
         let mut compared = 0;

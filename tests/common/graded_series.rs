@@ -16,9 +16,11 @@ use std::path::Path;
 pub fn outside(case: &Case, state: &State, u: &[f64]) -> Solution {
     let p = &case.problem;
     let m = &p.model;
+    // Per slave node: its row's pressure, or (lac) its macro-element's, a node between two
+    // macro-elements the mean of theirs, as `solve` writes them.
     let mut pressure = vec![0.0; m.n_nodes];
-    for (row, l) in p.rows.iter().zip(&state.lambda) {
-        pressure[p.interface.pieces[row.piece].slave_nodes[row.i]] = row.pressure(*l);
+    for c in contact_rates::metrics::contact_nodes(p, state) {
+        pressure[c.node] = c.pressure;
     }
     Solution {
         points: (0..m.n_nodes).map(|g| m.position(g)).collect(),
@@ -62,4 +64,34 @@ pub fn write_states(
     }
     pvd.push_str("</Collection>\n</VTKFile>\n");
     std::fs::write(dir.join(format!("level_{level}.pvd")), pvd).unwrap();
+}
+
+/// This project's own `method` solves of `study`'s levels 0..=`finest`, written as an outside
+/// code writes them and graded by `grade` as the code "outside" (grade solves its own
+/// mortar, nts and lac beside).
+pub fn grade_own_solves(
+    study: &str,
+    method: contact_rates::contact::Method,
+    finest: usize,
+) -> contact_rates::external::grade::Graded {
+    use contact_rates::external::grade::{GradeRequest, grade};
+    let loaded = contact_rates::verify::study_file::LoadedStudy::load(study).unwrap();
+    let params = loaded.file.family_parameters();
+    let dir = tempfile::tempdir().unwrap();
+    for level in 0..=finest {
+        let case = Case::build(&loaded.scene, level, method, &params).unwrap();
+        let solver = contact_rates::solve::SolverKind::Newton;
+        let (sol, _) = contact_rates::verify::solve_case(&case, solver, loaded.file.steps).unwrap();
+        write_states(dir.path(), level, &case, &sol.states, |_| ());
+    }
+    grade(&GradeRequest {
+        source: contact_rates::external::export::Source::Study(study.into()),
+        solutions: dir.path().to_path_buf(),
+        levels: None,
+        name: "outside".into(),
+        threshold: None,
+        names: contact_rates::io::solution::FieldNames::default(),
+        compare: true,
+    })
+    .unwrap()
 }
