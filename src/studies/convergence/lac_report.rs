@@ -7,23 +7,27 @@ use super::StudyResult;
 use crate::contact::Method;
 use crate::report::markdown::{Doc, Table};
 use crate::verify::quantity::Quantity;
-
-/// Errors at or below this are round-off of the solvers (their relative tolerance).
-const ROUND_OFF: f64 = 1e-10;
+use crate::verify::rates::{ROUNDOFF, Verdict};
 
 /// The best rate in h of the L2(Gamma_C) pressure error a profile of the given kind can
 /// reach on uniform meshes: piecewise constant min(1, beta - 1/2), piecewise linear
-/// min(2, beta - 1/2) where the pressure is ~ r^(beta - 1) at a point (best approximation
-/// of r^a in L2 on the O(1) segments at the point: h^(a + 1/2)); 1 and 2 for a smooth one.
-pub fn best_pressure_rate(res: &StudyResult, piecewise_constant: bool) -> f64 {
+/// min(2, beta - 1/2) where the pressure is ~ r^(beta - 1) at a point (`beta`: best
+/// approximation of r^a in L2 on the O(1) segments at the point is h^(a + 1/2)); 1 and 2
+/// for a smooth one (`beta` None).
+pub fn best_pressure_rate(beta: Option<f64>, piecewise_constant: bool) -> f64 {
     let order = if piecewise_constant { 1.0 } else { 2.0 };
-    let singular = res.scene.exact.as_ref().and_then(|e| e.singular.as_ref());
-    singular.map_or(order, |s| (s.exponent - 0.5).min(order))
+    beta.map_or(order, |b| (b - 0.5).min(order))
+}
+
+/// The exponent beta of the study's singular part, if its exact solution has one.
+fn singular_exponent(res: &StudyResult) -> Option<f64> {
+    let exact = res.scene.exact.as_ref()?;
+    exact.singular.as_ref().map(|s| s.exponent)
 }
 
 /// Which of mortar and nts lac's error `lac` is nearer to (in the ratio of errors).
 fn nearer(lac: f64, mortar: f64, nts: f64) -> &'static str {
-    let off = |x: f64| x <= ROUND_OFF;
+    let off = |x: f64| x <= ROUNDOFF;
     match (off(lac), off(mortar), off(nts)) {
         (true, true, false) => return "mortar (both at round-off)",
         (true, false, true) => return "nts (both at round-off)",
@@ -72,7 +76,7 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
             continue;
         };
         let ratio = |x: f64| match l / x {
-            _ if x <= ROUND_OFF => "-".into(),
+            _ if x <= ROUNDOFF => "-".into(),
             r if r < 1e-2 => format!("{r:.1e}"),
             r => format!("{r:.3}"),
         };
@@ -100,7 +104,7 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
         ) else {
             continue;
         };
-        let ratio = if e > ROUND_OFF { format!("{:.3}", d / e) } else { "-".into() };
+        let ratio = if e > ROUNDOFF { format!("{:.3}", d / e) } else { "-".into() };
         lines.push(format!(
             "{m}'s distance to mortar in the theorem norm at level {finest}: {d:.3e}, {ratio} of mortar's error; its rate {}.",
             rate(m, Quantity::ConeDistance)
@@ -109,15 +113,15 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
     if quantities.contains(&Quantity::L2Pressure) {
         lines.push(format!(
             "`l2_pressure`: lac's pressure is constant on each macro-element, so the best rate in h a profile like it can reach here is {:.3} (mortar's and nts's piecewise-linear profiles: {:.3}); lac's rate {}, mortar's {}.",
-            best_pressure_rate(res, true),
-            best_pressure_rate(res, false),
+            best_pressure_rate(singular_exponent(res), true),
+            best_pressure_rate(singular_exponent(res), false),
             rate(Method::Lac, Quantity::L2Pressure),
             rate(Method::Mortar, Quantity::L2Pressure)
         ));
     }
     let edge = res.rate(Method::Lac, Quantity::ContactEdge);
     if let (Some(r), Some(e)) = (edge, res.error(Method::Lac, finest, Quantity::ContactEdge))
-        && r.assessment.verdict == crate::verify::rates::Verdict::NotConverging
+        && r.assessment.verdict == Verdict::NotConverging
     {
         lines.push(format!(
             "`contact_edge` of lac does not converge: a pressure constant on macro-elements places the edge of contact at a macro-element end, so the error stays at about the distance from the exact edge to the nearest such end ({e:.3e} at level {finest}) until a finer level puts one nearer (docs/methods.md)."

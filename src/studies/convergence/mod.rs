@@ -14,6 +14,7 @@
 
 mod distance_report;
 mod lac_report;
+pub use lac_report::best_pressure_rate;
 pub mod report;
 pub mod results;
 

@@ -28,7 +28,7 @@ use crate::analytical::singular::Placement;
 use crate::contact::Interface;
 use crate::error::Result;
 use crate::scene::Scene;
-use crate::studies::convergence::{self, StudyResult};
+use crate::studies::convergence::{self, StudyResult, best_pressure_rate};
 use crate::verify::kind::{Found, Kind};
 use crate::verify::quantity::Quantity;
 use crate::verify::study_file::StudyFile;
@@ -173,7 +173,7 @@ pub fn best_rate(quantity: Quantity, beta: f64) -> Option<f64> {
     match quantity {
         Quantity::Theorem | Quantity::H1U | Quantity::L2Stress => Some(beta.min(1.0)),
         Quantity::BandStress => Some(beta.min(1.5)),
-        Quantity::L2Pressure => Some((beta - 0.5).min(2.0)),
+        Quantity::L2Pressure => Some(best_pressure_rate(Some(beta), false)),
         _ => None,
     }
 }

@@ -312,7 +312,7 @@ impl Regularity {
             let best_p0 = if self.graded() {
                 "none claimed".to_string()
             } else {
-                format!("{:.2}", (beta - 0.5).min(1.0))
+                format!("{:.2}", crate::studies::convergence::best_pressure_rate(Some(*beta), true))
             };
             t.row([
                 beta.to_string(),
