@@ -1039,7 +1039,8 @@ fn contact_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
                 series.push(Series {
                     label: format!("{m} {q}: {rate}"),
                     points,
-                    markers: true,
+                    // Colour: the quantity; style: the method (lac without markers).
+                    markers: m != Method::Lac,
                     line: true,
                     color: c,
                     thin: m == Method::Nts,
@@ -1053,8 +1054,12 @@ fn contact_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
     plot::loglog(
         &d.join("contact_vs_h.png"),
         &format!(
-            "{}: contact quantities against h (thick: mortar, thin: nts)",
-            res.name
+            "{}: contact quantities against h ({})",
+            res.name,
+            match res.file.methods.contains(&Method::Lac) {
+                true => "thin: nts, no dots: lac",
+                false => "thick: mortar, thin: nts",
+            }
         ),
         "h (max element diameter)",
         "relative error",
