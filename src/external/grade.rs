@@ -372,8 +372,9 @@ fn rows(
 ) -> Result<Vec<ErrorRecord>> {
     quantities
         .iter()
-        .map(|&quantity| {
-            let error = errors[&quantity];
+        // A quantity relative to a size the truth lacks has no row (verify::rates::relative_to).
+        .filter_map(|&quantity| Some((quantity, *errors.get(&quantity)?)))
+        .map(|(quantity, error)| {
             if !error.is_finite() {
                 return Err(Error::input(
                     file,
@@ -844,15 +845,14 @@ fn distance_to_mortar(
         stress = stress.max(d.stress.sqrt());
     }
     // A distance relative to a size the truth does not have (patch's exact solution gives
-    // no displacement: its H1 size is 0) is not measured.
+    // no displacement: its H1 size is 0) is not measured: the one rule of verify::rates.
     [
         (Quantity::ConeDistance, theorem, scale.theorem),
         (Quantity::ConeDistanceH1U, h1, scale.h1),
         (Quantity::ConeDistanceL2Stress, stress, scale.stress),
     ]
     .into_iter()
-    .filter(|(_, _, s)| *s > 0.0)
-    .map(|(q, v, s)| (q, v / s))
+    .filter_map(|(q, v, s)| Some((q, crate::verify::rates::relative_to(v, s, scale.theorem)?)))
     .collect()
 }
 

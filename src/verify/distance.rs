@@ -65,7 +65,7 @@ pub fn cone_distance(a: &P1History, b: &P1History, scale: &Scale) -> BTreeMap<Qu
             );
         }
     }
-    let relative = |v: f64, s: f64| v / s.max(f64::MIN_POSITIVE);
+    // A distance relative to a size the truth lacks is not measured (verify::rates).
     max.into_iter()
         .filter_map(|(q, v)| {
             let s = match q {
@@ -75,7 +75,7 @@ pub fn cone_distance(a: &P1History, b: &P1History, scale: &Scale) -> BTreeMap<Qu
                 Quantity::ConeDistanceL2Pressure => scale.pressure?,
                 _ => scale.jump,
             };
-            Some((q, relative(v, s)))
+            Some((q, crate::verify::rates::relative_to(v, s, scale.theorem)?))
         })
         .collect()
 }

@@ -419,8 +419,17 @@ fn asymptote(
             mortar: mortar.assessment.verdict,
         };
     };
-    if fd.rate >= fm.rate {
+    // "D falls no slower than mortar's error" is a rate claim: the one rule's, D's fit and
+    // its last judged rate both at mortar's rate.
+    if crate::verify::rates::reaches(&distance.assessment, fm.rate, 0.0) {
         return Asymptote::MortarRate { rate: fm.rate };
+    }
+    if fd.rate >= fm.rate {
+        // D's fit reaches mortar's rate and its last judged rate does not: undecided.
+        return Asymptote::Unsupported {
+            distance: distance.assessment.verdict,
+            mortar: mortar.assessment.verdict,
+        };
     }
     let observed = (0..d_errors.len())
         .find(|&i| {
@@ -609,6 +618,9 @@ impl AsymptoteRow {
                 }
             }
             (Some(r), _) => format!("tends to mortar's rate {r:.3} (D falls no slower)"),
+            _ if self.distance_verdict.supports_rate() && self.mortar_verdict.supports_rate() => {
+                "no asymptotic rate predicted (D's fit reaches mortar's rate, its last judged rate does not)".into()
+            }
             _ => format!(
                 "no asymptotic rate predicted (D {}, mortar {})",
                 self.distance_verdict.name(),

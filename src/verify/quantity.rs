@@ -252,13 +252,16 @@ impl Differences<'_> {
     }
 
     /// Every quantity's relative error (max over the steps, relative to the reference's
-    /// max over the steps); the pressure quantities only when the solution gives a pressure.
+    /// max over the steps); the pressure quantities only when the solution gives a pressure;
+    /// none relative to a size the truth lacks ([`crate::verify::rates::relative_to`]).
     pub fn relative(&self) -> BTreeMap<Quantity, f64> {
         let max_over = |f: &dyn Fn(&SquaredNorms) -> f64, v: &[SquaredNorms]| {
             v.iter().map(f).fold(0.0f64, f64::max)
         };
+        let theorem = max_over(&|n| n.theorem(), self.reference);
+        let relative = |value: f64, size: f64| crate::verify::rates::relative_to(value, size, theorem);
         let rel = |f: &dyn Fn(&SquaredNorms) -> f64| {
-            max_over(f, self.fields) / max_over(f, self.reference).max(f64::MIN_POSITIVE)
+            relative(max_over(f, self.fields), max_over(f, self.reference))
         };
         let max =
             |f: &dyn Fn(&ContactStep) -> f64| self.contact.iter().map(f).fold(0.0f64, f64::max);
@@ -267,17 +270,15 @@ impl Differences<'_> {
             .iter()
             .map(|b| b.sqrt())
             .fold(0.0f64, f64::max);
-        let mut out = BTreeMap::from([
+        let jump_size = self.contact_length.sqrt() * self.reference_displacement;
+        let mut out: Vec<(Quantity, Option<f64>)> = vec![
             (
                 Quantity::BandStress,
-                ratio(band, max_over(&|n| n.stress.sqrt(), self.reference)),
+                relative(band, max_over(&|n| n.stress.sqrt(), self.reference)),
             ),
             (
                 Quantity::L2Penetration,
-                ratio(
-                    max(&|c| c.penetration_l2.sqrt()),
-                    self.contact_length.sqrt() * self.reference_displacement,
-                ),
+                relative(max(&|c| c.penetration_l2.sqrt()), jump_size),
             ),
             (Quantity::Theorem, rel(&|n| n.theorem())),
             (Quantity::H1U, rel(&|n| n.h1())),
@@ -285,17 +286,21 @@ impl Differences<'_> {
             (Quantity::L2Stress, rel(&|n| n.stress.sqrt())),
             (
                 Quantity::MaxPenetration,
-                self.penetration / self.reference_displacement.max(f64::MIN_POSITIVE),
+                relative(self.penetration, self.reference_displacement),
             ),
-        ]);
+        ];
         if let Some(pressure) = self.pressure {
-            out.extend(self.pressure_quantities(pressure));
+            out.extend(self.pressure_quantities(pressure, &relative));
         }
-        out
+        out.into_iter().filter_map(|(q, v)| Some((q, v?))).collect()
     }
 
     /// The quantities of the pressure on Gamma_C.
-    fn pressure_quantities(&self, pressure: &[(f64, f64)]) -> [(Quantity, f64); 5] {
+    fn pressure_quantities(
+        &self,
+        pressure: &[(f64, f64)],
+        relative: &dyn Fn(f64, f64) -> Option<f64>,
+    ) -> [(Quantity, Option<f64>); 5] {
         let pressure_diff = pressure.iter().map(|p| p.0.sqrt()).fold(0.0f64, f64::max);
         let pressure_ref = pressure.iter().map(|p| p.1.sqrt()).fold(0.0f64, f64::max);
         let max = |f: &dyn Fn(&PressureStep) -> f64| {
@@ -308,26 +313,26 @@ impl Differences<'_> {
         [
             (
                 Quantity::ContactEdge,
-                max(&|c| c.edge) / self.contact_length,
+                Some(max(&|c| c.edge) / self.contact_length),
             ),
             (
                 Quantity::PressureResultant,
-                ratio(max(&|c| c.resultant.0.abs()), max(&|c| c.resultant.1)),
+                Some(ratio(max(&|c| c.resultant.0.abs()), max(&|c| c.resultant.1))),
             ),
             (
                 Quantity::PressureWeighted,
-                ratio(max(&|c| c.pressure_weighted.sqrt()), p_norm),
+                relative(max(&|c| c.pressure_weighted.sqrt()), p_norm),
             ),
             (
                 Quantity::PressureOscillation,
-                ratio(
+                Some(ratio(
                     max(&|c| (c.variation.0 - c.variation.1).abs()),
                     max(&|c| c.variation.1.max(c.pressure_max)),
-                ),
+                )),
             ),
             (
                 Quantity::L2Pressure,
-                pressure_diff / pressure_ref.max(f64::MIN_POSITIVE),
+                relative(pressure_diff, pressure_ref),
             ),
         ]
     }

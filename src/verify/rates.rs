@@ -60,6 +60,25 @@ pub fn successive(x: &[f64], y: &[f64]) -> Vec<f64> {
 /// Errors at or below this (relative) are round-off: the solvers' relative tolerance. They
 /// are marked and never fitted.
 pub const ROUNDOFF: f64 = 1e-10;
+/// A relative error or distance is measured only where the truth's size it divides by is at
+/// least this fraction of the truth's theorem norm: a smaller size is one the truth lacks
+/// (patch's exact displacement is 0, so its H1 size is 0) and the ratio measures nothing, so
+/// no row is written. The same fraction as [`ROUNDOFF`]: a size below it is round-off of the
+/// norm it is part of.
+pub const MIN_REFERENCE_SIZE: f64 = ROUNDOFF;
+
+/// `value / size` where `size` is at least [`MIN_REFERENCE_SIZE`] of the truth's theorem
+/// norm `theorem` (and positive); None where the truth lacks that size: the one rule for
+/// every relative error and distance, the cones' and a graded code's alike.
+pub fn relative_to(value: f64, size: f64, theorem: f64) -> Option<f64> {
+    (size > 0.0 && size >= MIN_REFERENCE_SIZE * theorem).then(|| value / size)
+}
+
+/// A fitted rate within this many standard errors of 0 is no rate: the errors are `not
+/// converging` (unaligned beta = 1.5, nts `l2_pressure`: 0.021 ± 0.013 over levels 5-7).
+/// A steady small rate measured to more than two standard errors stays fitted.
+pub const ZERO_RATE_STDERRS: f64 = 2.0;
+
 /// Fewest levels a fitted rate rests on; with fewer, only successive rates are given.
 pub const MIN_FIT_LEVELS: usize = 3;
 /// The fitted window: the longest trailing run of levels (at least [`MIN_FIT_LEVELS`])
@@ -104,7 +123,8 @@ pub enum Verdict {
     /// Fewer than [`MIN_FIT_LEVELS`] levels usable: successive rates only.
     TooFewLevels,
     /// The error stops falling while the mesh is refined: the last two judged rates average
-    /// at most [`STALLED`], or the last one is negative.
+    /// at most [`STALLED`], or the last one is negative, or the window's fitted rate lies
+    /// within [`ZERO_RATE_STDERRS`] standard errors of 0.
     NotConverging,
     /// Every level's error is at round-off ([`ROUNDOFF`]): the discretization is exact.
     RoundOff,
@@ -222,6 +242,15 @@ pub fn threshold_outcome(a: &Assessment, required: f64) -> Outcome {
         (Verdict::Fitted, Some(f)) if f.rate.min(last) >= required => Outcome::Pass,
         _ => Outcome::Unverified,
     }
+}
+
+/// The one rule behind every word of a report that claims a rate reaches a target
+/// ("follows its best", "sides with", "reaches", "tends to mortar's rate"): the threshold
+/// rule at `target - slack`, so a supported rate whose fit and last judged rate both reach
+/// it ([`threshold_outcome`] passes). Never the fit alone: a fit that reaches the target
+/// while the successive rates fall below it is still in transition.
+pub fn reaches(a: &Assessment, target: f64, slack: f64) -> bool {
+    threshold_outcome(a, target - slack) == Outcome::Pass
 }
 
 /// One level's error of one quantity.
@@ -387,7 +416,9 @@ fn rate_between(a: &LevelError, b: &LevelError) -> f64 {
 /// are `not converging`; fewer than [`MIN_FIT_LEVELS`] usable levels are `too few levels`; the last
 /// three judged rates strictly monotone by more than [`TREND`] are `falling` or `rising`;
 /// a trailing window of at least three levels whose judged rates spread by at most
-/// [`WINDOW_SPREAD`] is `fitted`; else `pre-asymptotic`. Errs on two levels with the same h.
+/// [`WINDOW_SPREAD`] is `fitted`, unless its fitted rate is within [`ZERO_RATE_STDERRS`]
+/// standard errors of 0 (`not converging`); else `pre-asymptotic`. Errs on two levels with
+/// the same h.
 pub fn assess(levels: &[LevelError], truth_error: f64) -> Result<Assessment, EqualH> {
     check_distinct_h(levels)?;
     let (mut out, usable) = classify(levels, truth_error);
@@ -442,6 +473,15 @@ pub fn assess(levels: &[LevelError], truth_error: f64) -> Result<Assessment, Equ
     };
     (out.fit, out.fit_dofs) = fit_over(window);
     out.used = window.iter().map(|e| e.level).collect();
+    if out.verdict == Verdict::Fitted
+        && out.fit.is_some_and(|f| f.rate <= ZERO_RATE_STDERRS * f.stderr)
+    {
+        // A rate the data cannot tell from 0 supports no rate.
+        out.verdict = Verdict::NotConverging;
+        (out.fit, out.fit_dofs) = (None, None);
+        out.used.clear();
+        return Ok(out);
+    }
     out.asymptotic_ratio = match (out.celik, out.fit) {
         (Some(c), Some(f)) if f.rate > 0.0 => Some(c.asymptotic_ratio(f.rate)),
         _ => None,

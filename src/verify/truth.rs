@@ -159,7 +159,7 @@ impl Truth<'_> {
     pub fn quantity_error(&self, q: Quantity) -> f64 {
         match self {
             Truth::Solved(_) if q.is_distance() => 0.0,
-            Truth::Solved(r) => r.quantity_errors[&q],
+            Truth::Solved(r) => r.quantity_errors.get(&q).copied().unwrap_or(0.0),
             Truth::Exact(..) => 0.0,
         }
     }

@@ -230,30 +230,36 @@ fn compared(doc: &mut Doc, res: &StudyResult) {
 }
 
 /// Each method read against its distance to mortar: for the theorem norm, h1_u and
-/// l2_stress, nts's observed verdict beside mortar's and D's, the largest |pythagorean|
-/// of decomposition.csv, D / e_mortar at the finest level, and what D's verdict supports
-/// of nts's asymptotic rate (asymptotes.csv).
+/// l2_stress, the method's observed verdict beside mortar's and its own D's, the largest
+/// |pythagorean| of decomposition.csv, D / e_mortar at the finest level, and what D's
+/// verdict supports of the method's asymptotic rate (asymptotes.csv). One row per method
+/// and quantity, every cell read from the method named in its row.
 fn decomposition(doc: &mut Doc, res: &StudyResult) {
     let mut table = Table::new([
+        "method",
         "quantity",
-        "nts observed",
+        "observed",
         "mortar",
         "D (distance to mortar)",
         "largest abs(pythagorean)",
         "D / e_mortar, finest level",
-        "nts's asymptotic rate",
+        "asymptotic rate",
     ]);
     for a in judge::asymptotes(&res.rates, &res.errors) {
+        let Some(method) = a.method.cone() else {
+            continue;
+        };
         let (q, dq) = judge::DECOMPOSED
             .into_iter()
             .find(|(q, _)| *q == a.quantity)
             .expect("a decomposed quantity");
         let describe = |m: Method, q: Quantity| res.rate(m, q).map_or("-".into(), |r| r.assessment.describe());
         table.row([
+            method.to_string(),
             format!("`{q}`"),
-            describe(Method::Nts, q),
+            describe(method, q),
             describe(Method::Mortar, q),
-            describe(Method::Nts, dq),
+            describe(method, dq),
             a.largest_pythagorean.map_or("-".into(), |v| format!("{v:.1e}")),
             match a.mortar_verdict {
                 // A ratio to round-off measures nothing.
@@ -266,8 +272,8 @@ fn decomposition(doc: &mut Doc, res: &StudyResult) {
     if table.is_empty() {
         return;
     }
-    doc.heading(3, "nts read against its distance to mortar")
-        .paragraph("Since D - e_mortar <= e_nts <= D + e_mortar, nts's error tends to the rate min(r_D, r_mortar) once D's rate is supported, and its observed rate turns where D overtakes e_mortar. `pythagorean` = e_nts / sqrt(e_mortar^2 + D^2) - 1 (decomposition.csv) is descriptive: near 0 where the two parts are orthogonal. Where D's verdict supports no rate, nothing is predicted. Where D has not yet overtaken e_mortar, the predicted level range takes D's rate over its own range (its fitted rate, its last successive rate, its fit over every level), D's line anchored at its finest level and mortar's at its fit (asymptotes.csv).")
+    doc.heading(3, "Each method read against its distance to mortar")
+        .paragraph("Since D - e_mortar <= e_X <= D + e_mortar for a method X with distance D to mortar on the same meshes, X's error tends to the rate min(r_D, r_mortar) once D's rate is supported, and its observed rate turns where D overtakes e_mortar. `pythagorean` = e_X / sqrt(e_mortar^2 + D^2) - 1 (decomposition.csv) is descriptive: near 0 where the two parts are orthogonal. Where D's verdict supports no rate, nothing is predicted. Where D has not yet overtaken e_mortar, the predicted level range takes D's rate over its own range (its fitted rate, its last successive rate, its fit over every level), D's line anchored at its finest level and mortar's at its fit (asymptotes.csv). Each row's cells are its method's own (asymptotes.csv's `method`).")
         .table(&table);
 }
 

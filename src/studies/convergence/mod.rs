@@ -607,8 +607,9 @@ fn error_rows(
     errors: &BTreeMap<Quantity, f64>,
 ) -> Result<Vec<ErrorRecord>> {
     sf.solution_quantities()
-        .map(|quantity| {
-            let error = errors[&quantity];
+        // A quantity relative to a size the truth lacks has no row (verify::rates::relative_to).
+        .filter_map(|quantity| Some((quantity, *errors.get(&quantity)?)))
+        .map(|(quantity, error)| {
             if !error.is_finite() {
                 return Err(Error::NotConverged(format!(
                     "{method} level {}: the {quantity} error is not finite",

@@ -110,7 +110,7 @@ pub(super) fn with_last(a: Option<&Assessment>) -> String {
 pub fn parity_rows(reg: &Regularity, quantities: &[Quantity]) -> Vec<ParityRow> {
     let mut rows = Vec::new();
     for (beta, res) in &reg.members {
-        for m in [Method::Mortar, Method::Nts] {
+        for &m in &res.file.methods {
             for &q in quantities {
                 for levels in [Levels::All, Levels::Even, Levels::Odd] {
                     let Some(a) = judge_levels(res, m, q, |l| levels.holds(l)) else {
@@ -146,7 +146,7 @@ pub fn parity_section(doc: &mut Doc, reg: &Regularity, quantities: &[Quantity]) 
     let mut disagree = Vec::new();
     for (beta, res) in &reg.members {
         for &q in quantities {
-            for m in [Method::Mortar, Method::Nts] {
+            for &m in &res.file.methods {
                 let [all, even, odd] = [Levels::All, Levels::Even, Levels::Odd]
                     .map(|l| judge_levels(res, m, q, |k| l.holds(k)));
                 if all.is_none() {

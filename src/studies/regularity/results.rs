@@ -51,11 +51,15 @@ fn regularity_headline(rows: &[RegularityRate]) -> String {
         let worst = theorem
             .iter()
             .filter(|r| r.follows_best == Some(false))
-            .filter_map(|r| Some((r.beta, r.best_rate? - r.rate?, r.rate?)))
+            // The judged rate is min(fit, last judged rate): the one rule's.
+            .filter_map(|r| {
+                let judged = r.rate?.min(r.last_rate.unwrap_or(f64::INFINITY));
+                Some((r.beta, r.best_rate? - judged, judged))
+            })
             .max_by(|a, b| a.1.total_cmp(&b.1));
         if let Some((beta, short, rate)) = worst {
             parts.push(format!(
-                "falls below it at beta = {} (by up to {short:.2}: {rate:.3} at beta = {beta})",
+                "falls below it at beta = {} (by up to {short:.2}: min(fit, last judged rate) {rate:.3} at beta = {beta})",
                 betas_where(&theorem, false).join(", ")
             ));
         }
