@@ -123,6 +123,11 @@ pub struct Piece {
     pub master_nodes: Vec<usize>,
     /// Abscissae of the body-2 nodes, from 0 to `length`.
     pub master_s: Vec<f64>,
+    /// Indices into `slave_nodes` of the interior body-1 nodes that are geometry points of
+    /// the mesh (gmsh's points on the contact curve, nodes of every level): LAC's
+    /// macro-elements end there, so that they follow a rule about the mesh alone. Mortar's
+    /// and nts's rows do not see them.
+    pub breaks: Vec<usize>,
 }
 
 /// Gamma_C as straight pieces.
@@ -328,6 +333,14 @@ impl Interface {
         let slave_edges = edges_on(0, &sc.slave_curve, "contact.slave_curve", "slave")?;
         let master_edges = edges_on(1, &sc.master_curve, "contact.master_curve", "master")?;
         let pos = |g: usize| model.position(g);
+        // Body 1's nodes at the geometry's points, in global numbers.
+        let off = model.node_offset[0];
+        let points: std::collections::BTreeSet<usize> = raw
+            .points
+            .iter()
+            .filter_map(|&r| model.meshes[0].local(r))
+            .map(|l| l + off)
+            .collect();
         let mut pieces = Vec::new();
         for chain in chains(&slave_edges, "contact.slave_curve", &sc.file)? {
             // Split at corners.
@@ -342,7 +355,10 @@ impl Interface {
                     cross.abs() > 1e-8 * d1[0].hypot(d1[1]) * d2[0].hypot(d2[1])
                 };
                 if corner || last {
-                    pieces.push(Self::piece(model, &chain[start..=k], &master_edges)?);
+                    let mut piece = Self::piece(model, &chain[start..=k], &master_edges)?;
+                    let interior = 1..piece.slave_nodes.len().saturating_sub(1);
+                    piece.breaks = interior.filter(|&j| points.contains(&piece.slave_nodes[j])).collect();
+                    pieces.push(piece);
                     start = k;
                 }
             }
@@ -430,6 +446,7 @@ impl Interface {
             slave_s,
             master_nodes: mnodes,
             master_s,
+            breaks: Vec::new(),
         })
     }
 
@@ -495,12 +512,15 @@ impl Piece {
         let end = self.point(self.length);
         let reversed = (end[0], end[1]) < (self.a[0], self.a[1]);
         let spans: Vec<[usize; 2]> = match reversed {
-            false => macro_elements(n),
-            true => macro_elements(n)
-                .iter()
-                .rev()
-                .map(|s| [n - s[1], n - s[0]])
-                .collect(),
+            false => macro_elements_between(n, &self.breaks),
+            true => {
+                let breaks: Vec<usize> = self.breaks.iter().rev().map(|b| n - b).collect();
+                macro_elements_between(n, &breaks)
+                    .iter()
+                    .rev()
+                    .map(|s| [n - s[1], n - s[0]])
+                    .collect()
+            }
         };
         spans
             .into_iter()
@@ -652,6 +672,19 @@ pub fn macro_elements(segments: usize) -> Vec<[usize; 2]> {
         let size = if segments - k == 3 { 3 } else { 2 };
         out.push([k, k + size]);
         k += size;
+    }
+    out
+}
+
+/// [`macro_elements`] on each run of segments between the piece's ends and its interior
+/// `breaks` (body-1 node indices, increasing, counted from the end where pairing starts):
+/// no macro-element spans a break, each run paired from its own first node.
+pub fn macro_elements_between(segments: usize, breaks: &[usize]) -> Vec<[usize; 2]> {
+    let mut out = Vec::new();
+    let mut start = 0;
+    for &end in breaks.iter().filter(|&&b| b > 0 && b < segments).chain(std::iter::once(&segments)) {
+        out.extend(macro_elements(end - start).iter().map(|m| [m[0] + start, m[1] + start]));
+        start = end;
     }
     out
 }

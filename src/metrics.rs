@@ -127,3 +127,38 @@ pub fn contact_nodes(p: &Problem, s: &State) -> Vec<ContactNode> {
     }
     out
 }
+
+/// The least plane-stress von Mises stress of any stress state that carries the traction
+/// (t_n, t_t) (normal and tangential to the boundary; stress units) at a boundary point:
+/// with sigma_nn = t_n, sigma_nt = t_t and sigma_tt free, sigma_nn^2 - sigma_nn sigma_tt +
+/// sigma_tt^2 + 3 sigma_nt^2 is least at sigma_tt = t_n / 2, where it is 3/4 t_n^2 + 3 t_t^2.
+pub fn least_von_mises_for_traction(normal: f64, tangential: f64) -> f64 {
+    (0.75 * normal * normal + 3.0 * tangential * tangential).sqrt()
+}
+
+/// The limit-load check of a viscoplastic scene at time `t`: the largest ratio, over the
+/// given tractions' edges (their ends and midpoints) on viscoplastic bodies, of
+/// [`least_von_mises_for_traction`] to the body's yield stress. Above 1 no stress field
+/// inside the yield surface carries the load there (the lower-bound theorem's admissible
+/// set is empty): the load is past the limit load, the rate-independent problem has no
+/// solution, and Perzyna's flow never relaxes (the plastic strain grows like t / lambda).
+/// None where no given traction acts on a viscoplastic body.
+pub fn limit_load_ratio(model: &crate::fe::Model, t: f64) -> Option<f64> {
+    let mut worst: Option<f64> = None;
+    for (&(i, [a, b]), &(body, n)) in model.traction_edges.iter().zip(&model.traction_normals) {
+        let (Some(g), Some(vp)) = (&model.scene.tractions[i].g, model.materials[body].viscoplastic) else {
+            continue;
+        };
+        let (pa, pb) = (model.position(a), model.position(b));
+        let mid = [0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1])];
+        for p in [pa, mid, pb] {
+            let gx = g.0[0].eval(p[0], p[1], t);
+            let gy = g.0[1].eval(p[0], p[1], t);
+            let normal = gx * n[0] + gy * n[1];
+            let tangential = -gx * n[1] + gy * n[0];
+            let ratio = least_von_mises_for_traction(normal, tangential) / vp.yield_stress;
+            worst = Some(worst.map_or(ratio, |w| w.max(ratio)));
+        }
+    }
+    worst
+}

@@ -31,7 +31,62 @@ pub fn section(reports: &Path) -> Result<String> {
             page.push_str(&results(reports)?);
         }
     }
+    page.push_str(&run_times(reports)?);
     Ok(page)
+}
+
+/// The wall time of every committed report that records one in its run.toml (`wall_s` at
+/// its top level; a family's members summed), as the page's last part: the one place the
+/// documentation takes a study's run time from.
+fn run_times(reports: &Path) -> Result<String> {
+    let mut rows = Vec::new();
+    let mut dirs: Vec<std::path::PathBuf> = std::fs::read_dir(reports)
+        .map_err(|e| crate::error::Error::input(reports, "reports", e.to_string()))?
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.is_dir())
+        .collect();
+    dirs.sort();
+    for dir in dirs {
+        let mut files: Vec<std::path::PathBuf> = std::iter::once(dir.join("run.toml"))
+            .chain(
+                std::fs::read_dir(&dir)
+                    .into_iter()
+                    .flatten()
+                    .flatten()
+                    .map(|e| e.path().join("run.toml")),
+            )
+            .filter(|p| p.is_file())
+            .collect();
+        files.sort();
+        let mut total = 0.0;
+        for f in &files {
+            let text = std::fs::read_to_string(f)
+                .map_err(|e| crate::error::Error::input(f, "run.toml", e.to_string()))?;
+            let value: toml::Value = toml::from_str(&text)
+                .map_err(|e| crate::error::Error::input(f, "run.toml", e.to_string()))?;
+            total += value.get("wall_s").and_then(toml::Value::as_float).unwrap_or(0.0);
+        }
+        if files.is_empty() {
+            continue;
+        }
+        let name = dir.file_name().map_or(String::new(), |n| n.to_string_lossy().to_string());
+        let parts = match files.len() {
+            1 => String::new(),
+            n => format!(" ({n} members' run.toml summed)"),
+        };
+        rows.push([format!("`{name}`"), format!("{total:.0} s{parts}")]);
+    }
+    let mut doc = Doc::new();
+    doc.heading(2, "Run times").paragraph(
+        "Wall time of each committed report's study on the machine that wrote it (2 cores), read from its run.toml (`wall_s`); the build comes first. Reports without a run.toml print their own time in their README.",
+    );
+    let mut table = Table::new(["study", "wall time"]);
+    for r in rows {
+        table.row(r);
+    }
+    doc.table(&table);
+    Ok(doc.finish())
 }
 
 /// The README's headline, for the reports under `reports`: three lines on what separates

@@ -38,6 +38,7 @@ fn piece(slave_s: Vec<f64>, master_s: Vec<f64>, len: f64) -> Piece {
         slave_s,
         master_nodes: (0..master_s.len()).collect(),
         master_s,
+        breaks: Vec::new(),
     }
 }
 

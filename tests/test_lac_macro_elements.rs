@@ -21,6 +21,7 @@ fn macro_element_averages_match_the_hand_computed_integrals() {
         slave_s: vec![0.0, 0.25, 0.5, 0.8, 1.0],
         master_nodes: (0..3).collect(),
         master_s: vec![0.0, 0.4, 1.0],
+        breaks: Vec::new(),
     };
     let rows = p.macro_averages();
     assert_eq!(rows.len(), 2);
@@ -164,6 +165,7 @@ fn macro_elements_do_not_depend_on_the_direction_of_a_piece() {
         slave_s: s.clone(),
         master_nodes: (0..4).collect(),
         master_s: m.clone(),
+        breaks: Vec::new(),
     };
     let mirror = |v: &Vec<f64>| v.iter().rev().map(|x| 1.0 - x).collect::<Vec<f64>>();
     let backward = Piece {
@@ -212,4 +214,61 @@ fn macro_elements_do_not_depend_on_the_direction_of_a_piece() {
             .zip(sb.iter_mut())
             .for_each(|(x, y)| assert!((*x - *y).abs() < 1e-14));
     }
+}
+
+/// Macro-elements end at every geometry point inside a piece (the transition point c of
+/// meshes/two_blocks_graded.geo is one): each run between the piece's ends and its breaks
+/// is paired on its own, in both directions of the piece alike.
+#[test]
+fn macro_elements_end_at_the_geometry_points_of_a_piece() {
+    use contact_rates::contact::macro_elements_between;
+    assert_eq!(macro_elements_between(8, &[]), macro_elements(8));
+    // A break at node 3 of 8 segments: runs of 3 and 5.
+    assert_eq!(macro_elements_between(8, &[3]), vec![[0, 3], [3, 5], [5, 8]]);
+    assert_eq!(macro_elements_between(9, &[2, 5]), vec![[0, 2], [2, 5], [5, 7], [7, 9]]);
+    for n in 2..30 {
+        for b in 2..n - 1 {
+            let m = macro_elements_between(n, &[b]);
+            assert!(m.iter().any(|s| s[1] == b), "n = {n}: a macro-element ends at the break {b}");
+            assert!(m.windows(2).all(|w| w[0][1] == w[1][0]));
+            assert!(m.iter().all(|s| (2..=3).contains(&(s[1] - s[0]))));
+        }
+    }
+    // The same piece and break, run forward and backward, gives the same macro-elements.
+    let s = vec![0.0, 0.1, 0.25, 0.4, 0.5, 0.7, 0.85, 1.0];
+    let m = vec![0.0, 0.3, 0.55, 1.0];
+    let forward = Piece {
+        a: [0.0, 1.0],
+        tangent: [1.0, 0.0],
+        length: 1.0,
+        normal: [0.0, 1.0],
+        slave_nodes: (0..8).collect(),
+        slave_s: s.clone(),
+        master_nodes: (0..4).collect(),
+        master_s: m.clone(),
+        breaks: vec![3],
+    };
+    let mirror = |v: &Vec<f64>| v.iter().rev().map(|x| 1.0 - x).collect::<Vec<f64>>();
+    let backward = Piece {
+        a: [1.0, 1.0],
+        tangent: [-1.0, 0.0],
+        slave_s: mirror(&s),
+        master_s: mirror(&m),
+        breaks: vec![4],
+        ..forward.clone()
+    };
+    let ends = |p: &Piece| {
+        let mut v: Vec<(i64, i64)> = p
+            .macro_averages()
+            .iter()
+            .map(|a| {
+                let (x0, x1) = (p.point(p.slave_s[a.span[0]])[0], p.point(p.slave_s[a.span[1]])[0]);
+                ((x0.min(x1) * 1e9).round() as i64, (x0.max(x1) * 1e9).round() as i64)
+            })
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(ends(&forward), ends(&backward));
+    assert!(ends(&forward).iter().any(|e| e.1 == 400_000_000), "a macro-element ends at x = 0.4");
 }

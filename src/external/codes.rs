@@ -13,6 +13,7 @@ use crate::verify::judge::AsymptoteRow;
 use crate::verify::quantity::Quantity;
 use crate::verify::rates::{Verdict, short_text};
 use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord, methods_in_order, read};
+use crate::contact::Method;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -248,59 +249,101 @@ impl Problem {
 /// Below this relative error a key error is round-off (the patch test's): exact.
 const EXACT: f64 = 1e-9;
 
-/// Which cone `code`'s key error at its finest level is nearer (in ratio) on that level, or
-/// that the cones are within 5% of each other there; where mortar is exact (the patch test),
-/// whether the code is too.
-fn sides_with(p: &Problem, code: &MethodLabel) -> String {
+/// Errors within this ratio of each other (5 %) cannot tell the cones apart at one level.
+const INDISTINCT: f64 = 1.05;
+
+/// What a code's key error at its finest level says of the cones on that level.
+enum Side {
+    /// The code or the cones lack the level.
+    Unknown,
+    /// Mortar is exact there (the patch test): whether the code is too, and its error over
+    /// each inexact cone's.
+    MortarExact { code_exact: bool, ratios: Vec<(Method, f64)> },
+    /// Every cone within [`INDISTINCT`] of the others.
+    Indistinct { level: usize, ratios: Vec<(Method, f64)> },
+    /// The cones nearest the code's error in ratio (the nearest and any within
+    /// [`INDISTINCT`] of it), with the code's error over each cone's.
+    Nearest { cones: Vec<Method>, level: usize, ratios: Vec<(Method, f64)> },
+}
+
+/// Which cone `code`'s key error at its finest level is nearest (in ratio) on that level,
+/// or that the cones are within 5 % of each other there; where mortar is exact (the patch
+/// test), whether the code is too.
+fn side(p: &Problem, code: &MethodLabel) -> Side {
     let key = p.key();
     let Some(finest) = p.finest(code, key) else {
-        return "-".into();
+        return Side::Unknown;
     };
-    let at = |m: crate::contact::Method| {
-        p.errors
-            .iter()
-            .find(|r| {
+    let cones: Vec<(Method, f64)> = p
+        .methods()
+        .iter()
+        .filter_map(|m| m.cone())
+        .filter_map(|m| {
+            let e = p.errors.iter().find(|r| {
                 r.method == MethodLabel::Cone(m) && r.quantity == key && r.level == finest.level
-            })
-            .map(|r| r.error)
-    };
-    let (Some(m), Some(n)) = (
-        at(crate::contact::Method::Mortar),
-        at(crate::contact::Method::Nts),
-    ) else {
-        return "-".into();
+            })?;
+            Some((m, e.error))
+        })
+        .collect();
+    let Some(&(_, mortar)) = cones.iter().find(|c| c.0 == Method::Mortar) else {
+        return Side::Unknown;
     };
     let x = finest.error;
-    if m <= EXACT {
-        return match x <= EXACT {
-            true => "mortar: exact, as mortar".into(),
-            false => format!(
-                "not exact, as nts ({:.2e} times nts's error; mortar exact)",
-                x / n
-            ),
+    let level = finest.level;
+    if mortar <= EXACT {
+        return Side::MortarExact {
+            code_exact: x <= EXACT,
+            ratios: cones.iter().filter(|c| c.1 > EXACT).map(|&(m, e)| (m, x / e)).collect(),
         };
     }
+    let ratios: Vec<(Method, f64)> = cones.iter().map(|&(m, e)| (m, x / e)).collect();
     let far = |a: f64, b: f64| (a / b).ln().abs();
-    let level = finest.level;
-    if far(m, n) < 0.05_f64.ln_1p() {
-        return format!(
-            "cones within 5% at level {level} ({:.3}, {:.3} times)",
-            x / m,
-            x / n
-        );
+    let within = |a: f64, b: f64| far(a, b) < INDISTINCT.ln();
+    if cones.iter().all(|a| cones.iter().all(|b| within(a.1, b.1))) {
+        return Side::Indistinct { level, ratios };
     }
-    match far(x, m) <= far(x, n) {
-        true => format!(
-            "mortar ({:.3} times mortar's, {:.3} nts's at level {level})",
-            x / m,
-            x / n
-        ),
-        false => format!(
-            "nts ({:.3} times nts's, {:.3} mortar's at level {level})",
-            x / n,
-            x / m
-        ),
+    let mut by_distance = cones.clone();
+    by_distance.sort_by(|a, b| far(x, a.1).total_cmp(&far(x, b.1)));
+    let nearest = by_distance[0].1;
+    Side::Nearest {
+        cones: by_distance.iter().filter(|c| within(c.1, nearest)).map(|c| c.0).collect(),
+        level,
+        ratios,
     }
+}
+
+/// "1.002 times mortar's, 3.1 times nts's": the code's error over each cone's.
+fn ratios_text(ratios: &[(Method, f64)]) -> String {
+    let parts: Vec<String> = ratios.iter().map(|(m, r)| format!("{r:.3} times {m}'s")).collect();
+    parts.join(", ")
+}
+
+impl Side {
+    /// The table cell.
+    fn cell(&self) -> String {
+        match self {
+            Side::Unknown => "-".into(),
+            Side::MortarExact { code_exact: true, .. } => "mortar: exact, as mortar".into(),
+            Side::MortarExact { code_exact: false, ratios } => {
+                format!("not exact, unlike mortar ({})", ratios_text(ratios))
+            }
+            Side::Indistinct { level, ratios } => format!(
+                "cones within 5% of each other at level {level} ({})",
+                ratios_text(ratios)
+            ),
+            Side::Nearest { cones, level, ratios } => format!(
+                "{} ({} at level {level})",
+                names(cones),
+                ratios_text(ratios)
+            ),
+        }
+    }
+}
+
+/// "mortar", "mortar and lac".
+fn names(cones: &[Method]) -> String {
+    let v: Vec<String> = cones.iter().map(|m| m.to_string()).collect();
+    v.join(" and ")
 }
 
 /// Assemble the report of the grade reports under `grades` into `out`, all or nothing.
@@ -371,7 +414,7 @@ fn plot_problem(p: &Problem, d: &Path) -> Result<()> {
 fn readme(problems: &[Problem]) -> String {
     let mut doc = Doc::new();
     doc.heading(1, "What real contact codes converge at");
-    doc.paragraph(LEAD);
+    doc.paragraph(SETUP).list(lead(problems));
     let flagged: Vec<String> = problems
         .iter()
         .flat_map(|p| &p.checks)
@@ -393,7 +436,70 @@ fn readme(problems: &[Problem]) -> String {
     doc.finish()
 }
 
-const LEAD: &str = "Three solvers of other projects, on the problems `export` writes: GetFEM 5.4's integral (mortar-type) and nodal (node-on-segment) contact bricks, and Kratos 10.4's mortar contact by the augmented Lagrangian method. Each is read beside this project's mortar (K_h^pi) and node-on-segment (K_h^I) cones on the same meshes, by the same judge. Where the cones differ (`crossover`, whose interface stays closed, and the regularity family, beta = 0.6 to 2.0, singular at the transition) the node-on-segment brick sides with nts and the two mortar codes with mortar (the tables say by how much: Kratos's mortar is not this project's, and near the strongest singularities its distance to mortar is a visible fraction of mortar's error); on `rates-exact` the distance between the cones is a few percent of mortar's error at these levels, so no code can be told apart there, and its distance to mortar is `falling`: only `crossover` gives that distance an asymptotic rate.";
+/// The codes graded and how (the set-up, not a finding: the findings follow from the rows).
+const SETUP: &str = "Solvers of other projects, on the problems `export` writes: GetFEM 5.4's integral (mortar-type) and nodal (node-on-segment) contact bricks, and Kratos 10.4's mortar contact by the augmented Lagrangian method. Each is read beside this project's cones (mortar K_h^pi, nts K_h^I and lac, the local average contact) on the same meshes, by the same judge.";
+
+/// The lead, from the rows: per problem which cone each code sides with at its finest level
+/// (or that the cones cannot be told apart there), and where a distance to mortar has a
+/// rate the judge supports.
+fn lead(problems: &[Problem]) -> Vec<String> {
+    let mut out = Vec::new();
+    for p in problems {
+        let key = p.key();
+        let codes: Vec<MethodLabel> = p.methods().into_iter().filter(|m| m.cone().is_none()).collect();
+        let sides: Vec<(MethodLabel, Side)> = codes.iter().map(|c| (c.clone(), side(p, c))).collect();
+        let line = match sides.first().map(|s| &s.1) {
+            Some(Side::Indistinct { level, .. }) if sides.iter().all(|s| matches!(s.1, Side::Indistinct { .. })) => {
+                format!("`{}` ({key}): the cones are within 5% of each other at level {level}, so no code can be told apart there", p.study)
+            }
+            _ => {
+                let parts: Vec<String> = sides
+                    .iter()
+                    .map(|(c, s)| match s {
+                        Side::Nearest { cones, level, ratios } => format!(
+                            "{c} sides with {} at level {level} ({})",
+                            names(cones),
+                            ratios_text(ratios)
+                        ),
+                        other => format!("{c}: {}", other.cell()),
+                    })
+                    .collect();
+                format!("`{}` ({key}): {}", p.study, parts.join("; "))
+            }
+        };
+        out.push(line);
+    }
+    let mut supported = Vec::new();
+    for p in problems {
+        let Some(distance) = crate::verify::judge::DECOMPOSED
+            .iter()
+            .find(|(q, _)| *q == p.key())
+            .map(|(_, d)| *d)
+        else {
+            continue;
+        };
+        let rated: Vec<String> = p
+            .methods()
+            .iter()
+            .filter_map(|m| {
+                let r = p.rate(m, distance)?;
+                let (rate, se) = (r.rate?, r.stderr?);
+                (r.verdict == Verdict::Fitted).then(|| format!("{m} {rate:.3} ± {se:.3}"))
+            })
+            .collect();
+        if !rated.is_empty() {
+            supported.push(format!("`{}` ({})", p.study, rated.join(", ")));
+        }
+    }
+    out.push(match supported.is_empty() {
+        true => "No distance to mortar in the key quantity has a rate the judge supports on these levels.".into(),
+        false => format!(
+            "The distance to mortar in the key quantity has a rate the judge supports (fitted) in {}; nowhere else on these levels (rates.csv, `cone_distance`, `cone_distance_l2_stress` for patch).",
+            supported.join("; ")
+        ),
+    });
+    out
+}
 
 fn section(doc: &mut Doc, p: &Problem) {
     let key = p.key();
@@ -446,7 +552,7 @@ fn section(doc: &mut Doc, p: &Problem) {
                 .map_or("-".into(), |r| format!("{:.4e}", r.error)),
             match m.cone() {
                 Some(_) => "-".into(),
-                None => sides_with(p, &m),
+                None => side(p, &m).cell(),
             },
             pressure,
             match mortar_exact {

@@ -95,6 +95,11 @@ impl BodyMesh {
         })
     }
 
+    /// This body's node index of the raw mesh's node `raw`, where the node is this body's.
+    pub fn local(&self, raw: usize) -> Option<usize> {
+        self.local_of_raw.get(raw).copied().filter(|&l| l != ABSENT)
+    }
+
     /// Edges (pairs of body node indices) of the physical curve `curve` that lie on this
     /// body; empty when the curve belongs to the other body.
     pub fn curve_edges(&self, raw: &RawMesh, curve: &str) -> Vec<[usize; 2]> {

@@ -64,6 +64,9 @@ pub struct RawMesh {
     pub lines: Vec<([usize; 2], i32)>,
     /// Physical names by (dimension, tag).
     pub physical_names: HashMap<(usize, i32), String>,
+    /// The nodes of the geometry's points (gmsh's node blocks of dimension 0): the ends and
+    /// the named points of the curves, nodes of every level (LAC's macro-elements end there).
+    pub points: Vec<usize>,
 }
 
 impl RawMesh {
@@ -118,6 +121,8 @@ impl RawMesh {
                     out.lines.push((l.map(|n| n + offset), *p));
                 }
             }
+            out.points
+                .extend(raw.points.iter().filter(|&&n| on_body[n]).map(|n| n + offset));
         }
         out
     }

@@ -151,7 +151,7 @@ fn read_nodes(
     let _max = c.count("the largest node tag")?;
     mesh.nodes.reserve(nnodes);
     for _ in 0..nblocks {
-        let _dim = c.count("a node block's dimension")?;
+        let dim = c.count("a node block's dimension")?;
         let _etag = c.int::<i32>("a node block's entity")?;
         let parametric = c.count("a node block's parametric flag")?;
         let n = c.count("a node block's size")?;
@@ -170,6 +170,9 @@ fn read_nodes(
             }
             if node_index.insert(tag, mesh.nodes.len()).is_some() {
                 return Err(c.err(format!("node tag {tag} appears twice")));
+            }
+            if dim == 0 {
+                mesh.points.push(mesh.nodes.len());
             }
             mesh.nodes.push([x, y]);
         }

@@ -102,7 +102,7 @@ pub const UNALIGNED_KIND: Kind = Kind {
     shards: false,
     run: |_, _| Ok(Some(Box::new(run(&UNALIGNED)?))),
     rejudge: Some(|_, dir| Ok(Box::new(rejudge(&UNALIGNED, dir)?))),
-    results: None,
+    results: Some(results::unaligned_section),
 };
 
 /// The kind `study regularity-graded`.
@@ -113,7 +113,7 @@ pub const GRADED_KIND: Kind = Kind {
     shards: false,
     run: |_, _| Ok(Some(Box::new(run(&GRADED)?))),
     rejudge: Some(|_, dir| Ok(Box::new(rejudge(&GRADED, dir)?))),
-    results: None,
+    results: Some(results::graded_section),
 };
 
 /// The betas of the aligned study.

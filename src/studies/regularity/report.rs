@@ -30,7 +30,7 @@ const QUANTITIES: [Quantity; 5] = [
 
 /// How far below its best rate a fitted rate may lie and still follow it: the tolerance of
 /// the studies' thresholds, or two standard errors where larger.
-const FOLLOW_TOLERANCE: f64 = 0.05;
+pub(crate) const FOLLOW_TOLERANCE: f64 = 0.05;
 
 /// One row of errors.csv.
 #[derive(Debug, Serialize)]

@@ -12,8 +12,23 @@ use std::path::Path;
 
 /// The regularity study's section of docs/results.md.
 pub fn section(reports: &Path) -> Result<String> {
+    family_section(reports, "regularity", "rates against the regularity beta of the contact transition (u ~ r^beta there)")
+}
+
+/// regularity-unaligned's section of docs/results.md.
+pub fn unaligned_section(reports: &Path) -> Result<String> {
+    family_section(reports, "regularity-unaligned", "the regularity family with the transition point off the nodes of both meshes, levels 0-7")
+}
+
+/// regularity-graded's section of docs/results.md.
+pub fn graded_section(reports: &Path) -> Result<String> {
+    family_section(reports, "regularity-graded", "the regularity family for beta < 1 on meshes graded toward the transition point (remeshed levels)")
+}
+
+/// One regularity family's section, from its report reports/`name`.
+fn family_section(reports: &Path, name: &str, what: &str) -> Result<String> {
     let mut doc = Doc::new();
-    regularity_section(&mut doc, reports)?;
+    regularity_section(&mut doc, reports, name, what)?;
     Ok(doc.finish())
 }
 
@@ -86,17 +101,22 @@ fn regularity_headline(rows: &[RegularityRate]) -> String {
     )
 }
 
-/// The regularity study: its rate table, beta x cone x quantity, with verdicts.
-fn regularity_section(doc: &mut Doc, reports: &Path) -> Result<()> {
-    let rows: Vec<RegularityRate> = read(&reports.join("regularity").join("rates.csv"))?;
-    doc.heading(
-        2,
-        format!("[`regularity`]({DOCS_REPORTS}/regularity/README.md): rates against the regularity beta of the contact transition (u ~ r^beta there)"),
-    )
-    .bullet(regularity_headline(&rows).replace("(reports/", &format!("({DOCS_REPORTS}/")))
-    .bullet("Theorem 3.1 applies only for beta > 1 (u in H^2, f in L2); † marks the betas where it does not. A rate is shown where its verdict supports one, with \"follows\" where it reaches the best rate within 0.05 (or two standard errors).")
+/// A regularity family: its rate table, beta x quantity x method, with verdicts.
+fn regularity_section(doc: &mut Doc, reports: &Path, name: &str, what: &str) -> Result<()> {
+    let rows: Vec<RegularityRate> = read(&reports.join(name).join("rates.csv"))?;
+    doc.heading(2, format!("[`{name}`]({DOCS_REPORTS}/{name}/README.md): {what}"));
+    if name == "regularity" {
+        doc.bullet(regularity_headline(&rows).replace("(reports/", &format!("({DOCS_REPORTS}/")));
+    }
+    doc.bullet(format!(
+        "Theorem 3.1 applies only for beta > 1 (u in H^2, f in L2); † marks the betas where it does not. A rate is shown where its verdict supports one, with \"follows\" where the fit and the last judged rate both reach the best rate within {} (or two standard errors of the fit): the threshold rule's min(fit, last judged rate).",
+        super::report::FOLLOW_TOLERANCE
+    ))
     .blank();
-    let mut table = Table::new(["beta", "quantity", "best rate", "mortar", "nts"]);
+    let methods = crate::verify::table::methods_in_order(rows.iter().map(|r| &r.method));
+    let mut header = vec!["beta".to_string(), "quantity".into(), "best rate".into()];
+    header.extend(methods.iter().map(|m| m.to_string()));
+    let mut table = Table::new(header);
     let mut keys: Vec<(f64, Quantity)> = Vec::new();
     for r in &rows {
         if !keys.contains(&(r.beta, r.quantity)) {
@@ -104,9 +124,9 @@ fn regularity_section(doc: &mut Doc, reports: &Path) -> Result<()> {
         }
     }
     for (beta, q) in keys {
-        let of = |m: Method| {
+        let of = |m: &crate::verify::table::MethodLabel| {
             rows.iter()
-                .find(|r| r.beta == beta && r.quantity == q && r.method == m)
+                .find(|r| r.beta == beta && r.quantity == q && &r.method == m)
         };
         let text = |r: Option<&RegularityRate>| match r {
             Some(r) => match (r.rate, r.stderr) {
@@ -125,15 +145,14 @@ fn regularity_section(doc: &mut Doc, reports: &Path) -> Result<()> {
         };
         // From any row of this beta: cone_distance has an nts row only.
         let applies = rows.iter().any(|r| r.beta == beta && r.theorem_applies);
-        table.row([
-            format!("{beta}{}", if applies { "" } else { " †" }),
-            format!("`{q}`"),
-            of(Method::Mortar)
-                .and_then(|r| r.best_rate)
-                .map_or("-".into(), |b| format!("{b:.2}")),
-            text(of(Method::Mortar)),
-            text(of(Method::Nts)),
-        ]);
+        let best = rows
+            .iter()
+            .find(|r| r.beta == beta && r.quantity == q)
+            .and_then(|r| r.best_rate)
+            .map_or("-".into(), |b| format!("{b:.2}"));
+        let mut cells = vec![format!("{beta}{}", if applies { "" } else { " †" }), format!("`{q}`"), best];
+        cells.extend(methods.iter().map(|m| text(of(m))));
+        table.row(cells);
     }
     doc.table(&table);
     Ok(())

@@ -197,8 +197,28 @@ pub struct StabilityRow {
         deserialize_with = "crate::io::empty_as_nan"
     )]
     pub max_penetration: f64,
+    /// Largest displacement component max_i |u_i| over the history (length units; blank if
+    /// not converged): the penetration's scale.
+    #[serde(
+        serialize_with = "crate::io::finite_or_empty",
+        deserialize_with = "crate::io::empty_as_nan",
+        default = "nan"
+    )]
+    pub max_displacement: f64,
+    /// The limit-load check at the final time ([`crate::metrics::limit_load_ratio`]): above
+    /// 1 the load is past the limit load (blank for an elastic scene).
+    #[serde(
+        serialize_with = "crate::io::finite_or_empty",
+        deserialize_with = "crate::io::empty_as_nan",
+        default = "nan"
+    )]
+    pub limit_load_ratio: f64,
     /// Wall time (s).
     pub wall_s: f64,
+}
+
+fn nan() -> f64 {
+    f64::NAN
 }
 
 /// What `study stability` measured.
@@ -564,6 +584,9 @@ fn run_variant(var: &Variant, method: Method) -> Result<Vec<StabilityRow>> {
         mean_step_iterations: 0.0,
         error: f64::NAN,
         max_penetration: f64::NAN,
+        max_displacement: f64::NAN,
+        limit_load_ratio: crate::metrics::limit_load_ratio(&case.problem.model, var.scene.final_time)
+            .unwrap_or(f64::NAN),
         wall_s,
     };
     let mut newton: Option<Solution> = None;
@@ -593,6 +616,11 @@ fn run_variant(var: &Variant, method: Method) -> Result<Vec<StabilityRow>> {
                     mean_step_iterations: sol.iterations() as f64 / sol.reports.len().max(1) as f64,
                     error,
                     max_penetration: max_penetration(&case, &sol),
+                    max_displacement: sol
+                        .states
+                        .iter()
+                        .map(|s| crate::solve::inf_norm(&s.u))
+                        .fold(0.0, f64::max),
                     ..row(*kind, wall_s)
                 });
                 if *kind == SolverKind::Newton {

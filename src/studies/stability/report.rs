@@ -8,7 +8,7 @@ use crate::report::folder::{write, write_folder};
 use crate::report::markdown::{Doc, Table};
 use crate::report::plot::{self, Series};
 use crate::solve::SolverKind;
-use crate::studies::stability::{HardCase, StabilityResult};
+use crate::studies::stability::{HardCase, StabilityResult, StabilityRow};
 use std::fmt::Write as _;
 use std::path::Path;
 use crate::verify::kind::Outcome;
@@ -167,6 +167,7 @@ fn hard_case(doc: &mut Doc, res: &StabilityResult, case: HardCase, d: &Path) {
             doc.image("error", &format!("{file}_error.png"));
         }
     }
+    overloaded(doc, res, case);
     let mut table = Table::new([
         "parameter",
         "method",
@@ -174,7 +175,7 @@ fn hard_case(doc: &mut Doc, res: &StabilityResult, case: HardCase, d: &Path) {
         "converged",
         "max / mean iterations per step",
         "error",
-        "max penetration",
+        "max penetration (over max |u|)",
         "wall (s)",
         "reason",
     ]);
@@ -193,12 +194,50 @@ fn hard_case(doc: &mut Doc, res: &StabilityResult, case: HardCase, d: &Path) {
             if r.converged { "yes" } else { "**no**" }.to_string(),
             format!("{} / {:.1}", r.max_step_iterations, r.mean_step_iterations),
             finite(r.error),
-            finite(r.max_penetration),
+            match (r.max_penetration.is_finite(), r.max_displacement > 0.0) {
+                (true, true) => format!("{} ({:.2e})", finite(r.max_penetration), r.max_penetration / r.max_displacement),
+                _ => finite(r.max_penetration),
+            },
             format!("{:.3}", r.wall_s),
             r.reason.replace('|', "/"),
         ]);
     }
     doc.table(&table);
+}
+
+/// The case's runs loaded past their limit load, named with the check's ratio and newton's
+/// largest displacement by parameter: there Perzyna's flow never relaxes, and what the
+/// runs measure is a flow that grows like t / lambda, not an equilibrium.
+fn overloaded(doc: &mut Doc, res: &StabilityResult, case: HardCase) {
+    let rows: Vec<&StabilityRow> = res.rows.iter().filter(|r| r.case == case).collect();
+    let over: Vec<&&StabilityRow> = rows.iter().filter(|r| r.limit_load_ratio > 1.0).collect();
+    let Some(worst) = over.iter().map(|r| r.limit_load_ratio).reduce(f64::max) else {
+        return;
+    };
+    let mut parameters: Vec<&str> = Vec::new();
+    for r in &over {
+        if !parameters.contains(&r.parameter.as_str()) {
+            parameters.push(&r.parameter);
+        }
+    }
+    let growth: Vec<String> = crate::contact::Method::ALL
+        .iter()
+        .filter_map(|&m| {
+            let u: Vec<String> = rows
+                .iter()
+                .filter(|r| r.method == m && r.solver == crate::solve::SolverKind::Newton && r.max_displacement.is_finite())
+                .map(|r| format!("{:.2e}", r.max_displacement))
+                .collect();
+            (!u.is_empty()).then(|| format!("{m} {}", u.join(", ")))
+        })
+        .collect();
+    doc.paragraph(format!(
+        "**Loaded past its limit load** ({} of {} runs: {}). The limit-load check: the least plane-stress von Mises stress of any stress state that carries the given traction on its edge, sqrt(3/4 t_n^2 + 3 t_t^2), reaches {worst:.2} times the yield stress at the final time. No stress field inside the yield surface carries such a load, so the rate-independent problem has no solution and Perzyna's flow never relaxes: the plastic strain grows like t / lambda, and the displacements and penetrations grow with k E / lambda once the viscosity no longer holds them. Newton's largest displacement max |u_i| by parameter: {}.",
+        over.len(),
+        rows.len(),
+        parameters.join(", "),
+        growth.join("; ")
+    ));
 }
 
 /// What `study stability` prints: one line per run, and where the report went.
