@@ -145,11 +145,15 @@ pub fn least_von_mises_for_traction(normal: f64, tangential: f64) -> f64 {
 /// None where no given traction acts on a viscoplastic body.
 pub fn limit_load_ratio(model: &crate::fe::Model, t: f64) -> Option<f64> {
     let mut worst: Option<f64> = None;
-    for (&(i, [a, b]), &(body, n)) in model.traction_edges.iter().zip(&model.traction_normals) {
+    for &(i, [a, b]) in &model.traction_edges {
+        let body = usize::from(a >= model.node_offset[1]);
         let (Some(g), Some(vp)) = (&model.scene.tractions[i].g, model.materials[body].viscoplastic) else {
             continue;
         };
         let (pa, pb) = (model.position(a), model.position(b));
+        // A unit normal of the edge: its sign does not matter (t_n enters squared).
+        let length = (pb[0] - pa[0]).hypot(pb[1] - pa[1]);
+        let n = [(pb[1] - pa[1]) / length, -(pb[0] - pa[0]) / length];
         let mid = [0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1])];
         for p in [pa, mid, pb] {
             let gx = g.0[0].eval(p[0], p[1], t);

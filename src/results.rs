@@ -31,6 +31,7 @@ pub fn section(reports: &Path) -> Result<String> {
             page.push_str(&results(reports)?);
         }
     }
+    page.push_str(&crate::external::codes::results_section(reports)?);
     page.push_str(&run_times(reports)?);
     Ok(page)
 }
@@ -138,8 +139,15 @@ pub fn headline(reports: &Path) -> Result<String> {
     doc.bullet(format!(
         "**Does not converge:** {}.",
         listed(&stalled_anywhere(&studies), "; ", "nothing")
-    ))
-    .blank();
+    ));
+    let fixed = fixed_anywhere(&studies);
+    if !fixed.is_empty() {
+        doc.bullet(format!(
+            "**Fixed at a node** (the same error on the last levels: a position every level keeps, bounded by the rows' resolution; each README prints the bound): {}.",
+            fixed.join("; ")
+        ));
+    }
+    doc.blank();
     let mut table = Table::new([
         "study: scene, measured against".to_string(),
         "where the cones differ: contact quantities at the finest level, nts's error / mortar's (rates)".to_string(),
@@ -244,6 +252,24 @@ fn stalled_anywhere(studies: &[(&str, &str, Report)]) -> Vec<String> {
         }
     }
     stalled
+        .iter()
+        .map(|(k, names)| format!("{k} (in {})", names.join(", ")))
+        .collect()
+}
+
+/// Each (method, quantity) fixed at a node, with the studies where it is.
+fn fixed_anywhere(studies: &[(&str, &str, Report)]) -> Vec<String> {
+    let mut fixed: Vec<(String, Vec<&str>)> = Vec::new();
+    for (name, _, report) in studies {
+        for r in report.rates.iter().filter(|r| r.verdict == Verdict::Fixed) {
+            let key = format!("{} `{}`", r.method, r.quantity);
+            match fixed.iter_mut().find(|(k, _)| *k == key) {
+                Some((_, names)) => names.push(name),
+                None => fixed.push((key, vec![name])),
+            }
+        }
+    }
+    fixed
         .iter()
         .map(|(k, names)| format!("{k} (in {})", names.join(", ")))
         .collect()

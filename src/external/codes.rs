@@ -577,3 +577,43 @@ fn section(doc: &mut Doc, p: &Problem) {
         &format!("error_vs_h_{}.png", p.study),
     );
 }
+
+/// The codes report's part of docs/results.md, from reports/codes/rates.csv: per problem,
+/// what each method's key error supports (the theorem norm, l2_stress where no
+/// displacement is graded), in a few characters ([`short_text`]).
+pub fn results_section(reports: &Path) -> Result<String> {
+    let path = reports.join("codes").join("rates.csv");
+    let rates: Vec<CodeRate> = read(&path)?;
+    let methods = methods_in_order(rates.iter().map(|r| &r.method));
+    let mut studies: Vec<&str> = Vec::new();
+    for r in &rates {
+        if !studies.contains(&r.study.as_str()) {
+            studies.push(&r.study);
+        }
+    }
+    let mut doc = Doc::new();
+    doc.heading(
+        2,
+        format!("[`codes`]({}/codes/README.md): GetFEM and Kratos graded beside the cones on the exported problems", crate::report::markdown::DOCS_REPORTS),
+    )
+    .paragraph("Each problem's key error (Theorem 3.1's norm; `l2_stress` on patch, whose exact solution has no displacement) judged for each code and each cone on the same meshes (reports/codes/rates.csv, column `reads`); the codes report leads with which cone each code sides with.");
+    let mut header = vec!["problem".to_string(), "quantity".to_string()];
+    header.extend(methods.iter().map(|m| m.to_string()));
+    let mut table = Table::new(header);
+    for study in studies {
+        let key = match rates.iter().any(|r| r.study == study && r.quantity == Quantity::Theorem) {
+            true => Quantity::Theorem,
+            false => Quantity::L2Stress,
+        };
+        let mut row = vec![format!("`{study}`"), format!("`{key}`")];
+        row.extend(methods.iter().map(|m| {
+            rates
+                .iter()
+                .find(|r| r.study == study && &r.method == m && r.quantity == key)
+                .map_or("-".into(), |r| r.reads.clone())
+        }));
+        table.row(row);
+    }
+    doc.table(&table);
+    Ok(doc.finish())
+}

@@ -74,6 +74,12 @@ pub fn relative_to(value: f64, size: f64, theorem: f64) -> Option<f64> {
     (size > 0.0 && size >= MIN_REFERENCE_SIZE * theorem).then(|| value / size)
 }
 
+/// Errors of the last [`MIN_FIT_LEVELS`] usable levels within this relative spread of each
+/// other are one value: `fixed` (a position the levels share, not a discretization error
+/// that stalls). 1e-9: the solvers' tolerance 1e-10 with a margin; a stalling error moves
+/// by far more (nts's l2_pressure by 1e-3 and beyond between levels).
+pub const FIXED_SPREAD: f64 = 1e-9;
+
 /// A fitted rate within this many standard errors of 0 is no rate: the errors are `not
 /// converging` (unaligned beta = 1.5, nts `l2_pressure`: 0.021 ± 0.013 over levels 5-7).
 /// A steady small rate measured to more than two standard errors stays fitted.
@@ -128,6 +134,11 @@ pub enum Verdict {
     NotConverging,
     /// Every level's error is at round-off ([`ROUNDOFF`]): the discretization is exact.
     RoundOff,
+    /// The error is the same to [`FIXED_SPREAD`] on the last [`MIN_FIT_LEVELS`] usable
+    /// levels while h falls: a discrete position that every level keeps (lac's contact edge
+    /// at the macro-element end nearest the exact edge, a node of every level), bounded by
+    /// the resolution of the rows, not a rate and not a stall of the discretization.
+    Fixed,
     /// The quantity is fixed by equilibrium (the contact resultant of a body held normal to
     /// Gamma_C only by the contact, computed by this project's cones): it measures the
     /// load's quadrature, not the cones, and is never fitted. Set by the study, never by
@@ -137,7 +148,7 @@ pub enum Verdict {
 
 impl Verdict {
     /// Every verdict, in the order of the rules.
-    pub const ALL: [Verdict; 8] = [
+    pub const ALL: [Verdict; 9] = [
         Verdict::Fitted,
         Verdict::Falling,
         Verdict::Rising,
@@ -145,6 +156,7 @@ impl Verdict {
         Verdict::TooFewLevels,
         Verdict::NotConverging,
         Verdict::RoundOff,
+        Verdict::Fixed,
         Verdict::FixedByEquilibrium,
     ];
 
@@ -158,6 +170,7 @@ impl Verdict {
             Verdict::TooFewLevels => "too few levels",
             Verdict::NotConverging => "not converging",
             Verdict::RoundOff => "round-off",
+            Verdict::Fixed => "fixed at a node",
             Verdict::FixedByEquilibrium => "fixed by equilibrium",
         }
     }
@@ -427,6 +440,13 @@ pub fn assess(levels: &[LevelError], truth_error: f64) -> Result<Assessment, Equ
         return Ok(out);
     }
     out.judged = judged_rates(&usable);
+    if let Some(last) = usable.get(usable.len().wrapping_sub(MIN_FIT_LEVELS)..) {
+        let (lo, hi) = last.iter().fold((f64::INFINITY, 0.0f64), |(a, b), e| (a.min(e.error), b.max(e.error)));
+        if usable.len() >= MIN_FIT_LEVELS && hi <= lo * (1.0 + FIXED_SPREAD) {
+            out.verdict = Verdict::Fixed;
+            return Ok(out);
+        }
+    }
     let rates: Vec<f64> = out.judged.iter().map(|r| r.rate).collect();
     let last_two = &rates[rates.len().saturating_sub(2)..];
     // The last two judged rates together (their mean: the rate across the last three
@@ -830,6 +850,9 @@ impl Assessment {
             }
             (Verdict::RoundOff, _) => format!("exact (round-off, <= {ROUNDOFF:.0e})"),
             (Verdict::NotConverging, _) => "**does not converge**".into(),
+            (Verdict::Fixed, _) => format!(
+                "fixed at a node (the same error to {FIXED_SPREAD:.0e} on the last {MIN_FIT_LEVELS} levels: a position every level keeps, not a rate)"
+            ),
             (Verdict::TooFewLevels, _) => format!("no fit (< {MIN_FIT_LEVELS} levels)"),
             (Verdict::FixedByEquilibrium, _) => {
                 "fixed by equilibrium: measures the load quadrature".into()

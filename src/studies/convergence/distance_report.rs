@@ -169,14 +169,22 @@ pub fn lead(doc: &mut Doc, res: &StudyResult) {
             finest.join(", ")
         ),
         format!(
-            "Theorem norm: mortar {}; nts {}.",
-            describe(Method::Mortar, Quantity::Theorem),
-            describe(Method::Nts, Quantity::Theorem)
+            "Theorem norm: {}.",
+            res.file
+                .methods
+                .iter()
+                .map(|&m| format!("{m} {}", describe(m, Quantity::Theorem)))
+                .collect::<Vec<_>>()
+                .join("; ")
         ),
         format!(
-            "The interface separates: contact on a fraction {} (mortar) and {} (nts) of Gamma_C at the finest level (levels.csv).",
-            fraction(Method::Mortar),
-            fraction(Method::Nts)
+            "The interface separates: contact on a fraction {} of Gamma_C at the finest level (levels.csv).",
+            res.file
+                .methods
+                .iter()
+                .map(|&m| format!("{} ({m})", fraction(m)))
+                .collect::<Vec<_>>()
+                .join(", ")
         ),
     ];
     if let Ok((mine, yours)) = beside(res, other) {

@@ -101,6 +101,11 @@ pub struct LevelInfo {
     pub plastic_fraction: f64,
     /// Whether the level was left out of the fits (error within 5x of the reference's).
     pub flagged: bool,
+    /// The largest part of Gamma_C one row resolves, relative to |Gamma_C|: a macro-element
+    /// for lac, a body-1 segment for the nodal rows (the bound of a contact edge fixed at a
+    /// row's end). Empty in reports written before it was measured.
+    #[serde(default)]
+    pub resolution: Option<f64>,
 }
 
 /// Which solution a profile point belongs to.
@@ -718,7 +723,28 @@ fn level_info(case: &Case, sol: &Solution, method: Method, flagged: bool) -> Lev
         contact_fraction: metrics::contact_fraction(&case.problem, last),
         plastic_fraction: metrics::plastic_fraction(&case.problem, last),
         flagged,
+        resolution: Some(resolution(&case.problem)),
     }
+}
+
+/// [`LevelInfo::resolution`]: the largest body-1 interval between the ends of one row's
+/// span (a macro-element) or between neighbouring nodes, over |Gamma_C|.
+fn resolution(p: &crate::solve::Problem) -> f64 {
+    let pieces = &p.interface.pieces;
+    let total: f64 = pieces.iter().map(|x| x.length).sum();
+    let segment = pieces
+        .iter()
+        .flat_map(|x| x.slave_s.windows(2).map(|w| w[1] - w[0]))
+        .fold(0.0f64, f64::max);
+    let span = p
+        .rows
+        .iter()
+        .map(|r| {
+            let s = &pieces[r.piece].slave_s;
+            (s[r.span[1]] - s[r.span[0]]).abs()
+        })
+        .fold(0.0f64, f64::max);
+    segment.max(span) / total
 }
 
 /// Pressure at the body-1 trace nodes and gap -[u.nu] at both bodies' trace nodes, at T.

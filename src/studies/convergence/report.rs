@@ -507,11 +507,54 @@ fn cones_compared(doc: &mut Doc, res: &StudyResult) {
             left_out.join(", ")
         ));
     }
+    fixed_at_a_node(doc, res);
     if [Method::Mortar, Method::Nts].iter().all(|m| res.file.methods.contains(m)) {
         doc.list(quantities.iter().filter_map(|&q| {
             let sentence = cones_sentence(res, q)?;
             Some(format!("{q}: {sentence} at level {finest}."))
         }));
+    }
+}
+
+/// The quantities whose error is fixed at a node (the same on the last levels), each with
+/// its value and the bound the rows' resolution gives it at the finest level (levels.csv
+/// `resolution`: the largest macro-element for lac, the largest body-1 segment for the
+/// nodal rows, over |Gamma_C|), and whether the error lies within it.
+fn fixed_at_a_node(doc: &mut Doc, res: &StudyResult) {
+    let finest = finest_level(res);
+    let lines: Vec<String> = res
+        .rates
+        .iter()
+        .filter(|r| r.assessment.verdict == crate::verify::rates::Verdict::Fixed)
+        .filter_map(|r| {
+            let m = r.method.cone()?;
+            let e = res.error(m, finest, r.quantity)?;
+            let bound = res
+                .levels
+                .iter()
+                .find(|l| l.method == m && l.level == finest)
+                .and_then(|l| l.resolution);
+            let levels = crate::verify::table::join(
+                &res.errors
+                    .iter()
+                    .filter(|x| x.method == m && x.quantity == r.quantity && (x.error - e).abs() <= crate::verify::rates::FIXED_SPREAD * e)
+                    .map(|x| x.level)
+                    .collect::<Vec<_>>(),
+            );
+            Some(match bound {
+                Some(b) => format!(
+                    "{m} `{}`: {e:.4e} on levels {levels}, {} the rows' resolution at level {finest} ({b:.4e} of |Gamma_C|: {}): a position every level keeps, which falls only once the rows resolve finer than it",
+                    r.quantity,
+                    if e <= b { "within" } else { "**beyond**" },
+                    if m == Method::Lac { "the largest macro-element" } else { "the largest body-1 segment" }
+                ),
+                None => format!("{m} `{}`: {e:.4e} on levels {levels}", r.quantity),
+            })
+        })
+        .collect();
+    if !lines.is_empty() {
+        doc.paragraph("Fixed at a node (the same error to 1e-9 on the last levels: not a rate, and not a discretization error that stalls):")
+            .list(lines);
     }
 }
 
@@ -598,8 +641,17 @@ fn cones_sentence(res: &StudyResult, q: Quantity) -> Option<String> {
     })
 }
 
-/// How the rates are judged, above the table of rates.
-const RATES_TEXT: &str = "Least-squares slope of log(error) against log(h) over the levels used (± standard error), rate against dofs, and successive rates between neighbouring levels, judged by the rules of docs/studies.md#rates. A rate never overstates: errors at round-off (<= 1e-10, the solvers' tolerance) are marked and never fitted (their successive rates are `-`), levels within 5x of the truth's own error in that quantity are left out, and a rate needs at least 3 levels. A quantity whose last two successive rates average at most 0.02, or whose last is negative, does not converge. Where the last three successive rates are strictly monotone and differ by more than 0.1 end to end, the rate is `falling` or `rising` (in transition): no rate is claimed, the last successive rate is given. Otherwise the levels used are the longest trailing window (at least 3 levels) whose successive rates lie within 0.1 of each other (`fitted`); without one the fit over every level is shown, flagged `pre-asymptotic`. Only `fitted` supports a rate. A threshold passes where the rate is fitted and both the fit and the last successive rate reach it, fails where the last successive rate is below it (for a falling rate, also its extrapolation to the finest level), and is `unverified` otherwise; only a failure makes the study exit non-zero. A contact resultant fixed by equilibrium is named so and never fitted. Beside the fit, the conventions of ASME V&V 20 (Celik et al. 2008, J. Fluids Eng. 130, 078001) on the last three levels: the observed order p (non-uniform ratio, fixed-point iteration), oscillatory convergence named, the GCI of the finest level (safety factor 1.25 at the observed order, in the units of the error) and the asymptotic ratio GCI_coarse / (r^p GCI_fine) at the rate in h printed (1 where that rate describes the last three levels; at the observed order it would be 1 by construction). The `theorem` quantity is max_n (||u - u_ref||_H1 + ||sigma - sigma_ref||_L2) over both bodies, relative to the reference's; Theorem 3.1 predicts h^(3/4) for mortar (K_h^pi) and h^(1/2) for nts (K_h^I); it does not cover lac (LAC), which the study files hold to mortar's h^(3/4), the order Drouet and Hild prove for it.";
+/// How the rates are judged, above the table of rates: the rules' constants read from
+/// verify::rates, so that the text cannot drift from the judge.
+fn rates_text() -> String {
+    use crate::verify::rates::{
+        GCI_SAFETY, MIN_FIT_LEVELS, MIN_RATE_SPAN, ROUNDOFF, STALLED, TREND, TRUTH_MARGIN,
+        WINDOW_SPREAD, ZERO_RATE_STDERRS,
+    };
+    format!(
+        "Least-squares slope of log(error) against log(h) over the levels used (± standard error), rate against dofs, and successive rates between neighbouring levels, judged by the rules of docs/studies.md#rates on the judged rates (between levels at least {MIN_RATE_SPAN}x apart in h: neighbours of a halving table). A rate never overstates: errors at round-off (<= {ROUNDOFF:.0e}, the solvers' tolerance) are marked and never fitted (their successive rates are `-`), levels within {TRUTH_MARGIN}x of the truth's own error in that quantity are left out, and a rate needs at least {MIN_FIT_LEVELS} levels. A quantity whose last two judged rates average at most {STALLED}, or whose last is negative, does not converge, and so does one whose fitted rate lies within {ZERO_RATE_STDERRS} standard errors of 0. Where the last three judged rates are strictly monotone and differ by more than {TREND} end to end, the rate is `falling` or `rising` (in transition): no rate is claimed, the last judged rate is given. Otherwise the levels used are the longest trailing window (at least {MIN_FIT_LEVELS} levels) whose judged rates lie within {WINDOW_SPREAD} of each other (`fitted`); without one the fit over every level is shown, flagged `pre-asymptotic`. Only `fitted` supports a rate. A threshold passes where the rate is fitted and both the fit and the last judged rate reach it, fails where the last judged rate is below it (for a falling rate, also its extrapolation to the finest level), and is `unverified` otherwise; only a failure makes the study exit non-zero. A contact resultant fixed by equilibrium is named so and never fitted. Beside the fit, the conventions of ASME V&V 20 (Celik et al. 2008, J. Fluids Eng. 130, 078001) on the last three levels: the observed order p (non-uniform ratio, fixed-point iteration), oscillatory convergence named, the GCI of the finest level (safety factor {GCI_SAFETY} at the observed order, in the units of the error) and the asymptotic ratio GCI_coarse / (r^p GCI_fine) at the rate in h printed (1 where that rate describes the last three levels; at the observed order it would be 1 by construction). The `theorem` quantity is max_n (||u - u_ref||_H1 + ||sigma - sigma_ref||_L2) over both bodies, relative to the reference's; Theorem 3.1 predicts h^(3/4) for mortar (K_h^pi) and h^(1/2) for nts (K_h^I); it does not cover lac (LAC), which the study files hold to mortar's h^(3/4), the order Drouet and Hild prove for it."
+    )
+}
 
 /// ## Rates: every cone and quantity's rate, with how it is judged.
 fn rates_table(doc: &mut Doc, res: &StudyResult) {
@@ -638,7 +690,7 @@ fn rates_table(doc: &mut Doc, res: &StudyResult) {
             }),
         ]);
     }
-    doc.heading(2, "Rates").paragraph(RATES_TEXT).table(&table);
+    doc.heading(2, "Rates").paragraph(rates_text()).table(&table);
 }
 
 /// ## Errors: per cone and level, the mesh, the errors that matter most and the solve.
