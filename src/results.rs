@@ -196,7 +196,7 @@ fn cones_differ(studies: &[(&str, &str, Report)]) -> String {
         )
     } else {
         format!(
-            "over the {} studies, {total} contact-quantity errors separate them (ratio beyond {SEPARATES}x at the finest level, among the quantities where both cones' verdicts support a comparison; the others are listed in docs/results.md), nts's the larger in {nts_larger}, by up to {widest:.0}x{exact}",
+            "over the {} studies, {total} contact-quantity errors separate them (ratio beyond {SEPARATES}x at the finest level, among the quantities where every method's verdict supports a comparison, the rule of each study's README; the others are listed in docs/results.md), nts's the larger in {nts_larger}, by up to {widest:.0}x{exact}",
             studies.len()
         )
     }

@@ -256,9 +256,9 @@ const INDISTINCT: f64 = 1.05;
 enum Side {
     /// The code or the cones lack the level.
     Unknown,
-    /// Mortar is exact there (the patch test): whether the code is too, and its error over
-    /// each inexact cone's.
-    MortarExact { code_exact: bool, ratios: Vec<(Method, f64)> },
+    /// Mortar is exact there (the patch test): the exact cones, whether the code is too, and
+    /// its error over each inexact cone's.
+    MortarExact { exact: Vec<Method>, code_exact: bool, ratios: Vec<(Method, f64)> },
     /// Every cone within [`INDISTINCT`] of the others.
     Indistinct { level: usize, ratios: Vec<(Method, f64)> },
     /// The cones nearest the code's error in ratio (the nearest and any within
@@ -292,6 +292,7 @@ fn side(p: &Problem, code: &MethodLabel) -> Side {
     let level = finest.level;
     if mortar <= EXACT {
         return Side::MortarExact {
+            exact: cones.iter().filter(|c| c.1 <= EXACT).map(|c| c.0).collect(),
             code_exact: x <= EXACT,
             ratios: cones.iter().filter(|c| c.1 > EXACT).map(|&(m, e)| (m, x / e)).collect(),
         };
@@ -314,7 +315,14 @@ fn side(p: &Problem, code: &MethodLabel) -> Side {
 
 /// "1.002 times mortar's, 3.1 times nts's": the code's error over each cone's.
 fn ratios_text(ratios: &[(Method, f64)]) -> String {
-    let parts: Vec<String> = ratios.iter().map(|(m, r)| format!("{r:.3} times {m}'s")).collect();
+    // Three decimals, or three digits where the ratio is small.
+    let parts: Vec<String> = ratios
+        .iter()
+        .map(|(m, r)| match *r < 0.01 {
+            true => format!("{r:.2e} times {m}'s"),
+            false => format!("{r:.3} times {m}'s"),
+        })
+        .collect();
     parts.join(", ")
 }
 
@@ -323,9 +331,9 @@ impl Side {
     fn cell(&self) -> String {
         match self {
             Side::Unknown => "-".into(),
-            Side::MortarExact { code_exact: true, .. } => "mortar: exact, as mortar".into(),
-            Side::MortarExact { code_exact: false, ratios } => {
-                format!("not exact, unlike mortar ({})", ratios_text(ratios))
+            Side::MortarExact { exact, code_exact: true, .. } => format!("exact, as {}", names(exact)),
+            Side::MortarExact { exact, code_exact: false, ratios } => {
+                format!("not exact, unlike {} ({})", names(exact), ratios_text(ratios))
             }
             Side::Indistinct { level, ratios } => format!(
                 "cones within 5% of each other at level {level} ({})",
