@@ -23,7 +23,7 @@ use std::path::Path;
 pub fn section(reports: &Path) -> Result<String> {
     let mut doc = Doc::new();
     doc.heading(1, "Results").paragraph(
-        "What the committed reports measured (`cargo run --release -- results` prints this page from their CSVs; a test fails when it no longer matches them). Rates are least-squares slopes in h over the levels named, with the verdict of [the rate rules](studies.md#rates) (fitted; falling or rising: in transition; pre-asymptotic, not converging, round-off, fixed by equilibrium). Only a fitted verdict supports a rate.",
+        "What the committed reports measured (`cargo run --release -- results` prints this page from their CSVs; a test fails when it no longer matches them). Rates are least-squares slopes in h over the levels named, with the verdict of [the rate rules](studies.md#rates) (fitted; falling or rising: in transition; pre-asymptotic, not converging, round-off, fixed at a node, fixed by equilibrium). Only a fitted verdict supports a rate.",
     );
     let mut page = doc.finish();
     for kind in KINDS {
@@ -241,35 +241,32 @@ fn theorem_rates(studies: &[(&str, &str, Report)], m: Method) -> String {
 
 /// Each (method, quantity) that does not converge, with the studies where it stalls.
 fn stalled_anywhere(studies: &[(&str, &str, Report)]) -> Vec<String> {
-    let mut stalled: Vec<(String, Vec<&str>)> = Vec::new();
-    for (name, _, report) in studies {
-        for r in report.stalled() {
-            let key = format!("{} `{}`", r.method, r.quantity);
-            match stalled.iter_mut().find(|(k, _)| *k == key) {
-                Some((_, names)) => names.push(name),
-                None => stalled.push((key, vec![name])),
-            }
-        }
-    }
-    stalled
-        .iter()
-        .map(|(k, names)| format!("{k} (in {})", names.join(", ")))
-        .collect()
+    by_study(studies, |report| report.stalled().collect())
 }
 
 /// Each (method, quantity) fixed at a node, with the studies where it is.
 fn fixed_anywhere(studies: &[(&str, &str, Report)]) -> Vec<String> {
-    let mut fixed: Vec<(String, Vec<&str>)> = Vec::new();
+    by_study(studies, |report| {
+        report.rates.iter().filter(|r| r.verdict == Verdict::Fixed).collect()
+    })
+}
+
+/// "method `quantity` (in study, study)" for each row `pick` takes from the studies.
+fn by_study<'a>(
+    studies: &'a [(&str, &str, Report)],
+    pick: impl Fn(&'a Report) -> Vec<&'a RateRecord>,
+) -> Vec<String> {
+    let mut found: Vec<(String, Vec<&str>)> = Vec::new();
     for (name, _, report) in studies {
-        for r in report.rates.iter().filter(|r| r.verdict == Verdict::Fixed) {
+        for r in pick(report) {
             let key = format!("{} `{}`", r.method, r.quantity);
-            match fixed.iter_mut().find(|(k, _)| *k == key) {
+            match found.iter_mut().find(|(k, _)| *k == key) {
                 Some((_, names)) => names.push(name),
-                None => fixed.push((key, vec![name])),
+                None => found.push((key, vec![name])),
             }
         }
     }
-    fixed
+    found
         .iter()
         .map(|(k, names)| format!("{k} (in {})", names.join(", ")))
         .collect()

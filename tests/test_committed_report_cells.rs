@@ -55,26 +55,24 @@ fn tables(md: &str) -> Vec<MdTable> {
     out
 }
 
-fn readmes(dir: &Path, out: &mut Vec<PathBuf>) {
+/// Every file below `dir` that `keep` takes, recursively.
+fn files(dir: &Path, keep: &dyn Fn(&Path) -> bool, out: &mut Vec<PathBuf>) {
     for entry in std::fs::read_dir(dir).expect("reports/ is readable") {
         let path = entry.expect("an entry").path();
         if path.is_dir() {
-            readmes(&path, out);
-        } else if path.file_name().is_some_and(|n| n == "README.md") {
+            files(&path, keep, out);
+        } else if keep(&path) {
             out.push(path);
         }
     }
 }
 
+fn readmes(dir: &Path, out: &mut Vec<PathBuf>) {
+    files(dir, &|p| p.file_name().is_some_and(|n| n == "README.md"), out);
+}
+
 fn csv_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    for entry in std::fs::read_dir(dir).expect("reports/ is readable") {
-        let path = entry.expect("an entry").path();
-        if path.is_dir() {
-            csv_files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "csv") {
-            out.push(path);
-        }
-    }
+    files(dir, &|p| p.extension().is_some_and(|e| e == "csv"), out);
 }
 
 fn reports() -> PathBuf {
@@ -146,6 +144,7 @@ fn expected_rate_cell(row: &BTreeMap<String, String>) -> String {
         "not converging" => "does not converge".into(),
         "too few levels" => "no fit".into(),
         "fixed by equilibrium" => "fixed by equilibrium".into(),
+        "fixed at a node" => "fixed at a node".into(),
         v => panic!("unknown verdict {v}"),
     }
 }

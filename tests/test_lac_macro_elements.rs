@@ -156,25 +156,8 @@ fn lac_rows_on_split_levels_are_the_parent_segments() {
 fn macro_elements_do_not_depend_on_the_direction_of_a_piece() {
     let s = vec![0.0, 0.15, 0.35, 0.5, 0.7, 1.0];
     let m = vec![0.0, 0.3, 0.55, 1.0];
-    let forward = Piece {
-        a: [0.0, 1.0],
-        tangent: [1.0, 0.0],
-        length: 1.0,
-        normal: [0.0, 1.0],
-        slave_nodes: (0..6).collect(),
-        slave_s: s.clone(),
-        master_nodes: (0..4).collect(),
-        master_s: m.clone(),
-        breaks: Vec::new(),
-    };
-    let mirror = |v: &Vec<f64>| v.iter().rev().map(|x| 1.0 - x).collect::<Vec<f64>>();
-    let backward = Piece {
-        a: [1.0, 1.0],
-        tangent: [-1.0, 0.0],
-        slave_s: mirror(&s),
-        master_s: mirror(&m),
-        ..forward.clone()
-    };
+    let forward = piece_along_y1(&s, &m, Vec::new());
+    let backward = mirrored(&forward, Vec::new());
     let intervals = |p: &Piece| {
         let mut v: Vec<(f64, f64, f64)> = p
             .macro_averages()
@@ -237,26 +220,8 @@ fn macro_elements_end_at_the_geometry_points_of_a_piece() {
     // The same piece and break, run forward and backward, gives the same macro-elements.
     let s = vec![0.0, 0.1, 0.25, 0.4, 0.5, 0.7, 0.85, 1.0];
     let m = vec![0.0, 0.3, 0.55, 1.0];
-    let forward = Piece {
-        a: [0.0, 1.0],
-        tangent: [1.0, 0.0],
-        length: 1.0,
-        normal: [0.0, 1.0],
-        slave_nodes: (0..8).collect(),
-        slave_s: s.clone(),
-        master_nodes: (0..4).collect(),
-        master_s: m.clone(),
-        breaks: vec![3],
-    };
-    let mirror = |v: &Vec<f64>| v.iter().rev().map(|x| 1.0 - x).collect::<Vec<f64>>();
-    let backward = Piece {
-        a: [1.0, 1.0],
-        tangent: [-1.0, 0.0],
-        slave_s: mirror(&s),
-        master_s: mirror(&m),
-        breaks: vec![4],
-        ..forward.clone()
-    };
+    let forward = piece_along_y1(&s, &m, vec![3]);
+    let backward = mirrored(&forward, vec![4]);
     let ends = |p: &Piece| {
         let mut v: Vec<(i64, i64)> = p
             .macro_averages()
@@ -271,4 +236,33 @@ fn macro_elements_end_at_the_geometry_points_of_a_piece() {
     };
     assert_eq!(ends(&forward), ends(&backward));
     assert!(ends(&forward).iter().any(|e| e.1 == 400_000_000), "a macro-element ends at x = 0.4");
+}
+
+/// A piece of Gamma_C along y = 1 from x = 0 to 1, body-1 abscissae `s`, body-2 `m`.
+fn piece_along_y1(s: &[f64], m: &[f64], breaks: Vec<usize>) -> Piece {
+    Piece {
+        a: [0.0, 1.0],
+        tangent: [1.0, 0.0],
+        length: 1.0,
+        normal: [0.0, 1.0],
+        slave_nodes: (0..s.len()).collect(),
+        slave_s: s.to_vec(),
+        master_nodes: (0..m.len()).collect(),
+        master_s: m.to_vec(),
+        breaks,
+    }
+}
+
+/// The same piece run from x = 1 to 0 (its abscissae mirrored), with `breaks` in the
+/// mirrored node numbering.
+fn mirrored(p: &Piece, breaks: Vec<usize>) -> Piece {
+    let mirror = |v: &Vec<f64>| v.iter().rev().map(|x| 1.0 - x).collect::<Vec<f64>>();
+    Piece {
+        a: [1.0, 1.0],
+        tangent: [-1.0, 0.0],
+        slave_s: mirror(&p.slave_s),
+        master_s: mirror(&p.master_s),
+        breaks,
+        ..p.clone()
+    }
 }

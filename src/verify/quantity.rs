@@ -317,7 +317,7 @@ impl Differences<'_> {
             ),
             (
                 Quantity::PressureResultant,
-                Some(ratio(max(&|c| c.resultant.0.abs()), max(&|c| c.resultant.1))),
+                relative(max(&|c| c.resultant.0.abs()), max(&|c| c.resultant.1)),
             ),
             (
                 Quantity::PressureWeighted,
@@ -325,10 +325,10 @@ impl Differences<'_> {
             ),
             (
                 Quantity::PressureOscillation,
-                Some(ratio(
+                relative(
                     max(&|c| (c.variation.0 - c.variation.1).abs()),
                     max(&|c| c.variation.1.max(c.pressure_max)),
-                )),
+                ),
             ),
             (
                 Quantity::L2Pressure,
@@ -338,7 +338,3 @@ impl Differences<'_> {
     }
 }
 
-/// a / b, with b kept off 0.
-fn ratio(a: f64, b: f64) -> f64 {
-    a / b.max(f64::MIN_POSITIVE)
-}

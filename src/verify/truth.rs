@@ -222,7 +222,10 @@ pub fn exact_errors(
             .map(|d| d.energy.abs())
             .fold(0.0f64, f64::max)
             .sqrt();
-        errors.insert(Quantity::Consistency, term / energy.max(f64::MIN_POSITIVE));
+        // A size the truth lacks measures nothing (verify::rates::relative_to): no row.
+        if let Some(v) = crate::verify::rates::relative_to(term, energy, scale.theorem) {
+            errors.insert(Quantity::Consistency, v);
+        }
     }
     (errors, scale)
 }

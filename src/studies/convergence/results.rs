@@ -327,7 +327,7 @@ pub(crate) fn study_section(doc: &mut Doc, dir: &Path, name: &str, what: &str) -
     }
     plasticity_and_time(doc, dir)?;
     doc.bullet(format!(
-        "nts at h^(1/2) (a rate within {NEAR_HALF} of 0.5): {}.",
+        "nts at h^(1/2) (the fit and the last judged rate within {NEAR_HALF} of 0.5): {}.",
         listed(&near_half(&report), "; ", "no quantity")
     ));
     separation_bullets(doc, &report);
@@ -360,15 +360,16 @@ pub(crate) fn study_section(doc: &mut Doc, dir: &Path, name: &str, what: &str) -
     Ok(())
 }
 
-/// The quantities other than the theorem norm where nts's fitted rate is
-/// within [`NEAR_HALF`] of 1/2.
+/// The quantities other than the theorem norm where nts's fitted rate and its last judged
+/// rate are both within [`NEAR_HALF`] of 1/2 (a rate claim: never the fit alone).
 pub(crate) fn near_half(report: &Report) -> Vec<String> {
+    let near = |v: f64| (v - 0.5).abs() <= NEAR_HALF;
     report
         .rates
         .iter()
         .filter(|r| r.method == Method::Nts && r.quantity != Quantity::Theorem)
         .filter(|r| r.verdict.supports_rate())
-        .filter(|r| r.rate.is_some_and(|v| (v - 0.5).abs() <= NEAR_HALF))
+        .filter(|r| r.rate.is_some_and(near) && r.last_rate.is_some_and(near))
         .map(|r| {
             format!(
                 "{} {}, last successive rates {}",
