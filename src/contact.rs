@@ -357,7 +357,9 @@ impl Interface {
                 if corner || last {
                     let mut piece = Self::piece(model, &chain[start..=k], &master_edges)?;
                     let interior = 1..piece.slave_nodes.len().saturating_sub(1);
-                    piece.breaks = interior.filter(|&j| points.contains(&piece.slave_nodes[j])).collect();
+                    piece.breaks = interior
+                        .filter(|&j| points.contains(&piece.slave_nodes[j]))
+                        .collect();
                     pieces.push(piece);
                     start = k;
                 }
@@ -682,8 +684,16 @@ pub fn macro_elements(segments: usize) -> Vec<[usize; 2]> {
 pub fn macro_elements_between(segments: usize, breaks: &[usize]) -> Vec<[usize; 2]> {
     let mut out = Vec::new();
     let mut start = 0;
-    for &end in breaks.iter().filter(|&&b| b > 0 && b < segments).chain(std::iter::once(&segments)) {
-        out.extend(macro_elements(end - start).iter().map(|m| [m[0] + start, m[1] + start]));
+    for &end in breaks
+        .iter()
+        .filter(|&&b| b > 0 && b < segments)
+        .chain(std::iter::once(&segments))
+    {
+        out.extend(
+            macro_elements(end - start)
+                .iter()
+                .map(|m| [m[0] + start, m[1] + start]),
+        );
         start = end;
     }
     out

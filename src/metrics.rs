@@ -147,7 +147,10 @@ pub fn limit_load_ratio(model: &crate::fe::Model, t: f64) -> Option<f64> {
     let mut worst: Option<f64> = None;
     for &(i, [a, b]) in &model.traction_edges {
         let body = usize::from(a >= model.node_offset[1]);
-        let (Some(g), Some(vp)) = (&model.scene.tractions[i].g, model.materials[body].viscoplastic) else {
+        let (Some(g), Some(vp)) = (
+            &model.scene.tractions[i].g,
+            model.materials[body].viscoplastic,
+        ) else {
             continue;
         };
         let (pa, pb) = (model.position(a), model.position(b));

@@ -59,19 +59,23 @@ fn run_times(reports: &Path) -> Result<String> {
             )
             .filter(|p| p.is_file())
             .collect();
+        if files.is_empty() {
+            continue;
+        }
         files.sort();
         let mut total = 0.0;
         for f in &files {
             let text = std::fs::read_to_string(f)
                 .map_err(|e| crate::error::Error::input(f, "run.toml", e.to_string()))?;
-            let value: toml::Value = toml::from_str(&text)
-                .map_err(|e| crate::error::Error::input(f, "run.toml", e.to_string()))?;
-            total += value.get("wall_s").and_then(toml::Value::as_float).unwrap_or(0.0);
+            let value: toml::Value = crate::error::parse_toml(&text, f, "run facts")?;
+            total += value
+                .get("wall_s")
+                .and_then(toml::Value::as_float)
+                .unwrap_or(0.0);
         }
-        if files.is_empty() {
-            continue;
-        }
-        let name = dir.file_name().map_or(String::new(), |n| n.to_string_lossy().to_string());
+        let name = dir
+            .file_name()
+            .map_or(String::new(), |n| n.to_string_lossy().to_string());
         let parts = match files.len() {
             1 => String::new(),
             n => format!(" ({n} members' run.toml summed)"),
@@ -247,7 +251,11 @@ fn stalled_anywhere(studies: &[(&str, &str, Report)]) -> Vec<String> {
 /// Each (method, quantity) fixed at a node, with the studies where it is.
 fn fixed_anywhere(studies: &[(&str, &str, Report)]) -> Vec<String> {
     by_study(studies, |report| {
-        report.rates.iter().filter(|r| r.verdict == Verdict::Fixed).collect()
+        report
+            .rates
+            .iter()
+            .filter(|r| r.verdict == Verdict::Fixed)
+            .collect()
     })
 }
 

@@ -68,7 +68,11 @@ fn files(dir: &Path, keep: &dyn Fn(&Path) -> bool, out: &mut Vec<PathBuf>) {
 }
 
 fn readmes(dir: &Path, out: &mut Vec<PathBuf>) {
-    files(dir, &|p| p.file_name().is_some_and(|n| n == "README.md"), out);
+    files(
+        dir,
+        &|p| p.file_name().is_some_and(|n| n == "README.md"),
+        out,
+    );
 }
 
 fn csv_files(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -81,13 +85,23 @@ fn reports() -> PathBuf {
 
 /// A CSV file as rows of (column -> value).
 fn read_csv(path: &Path) -> Vec<BTreeMap<String, String>> {
-    let mut reader = csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let header: Vec<String> = reader.headers().expect("a header").iter().map(String::from).collect();
+    let mut reader =
+        csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let header: Vec<String> = reader
+        .headers()
+        .expect("a header")
+        .iter()
+        .map(String::from)
+        .collect();
     reader
         .records()
         .map(|r| {
             let r = r.expect("a record");
-            header.iter().cloned().zip(r.iter().map(String::from)).collect()
+            header
+                .iter()
+                .cloned()
+                .zip(r.iter().map(String::from))
+                .collect()
         })
         .collect()
 }
@@ -100,7 +114,18 @@ fn method_column(header: &[String]) -> Option<usize> {
 const METHODS: [&str; 3] = ["mortar", "nts", "lac"];
 
 /// Column headers that name what a row is about (a row's key is its leading cells of these).
-const KEYS: [&str; 10] = ["quantity", "level", "beta", "family", "scene", "case", "parameter", "study", "solver", "levels"];
+const KEYS: [&str; 10] = [
+    "quantity",
+    "level",
+    "beta",
+    "family",
+    "scene",
+    "case",
+    "parameter",
+    "study",
+    "solver",
+    "levels",
+];
 
 /// Tables without a method column that print one key twice: rows from more than one
 /// method (or the same row twice), which a reader cannot tell apart.
@@ -112,7 +137,12 @@ fn mixed_tables(readme: &Path) -> Vec<String> {
             continue;
         }
         // A row's key: its leading cells that name what the row is about.
-        let keys = t.header.iter().take_while(|h| KEYS.contains(&h.as_str())).count().max(1);
+        let keys = t
+            .header
+            .iter()
+            .take_while(|h| KEYS.contains(&h.as_str()))
+            .count()
+            .max(1);
         let mut seen = BTreeMap::new();
         for row in &t.rows {
             let key = row[..keys.min(row.len())].join(" / ");
@@ -136,7 +166,11 @@ fn expected_rate_cell(row: &BTreeMap<String, String>) -> String {
     let num = |k: &str| row.get(k).and_then(|v| v.parse::<f64>().ok());
     let last = num("last_rate").map_or("NaN".into(), |v| format!("{v:.3}"));
     match row["verdict"].as_str() {
-        "fitted" => format!("{:.3} ± {:.3}", num("rate").unwrap(), num("stderr").unwrap()),
+        "fitted" => format!(
+            "{:.3} ± {:.3}",
+            num("rate").unwrap(),
+            num("stderr").unwrap()
+        ),
         "falling" => format!("falling (last successive rate {last})"),
         "rising" => format!("rising (last successive rate {last})"),
         "pre-asymptotic" => "(pre-asymptotic)".into(),
@@ -178,16 +212,29 @@ fn foreign_cells(readme: &Path) -> (usize, Vec<String>) {
         return (0, Vec::new());
     }
     let rates = read_csv(&rates_path);
-    if !rates.first().is_some_and(|r| r.contains_key("method") && r.contains_key("verdict") && r.contains_key("stderr")) {
+    if !rates.first().is_some_and(|r| {
+        r.contains_key("method") && r.contains_key("verdict") && r.contains_key("stderr")
+    }) {
         return (0, Vec::new());
     }
-    let asymptotes = if asymptotes_path.exists() { read_csv(&asymptotes_path) } else { Vec::new() };
-    let rate = |m: &str, q: &str| rates.iter().find(|r| r["method"] == m && r["quantity"] == q);
+    let asymptotes = if asymptotes_path.exists() {
+        read_csv(&asymptotes_path)
+    } else {
+        Vec::new()
+    };
+    let rate = |m: &str, q: &str| {
+        rates
+            .iter()
+            .find(|r| r["method"] == m && r["quantity"] == q)
+    };
     let text = std::fs::read_to_string(readme).expect("a README");
     let (mut checked, mut bad) = (0, Vec::new());
     let mut read_against_distance: Vec<(String, String)> = Vec::new();
     for t in tables(&text) {
-        let (Some(mc), Some(qc)) = (method_column(&t.header), t.header.iter().position(|h| h == "quantity")) else {
+        let (Some(mc), Some(qc)) = (
+            method_column(&t.header),
+            t.header.iter().position(|h| h == "quantity"),
+        ) else {
             continue;
         };
         let col = |name: &str| t.header.iter().position(|h| h == name);
@@ -200,7 +247,11 @@ fn foreign_cells(readme: &Path) -> (usize, Vec<String>) {
             let mut check = |what: &str, cell: &str, ok: bool| {
                 checked += 1;
                 if !ok {
-                    bad.push(format!("{}: table \"{}\", {m} {q}, {what}: \"{cell}\"", readme.display(), t.heading));
+                    bad.push(format!(
+                        "{}: table \"{}\", {m} {q}, {what}: \"{cell}\"",
+                        readme.display(),
+                        t.heading
+                    ));
                 }
             };
             match col("verdict") {
@@ -209,7 +260,8 @@ fn foreign_cells(readme: &Path) -> (usize, Vec<String>) {
                 Some(v) => {
                     if let (Some(c), Some(r)) = (col("rate in h"), rate(m, q)) {
                         check("verdict", &row[v], row[v] == r["verdict"]);
-                        let expected = match (r["rate"].parse::<f64>(), r["stderr"].parse::<f64>()) {
+                        let expected = match (r["rate"].parse::<f64>(), r["stderr"].parse::<f64>())
+                        {
                             (Ok(x), Ok(se)) => format!("{x:.3} ± {se:.3}"),
                             _ => "-".into(),
                         };
@@ -231,10 +283,14 @@ fn foreign_cells(readme: &Path) -> (usize, Vec<String>) {
                 let ok = rate(m, dq).is_some_and(|r| cell_matches(&row[c], r));
                 check("D", &row[c], ok);
             }
-            let asymptote = asymptotes.iter().find(|a| a["method"] == m && a["quantity"] == q);
+            let asymptote = asymptotes
+                .iter()
+                .find(|a| a["method"] == m && a["quantity"] == q);
             if let (Some(c), Some(a)) = (col("D / e_mortar, finest level"), asymptote) {
                 let ok = row[c].starts_with("mortar exact")
-                    || a["finest_ratio"].parse::<f64>().is_ok_and(|v| row[c] == format!("{v:.2}"));
+                    || a["finest_ratio"]
+                        .parse::<f64>()
+                        .is_ok_and(|v| row[c] == format!("{v:.2}"));
                 check("D / e_mortar", &row[c], ok);
             }
             if col("asymptotic rate").is_some() {
@@ -252,8 +308,14 @@ fn foreign_cells(readme: &Path) -> (usize, Vec<String>) {
     // Every row of asymptotes.csv is a row of the README's distance table, under its method
     // (reports/codes, whose asymptotes.csv spans problems, prints its key quantity's only).
     let one_problem = asymptotes.first().is_none_or(|a| !a.contains_key("study"));
-    for a in asymptotes.iter().filter(|a| one_problem && METHODS.contains(&a["method"].as_str())) {
-        if !read_against_distance.iter().any(|(m, q)| *m == a["method"] && *q == a["quantity"]) {
+    for a in asymptotes
+        .iter()
+        .filter(|a| one_problem && METHODS.contains(&a["method"].as_str()))
+    {
+        if !read_against_distance
+            .iter()
+            .any(|(m, q)| *m == a["method"] && *q == a["quantity"])
+        {
             bad.push(format!(
                 "{}: asymptotes.csv's {} {} is no row of a table with a method column",
                 readme.display(),
@@ -269,9 +331,18 @@ fn foreign_cells(readme: &Path) -> (usize, Vec<String>) {
 fn no_committed_table_mixes_methods_without_a_method_column() {
     let mut files = Vec::new();
     readmes(&reports(), &mut files);
-    assert!(files.len() > 20, "the committed READMEs are found ({})", files.len());
+    assert!(
+        files.len() > 20,
+        "the committed READMEs are found ({})",
+        files.len()
+    );
     let bad: Vec<String> = files.iter().flat_map(|f| mixed_tables(f)).collect();
-    assert!(bad.is_empty(), "{} tables mix methods' rows:\n{}", bad.len(), bad.join("\n"));
+    assert!(
+        bad.is_empty(),
+        "{} tables mix methods' rows:\n{}",
+        bad.len(),
+        bad.join("\n")
+    );
 }
 
 #[test]
@@ -284,7 +355,12 @@ fn every_rate_verdict_and_ratio_cell_is_its_rows_method() {
         checked += n;
         bad.extend(b);
     }
-    assert!(bad.is_empty(), "{} of {checked} cells are not their row's method's:\n{}", bad.len(), bad.join("\n"));
+    assert!(
+        bad.is_empty(),
+        "{} of {checked} cells are not their row's method's:\n{}",
+        bad.len(),
+        bad.join("\n")
+    );
     // 19 convergence READMEs with a rates table, 18 with a distance table.
     assert!(checked > 700, "cells checked: {checked}");
 }
@@ -296,7 +372,11 @@ const RELATIVE: [&str; 3] = ["error", "mortar_error", "distance"];
 fn committed_csvs_are_finite_and_no_relative_error_exceeds_1e3() {
     let mut files = Vec::new();
     csv_files(&reports(), &mut files);
-    assert!(files.len() > 50, "the committed CSVs are found ({})", files.len());
+    assert!(
+        files.len() > 50,
+        "the committed CSVs are found ({})",
+        files.len()
+    );
     let mut bad = Vec::new();
     for f in &files {
         for (i, row) in read_csv(f).iter().enumerate() {
@@ -310,5 +390,10 @@ fn committed_csvs_are_finite_and_no_relative_error_exceeds_1e3() {
             }
         }
     }
-    assert!(bad.is_empty(), "{} values:\n{}", bad.len(), bad[..bad.len().min(40)].join("\n"));
+    assert!(
+        bad.is_empty(),
+        "{} values:\n{}",
+        bad.len(),
+        bad[..bad.len().min(40)].join("\n")
+    );
 }

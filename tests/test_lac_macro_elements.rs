@@ -207,12 +207,21 @@ fn macro_elements_end_at_the_geometry_points_of_a_piece() {
     use contact_rates::contact::macro_elements_between;
     assert_eq!(macro_elements_between(8, &[]), macro_elements(8));
     // A break at node 3 of 8 segments: runs of 3 and 5.
-    assert_eq!(macro_elements_between(8, &[3]), vec![[0, 3], [3, 5], [5, 8]]);
-    assert_eq!(macro_elements_between(9, &[2, 5]), vec![[0, 2], [2, 5], [5, 7], [7, 9]]);
+    assert_eq!(
+        macro_elements_between(8, &[3]),
+        vec![[0, 3], [3, 5], [5, 8]]
+    );
+    assert_eq!(
+        macro_elements_between(9, &[2, 5]),
+        vec![[0, 2], [2, 5], [5, 7], [7, 9]]
+    );
     for n in 2..30 {
         for b in 2..n - 1 {
             let m = macro_elements_between(n, &[b]);
-            assert!(m.iter().any(|s| s[1] == b), "n = {n}: a macro-element ends at the break {b}");
+            assert!(
+                m.iter().any(|s| s[1] == b),
+                "n = {n}: a macro-element ends at the break {b}"
+            );
             assert!(m.windows(2).all(|w| w[0][1] == w[1][0]));
             assert!(m.iter().all(|s| (2..=3).contains(&(s[1] - s[0]))));
         }
@@ -227,15 +236,24 @@ fn macro_elements_end_at_the_geometry_points_of_a_piece() {
             .macro_averages()
             .iter()
             .map(|a| {
-                let (x0, x1) = (p.point(p.slave_s[a.span[0]])[0], p.point(p.slave_s[a.span[1]])[0]);
-                ((x0.min(x1) * 1e9).round() as i64, (x0.max(x1) * 1e9).round() as i64)
+                let (x0, x1) = (
+                    p.point(p.slave_s[a.span[0]])[0],
+                    p.point(p.slave_s[a.span[1]])[0],
+                );
+                (
+                    (x0.min(x1) * 1e9).round() as i64,
+                    (x0.max(x1) * 1e9).round() as i64,
+                )
             })
             .collect();
         v.sort();
         v
     };
     assert_eq!(ends(&forward), ends(&backward));
-    assert!(ends(&forward).iter().any(|e| e.1 == 400_000_000), "a macro-element ends at x = 0.4");
+    assert!(
+        ends(&forward).iter().any(|e| e.1 == 400_000_000),
+        "a macro-element ends at x = 0.4"
+    );
 }
 
 /// A piece of Gamma_C along y = 1 from x = 0 to 1, body-1 abscissae `s`, body-2 `m`.

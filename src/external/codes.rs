@@ -4,6 +4,7 @@
 //! code sides with where the cones differ, and says where the levels cannot tell them apart.
 
 use super::checks::CheckRecord;
+use crate::contact::Method;
 use crate::error::{Error, Result};
 use crate::io::csv_bytes;
 use crate::report::folder::{write, write_folder};
@@ -13,7 +14,6 @@ use crate::verify::judge::AsymptoteRow;
 use crate::verify::quantity::Quantity;
 use crate::verify::rates::{Verdict, short_text};
 use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord, methods_in_order, read};
-use crate::contact::Method;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -213,10 +213,7 @@ impl Problem {
 
     /// The key quantity: the theorem norm, or l2_stress where no displacement is graded.
     fn key(&self) -> Quantity {
-        match self.errors.iter().any(|r| r.quantity == Quantity::Theorem) {
-            true => Quantity::Theorem,
-            false => Quantity::L2Stress,
-        }
+        key_of(self.errors.iter().map(|r| r.quantity))
     }
 
     fn methods(&self) -> Vec<MethodLabel> {
@@ -246,6 +243,15 @@ impl Problem {
     }
 }
 
+/// A problem's key quantity among the quantities it measures: the theorem norm, or
+/// l2_stress where no displacement is graded (patch: no theorem-norm rows).
+fn key_of(mut quantities: impl Iterator<Item = Quantity>) -> Quantity {
+    match quantities.any(|q| q == Quantity::Theorem) {
+        true => Quantity::Theorem,
+        false => Quantity::L2Stress,
+    }
+}
+
 /// Below this relative error a key error is round-off (the patch test's): exact.
 const EXACT: f64 = 1e-9;
 
@@ -258,12 +264,23 @@ enum Side {
     Unknown,
     /// Mortar is exact there (the patch test): the exact cones, whether the code is too, and
     /// its error over each inexact cone's.
-    MortarExact { exact: Vec<Method>, code_exact: bool, ratios: Vec<(Method, f64)> },
+    MortarExact {
+        exact: Vec<Method>,
+        code_exact: bool,
+        ratios: Vec<(Method, f64)>,
+    },
     /// Every cone within [`INDISTINCT`] of the others.
-    Indistinct { level: usize, ratios: Vec<(Method, f64)> },
+    Indistinct {
+        level: usize,
+        ratios: Vec<(Method, f64)>,
+    },
     /// The cones nearest the code's error in ratio (the nearest and any within
     /// [`INDISTINCT`] of it), with the code's error over each cone's.
-    Nearest { cones: Vec<Method>, level: usize, ratios: Vec<(Method, f64)> },
+    Nearest {
+        cones: Vec<Method>,
+        level: usize,
+        ratios: Vec<(Method, f64)>,
+    },
 }
 
 /// Which cone `code`'s key error at its finest level is nearest (in ratio) on that level,
@@ -294,7 +311,11 @@ fn side(p: &Problem, code: &MethodLabel) -> Side {
         return Side::MortarExact {
             exact: cones.iter().filter(|c| c.1 <= EXACT).map(|c| c.0).collect(),
             code_exact: x <= EXACT,
-            ratios: cones.iter().filter(|c| c.1 > EXACT).map(|&(m, e)| (m, x / e)).collect(),
+            ratios: cones
+                .iter()
+                .filter(|c| c.1 > EXACT)
+                .map(|&(m, e)| (m, x / e))
+                .collect(),
         };
     }
     let ratios: Vec<(Method, f64)> = cones.iter().map(|&(m, e)| (m, x / e)).collect();
@@ -307,7 +328,11 @@ fn side(p: &Problem, code: &MethodLabel) -> Side {
     by_distance.sort_by(|a, b| far(x, a.1).total_cmp(&far(x, b.1)));
     let nearest = by_distance[0].1;
     Side::Nearest {
-        cones: by_distance.iter().filter(|c| within(c.1, nearest)).map(|c| c.0).collect(),
+        cones: by_distance
+            .iter()
+            .filter(|c| within(c.1, nearest))
+            .map(|c| c.0)
+            .collect(),
         level,
         ratios,
     }
@@ -331,15 +356,31 @@ impl Side {
     fn cell(&self) -> String {
         match self {
             Side::Unknown => "-".into(),
-            Side::MortarExact { exact, code_exact: true, .. } => format!("exact, as {}", names(exact)),
-            Side::MortarExact { exact, code_exact: false, ratios } => {
-                format!("not exact, unlike {} ({})", names(exact), ratios_text(ratios))
+            Side::MortarExact {
+                exact,
+                code_exact: true,
+                ..
+            } => format!("exact, as {}", names(exact)),
+            Side::MortarExact {
+                exact,
+                code_exact: false,
+                ratios,
+            } => {
+                format!(
+                    "not exact, unlike {} ({})",
+                    names(exact),
+                    ratios_text(ratios)
+                )
             }
             Side::Indistinct { level, ratios } => format!(
                 "cones within 5% of each other at level {level} ({})",
                 ratios_text(ratios)
             ),
-            Side::Nearest { cones, level, ratios } => format!(
+            Side::Nearest {
+                cones,
+                level,
+                ratios,
+            } => format!(
                 "{} ({} at level {level})",
                 names(cones),
                 ratios_text(ratios)
@@ -454,17 +495,31 @@ fn lead(problems: &[Problem]) -> Vec<String> {
     let mut out = Vec::new();
     for p in problems {
         let key = p.key();
-        let codes: Vec<MethodLabel> = p.methods().into_iter().filter(|m| m.cone().is_none()).collect();
-        let sides: Vec<(MethodLabel, Side)> = codes.iter().map(|c| (c.clone(), side(p, c))).collect();
+        let codes: Vec<MethodLabel> = p
+            .methods()
+            .into_iter()
+            .filter(|m| m.cone().is_none())
+            .collect();
+        let sides: Vec<(MethodLabel, Side)> =
+            codes.iter().map(|c| (c.clone(), side(p, c))).collect();
         let line = match sides.first().map(|s| &s.1) {
-            Some(Side::Indistinct { level, .. }) if sides.iter().all(|s| matches!(s.1, Side::Indistinct { .. })) => {
-                format!("`{}` ({key}): the cones are within 5% of each other at level {level}, so no code can be told apart there", p.study)
+            Some(Side::Indistinct { level, .. })
+                if sides.iter().all(|s| matches!(s.1, Side::Indistinct { .. })) =>
+            {
+                format!(
+                    "`{}` ({key}): the cones are within 5% of each other at level {level}, so no code can be told apart there",
+                    p.study
+                )
             }
             _ => {
                 let parts: Vec<String> = sides
                     .iter()
                     .map(|(c, s)| match s {
-                        Side::Nearest { cones, level, ratios } => format!(
+                        Side::Nearest {
+                            cones,
+                            level,
+                            ratios,
+                        } => format!(
                             "{c} sides with {} at level {level} ({})",
                             names(cones),
                             ratios_text(ratios)
@@ -609,10 +664,12 @@ pub fn results_section(reports: &Path) -> Result<String> {
     header.extend(methods.iter().map(|m| m.to_string()));
     let mut table = Table::new(header);
     for study in studies {
-        let key = match rates.iter().any(|r| r.study == study && r.quantity == Quantity::Theorem) {
-            true => Quantity::Theorem,
-            false => Quantity::L2Stress,
-        };
+        let key = key_of(
+            rates
+                .iter()
+                .filter(|r| r.study == study)
+                .map(|r| r.quantity),
+        );
         let mut row = vec![format!("`{study}`"), format!("`{key}`")];
         row.extend(methods.iter().map(|m| {
             rates

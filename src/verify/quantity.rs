@@ -259,7 +259,8 @@ impl Differences<'_> {
             v.iter().map(f).fold(0.0f64, f64::max)
         };
         let theorem = max_over(&|n| n.theorem(), self.reference);
-        let relative = |value: f64, size: f64| crate::verify::rates::relative_to(value, size, theorem);
+        let relative =
+            |value: f64, size: f64| crate::verify::rates::relative_to(value, size, theorem);
         let rel = |f: &dyn Fn(&SquaredNorms) -> f64| {
             relative(max_over(f, self.fields), max_over(f, self.reference))
         };
@@ -330,11 +331,7 @@ impl Differences<'_> {
                     max(&|c| c.variation.1.max(c.pressure_max)),
                 ),
             ),
-            (
-                Quantity::L2Pressure,
-                relative(pressure_diff, pressure_ref),
-            ),
+            (Quantity::L2Pressure, relative(pressure_diff, pressure_ref)),
         ]
     }
 }
-

@@ -258,7 +258,7 @@ pub fn threshold_outcome(a: &Assessment, required: f64) -> Outcome {
 }
 
 /// The one rule behind every word of a report that claims a rate reaches a target
-/// ("follows its best", "sides with", "reaches", "tends to mortar's rate"): the threshold
+/// ("follows its best", "tends to mortar's rate", "D falls no slower"): the threshold
 /// rule at `target - slack`, so a supported rate whose fit and last judged rate both reach
 /// it ([`threshold_outcome`] passes). Never the fit alone: a fit that reaches the target
 /// while the successive rates fall below it is still in transition.
@@ -440,12 +440,9 @@ pub fn assess(levels: &[LevelError], truth_error: f64) -> Result<Assessment, Equ
         return Ok(out);
     }
     out.judged = judged_rates(&usable);
-    if let Some(last) = usable.get(usable.len().wrapping_sub(MIN_FIT_LEVELS)..) {
-        let (lo, hi) = last.iter().fold((f64::INFINITY, 0.0f64), |(a, b), e| (a.min(e.error), b.max(e.error)));
-        if usable.len() >= MIN_FIT_LEVELS && hi <= lo * (1.0 + FIXED_SPREAD) {
-            out.verdict = Verdict::Fixed;
-            return Ok(out);
-        }
+    if fixed(&usable) {
+        out.verdict = Verdict::Fixed;
+        return Ok(out);
     }
     let rates: Vec<f64> = out.judged.iter().map(|r| r.rate).collect();
     let last_two = &rates[rates.len().saturating_sub(2)..];
@@ -494,7 +491,9 @@ pub fn assess(levels: &[LevelError], truth_error: f64) -> Result<Assessment, Equ
     (out.fit, out.fit_dofs) = fit_over(window);
     out.used = window.iter().map(|e| e.level).collect();
     if out.verdict == Verdict::Fitted
-        && out.fit.is_some_and(|f| f.rate <= ZERO_RATE_STDERRS * f.stderr)
+        && out
+            .fit
+            .is_some_and(|f| f.rate <= ZERO_RATE_STDERRS * f.stderr)
     {
         // A rate the data cannot tell from 0 supports no rate.
         out.verdict = Verdict::NotConverging;
@@ -507,6 +506,21 @@ pub fn assess(levels: &[LevelError], truth_error: f64) -> Result<Assessment, Equ
         _ => None,
     };
     Ok(out)
+}
+
+/// Whether the last [`MIN_FIT_LEVELS`] usable levels' errors agree to [`FIXED_SPREAD`].
+fn fixed(usable: &[&LevelError]) -> bool {
+    let Some(last) = usable
+        .len()
+        .checked_sub(MIN_FIT_LEVELS)
+        .map(|i| &usable[i..])
+    else {
+        return false;
+    };
+    let (lo, hi) = last.iter().fold((f64::INFINITY, 0.0f64), |(a, b), e| {
+        (a.min(e.error), b.max(e.error))
+    });
+    hi <= lo * (1.0 + FIXED_SPREAD)
 }
 
 /// Refuse two levels with the same h (relative 1e-12): no rate between them.

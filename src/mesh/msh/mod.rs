@@ -121,8 +121,12 @@ impl RawMesh {
                     out.lines.push((l.map(|n| n + offset), *p));
                 }
             }
-            out.points
-                .extend(raw.points.iter().filter(|&&n| on_body[n]).map(|n| n + offset));
+            out.points.extend(
+                raw.points
+                    .iter()
+                    .filter(|&&n| on_body[n])
+                    .map(|n| n + offset),
+            );
         }
         out
     }

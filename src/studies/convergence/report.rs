@@ -553,8 +553,11 @@ fn fixed_at_a_node(doc: &mut Doc, res: &StudyResult) {
         })
         .collect();
     if !lines.is_empty() {
-        doc.paragraph("Fixed at a node (the same error to 1e-9 on the last levels: not a rate, and not a discretization error that stalls):")
-            .list(lines);
+        doc.paragraph(format!(
+            "Fixed at a node (the same error to {:.0e} on the last levels: not a rate, and not a discretization error that stalls):",
+            crate::verify::rates::FIXED_SPREAD
+        ))
+        .list(lines);
     }
 }
 

@@ -571,6 +571,9 @@ fn run_variant(var: &Variant, method: Method) -> Result<Vec<StabilityRow>> {
         Some((scene, unit)) => Some((Case::build(scene, var.level, method, &var.params)?, *unit)),
         None => None,
     };
+    // The scene's load against its yield stress: one figure per variant, on every row.
+    let limit_load_ratio = crate::metrics::limit_load_ratio(&case.problem.model, var.scene.final_time)
+        .unwrap_or(f64::NAN);
     // A run's row before its outcome is known: the failure's blanks.
     let row = |solver: SolverKind, wall_s: f64| StabilityRow {
         case: var.case,
@@ -585,8 +588,7 @@ fn run_variant(var: &Variant, method: Method) -> Result<Vec<StabilityRow>> {
         error: f64::NAN,
         max_penetration: f64::NAN,
         max_displacement: f64::NAN,
-        limit_load_ratio: crate::metrics::limit_load_ratio(&case.problem.model, var.scene.final_time)
-            .unwrap_or(f64::NAN),
+        limit_load_ratio,
         wall_s,
     };
     let mut newton: Option<Solution> = None;
