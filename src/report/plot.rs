@@ -47,13 +47,16 @@ fn titled_figure<'p>(
         .map_err(err(path))
 }
 
-/// Colours of the series (colour-blind friendly).
-pub const COLORS: [RGBColor; 5] = [
+/// Colours of the series (colour-blind friendly: Okabe and Ito's palette). Seven, so that
+/// the codes report's six series (three cones, three codes) never share a colour.
+pub const COLORS: [RGBColor; 7] = [
     RGBColor(0, 114, 178),
     RGBColor(213, 94, 0),
     RGBColor(0, 0, 0),
     RGBColor(0, 158, 115),
     RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
 ];
 
 /// Font size of the tick labels of [`loglog`] and [`lines`] (pixels).
