@@ -16,7 +16,8 @@ pub struct Case {
     pub problem: Problem,
     /// Refinement level (0 = gmsh's own mesh).
     pub level: usize,
-    /// Max element diameter over both bodies.
+    /// The judge's h ([`Model::judge_h`]): the largest element diameter over both bodies on
+    /// split levels, the effective size on remeshed ones (length).
     pub h: f64,
     /// gmsh and .geo provenance.
     pub mesh: gmsh::GeneratedMesh,
@@ -186,7 +187,7 @@ impl Case {
         let t1 = Instant::now();
         let model = Model::new(scene, &raw, &generated.path)?;
         let interface = Interface::new(&model, &raw)?;
-        let h = model.h();
+        let h = model.judge_h();
         let warnings = support_warnings(&model, &interface, &raw)?;
         verify_exact(&model, &interface, &raw)?;
         let problem = Problem::new(model, interface, method);

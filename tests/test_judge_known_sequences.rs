@@ -276,3 +276,49 @@ fn the_crossing_of_the_distance_with_mortars_error_is_predicted_where_the_lines_
     // The pythagorean column is 0 by construction here.
     assert!(theorem.largest_pythagorean.unwrap() < 1e-14);
 }
+
+/// Reference: issue 72 (remeshed families judged in their own h).
+/// Goal: no level enters a fitted window unchecked: on the level-to-level steps in h of
+/// regularity-graded's largest element (1.869, 2.183, 1.812, 1.904, 1.979), level 3 pairs
+/// with level 1 (2 -> 3 is under the 1.9 rule), so level 2 ends no judged rate in a window
+/// that starts at 2; the window must then start where every level is an end of one.
+/// Data: e = h (rate 1 exactly), no wobble; a second table whose level 2 is off the line
+/// by 30 % (rate 1.44 and 0.56 into and out of it), which a window holding level 2
+/// unchecked would fit.
+#[test]
+fn every_level_of_a_window_ends_a_judged_rate_inside_it() {
+    let steps = [1.869, 2.183, 1.812, 1.904, 1.979];
+    let mut h = vec![0.35];
+    for s in steps {
+        h.push(h.last().unwrap() / s);
+    }
+    let check = |errors: &[f64]| {
+        let levels = levels_of((0..6).map(|l| (l, h[l], 4f64.powi(l as i32), errors[l])));
+        let a = assess(&levels, 0.0).unwrap();
+        for &l in &a.used {
+            let inside = a.judged.iter().any(|r| {
+                (r.levels.0 == l || r.levels.1 == l)
+                    && a.used.contains(&r.levels.0)
+                    && a.used.contains(&r.levels.1)
+            });
+            assert!(
+                inside,
+                "level {l} of window {:?} ends no judged rate inside it: {:?}",
+                a.used, a.judged
+            );
+        }
+        a
+    };
+    let exact: Vec<f64> = h.iter().map(|&h| h).collect();
+    let a = check(&exact);
+    assert_eq!(a.verdict, Verdict::Fitted);
+    assert!((a.fit.unwrap().rate - 1.0).abs() < 1e-12, "{:?}", a.fit);
+    let mut bent = exact.clone();
+    bent[2] *= 1.3;
+    let b = check(&bent);
+    println!(
+        "bent level 2: {:?} {:?} over {:?}",
+        b.verdict, b.fit, b.used
+    );
+    assert!(!b.used.contains(&2) || b.verdict != Verdict::Fitted);
+}

@@ -721,7 +721,7 @@ fn grade_level(
         times: steps.iter().map(|s| s.0).collect(),
         stress_given: steps[0].1.stress.is_some(),
         pressure_given: steps.iter().all(|s| s.1.pressure.is_some()),
-        h: outside.model.h(),
+        h: outside.model.judge_h(),
         dofs: outside.model.n_free,
         triangles: outside.model.elements.len(),
     };

@@ -631,24 +631,37 @@ fn fit_over(window: &[&LevelError]) -> (Option<Fit>, Option<Fit>) {
 
 /// The first index into `usable` of the longest trailing window of at least
 /// [`MIN_FIT_LEVELS`] levels holding at least two judged rates (both levels in the window)
-/// that spread by at most [`WINDOW_SPREAD`]; None where no such window exists.
+/// that spread by at most [`WINDOW_SPREAD`], every level of it an end of one of those
+/// rates (a level no judged rate inside the window reads would enter the fit unchecked:
+/// on remeshed levels a step under [`MIN_RATE_SPAN`] pairs a level with the one before
+/// its neighbour); None where no such window exists.
 fn trailing_window(usable: &[&LevelError], judged: &[JudgedRate]) -> Option<usize> {
     let mut start = None;
     for first in (0..=usable.len() - MIN_FIT_LEVELS).rev() {
-        let inside: Vec<f64> = judged
+        let window = &usable[first..];
+        let inside: Vec<&JudgedRate> = judged
             .iter()
-            .filter(|r| usable[first..].iter().any(|e| e.level == r.levels.0))
-            .map(|r| r.rate)
+            .filter(|r| window.iter().any(|e| e.level == r.levels.0))
             .collect();
         if inside.len() < 2 {
             continue;
         }
-        let spread = inside.iter().copied().fold(f64::NEG_INFINITY, f64::max)
-            - inside.iter().copied().fold(f64::INFINITY, f64::min);
+        let spread = inside
+            .iter()
+            .map(|r| r.rate)
+            .fold(f64::NEG_INFINITY, f64::max)
+            - inside.iter().map(|r| r.rate).fold(f64::INFINITY, f64::min);
         if spread > WINDOW_SPREAD {
             break;
         }
-        start = Some(first);
+        let covered = window.iter().all(|e| {
+            inside
+                .iter()
+                .any(|r| r.levels.0 == e.level || r.levels.1 == e.level)
+        });
+        if covered {
+            start = Some(first);
+        }
     }
     start
 }

@@ -83,8 +83,17 @@ pub struct LevelInfo {
     pub method: Method,
     /// Level.
     pub level: usize,
-    /// Max element diameter over both bodies (length).
+    /// The judge's h (length): `h_max` on nested (split) levels, `h_eff` on levels meshed
+    /// anew (`refinement = "remesh"`; see [`crate::fe::Model::judge_h`]).
     pub h: f64,
+    /// Largest element diameter over both bodies (length). Empty in reports written
+    /// before it was printed.
+    #[serde(default)]
+    pub h_max: Option<f64>,
+    /// Effective size (|Omega| / number of triangles)^(1/2) (length). Empty in reports
+    /// written before it was printed.
+    #[serde(default)]
+    pub h_eff: Option<f64>,
     /// Free dofs.
     pub dofs: usize,
     /// Body-1 nodes on Gamma_C.
@@ -715,6 +724,8 @@ fn level_info(case: &Case, sol: &Solution, method: Method, flagged: bool) -> Lev
         method,
         level: case.level,
         h: case.h,
+        h_max: Some(case.problem.model.h()),
+        h_eff: Some(case.problem.model.effective_h()),
         dofs: case.problem.model.n_free,
         slave_nodes: pieces.iter().map(|p| p.slave_nodes.len()).sum(),
         master_nodes: pieces.iter().map(|p| p.master_nodes.len()).sum(),

@@ -356,7 +356,7 @@ pub fn against_uniform(doc: &mut Doc, reg: &Regularity, reports: &Path, quantiti
         doc.paragraph("reports/regularity/errors.csv is missing: run `cargo run --release -- study regularity` first.");
         return Ok(());
     };
-    doc.paragraph("A rate in dofs N is the slope of -log(error) against log(N) over the levels of the fit; on uniform meshes it is half the rate in h. On graded meshes h is the largest element's diameter (far from c), and the levels are meshed anew by gmsh, not split: neighbouring meshes are not nested, so each level's error carries its own mesh's arrangement around c and the successive rates scatter more than under splitting. The judge needs no nesting (it reads h and N of each level), but that scatter can keep a window from fitting where nested meshes would.");
+    doc.paragraph("A rate in dofs N is the slope of -log(error) against log(N) over the levels of the fit; on uniform meshes it is half the rate in h. On graded meshes the levels are meshed anew by gmsh, not split, and their largest element (far from c) shrinks by uneven steps; the judge's h there is the effective size h_eff = (|Omega| / number of triangles)^(1/2) (levels.csv `h`, beside `h_max`), the size of a uniform mesh with as many triangles, so that a rate in h is twice the rate in triangles. The judge needs no nesting (it reads h and N of each level).");
     let mut t = Table::new(
         [
             "beta",
