@@ -47,6 +47,26 @@ fn write_family(family: &Family) -> std::io::Result<()> {
         } else {
             (0.0, 0.0, 0.0)
         };
+        let graded = matches!(family.placement, Placement::Graded { .. });
+        let (mortar_source, nts_source) = if beta > 1.0 {
+            (
+                "Theorem 3.1 of Fernandez, Hild and Viano: K_h^pi, h^(3/4) for u in W^(1,inf)(0,T; H^2), Gamma_C straight, sigma_nu in H^(1/2)(Gamma_C) (Lemma 3.1)",
+                "Theorem 3.1 of Fernandez, Hild and Viano: K_h^I, h^(1/2), the same hypotheses",
+            )
+        } else {
+            (
+                "Theorem 3.1 does not apply (u not in H^2; f not in L2 for beta <= 1): only convergence is asked",
+                "Theorem 3.1 does not apply (u not in H^2; f not in L2 for beta <= 1): only convergence is asked",
+            )
+        };
+        // LAC: Drouet and Hild's estimate (elastic bodies, read from its abstract as h^1 for
+        // u in H^2; its mesh hypotheses unread) where beta > 1 on uniform meshes; none else.
+        let lac = match (beta > 1.0, graded) {
+            (true, false) => "lac = { rate = 1.0, source = \"Drouet and Hild, Numer. Math. 136 (2017): optimal for elastic bodies with P1, read as h^1 for u in H^2 (abstract only: the theorem and its mesh hypotheses are a claim under test)\" }".to_string(),
+            (true, true) => "lac = { none = \"graded meshes: Drouet and Hild's estimate is taken for quasi-uniform meshes\" }".to_string(),
+            (false, false) => "lac = { none = \"beta <= 1: u is not in H^2, below the regularity of Drouet and Hild's optimal rate\" }".to_string(),
+            (false, true) => "lac = { none = \"beta <= 1: u is not in H^2, below the regularity of Drouet and Hild's optimal rate; and the meshes are graded, not quasi-uniform\" }".to_string(),
+        };
         let levels: Vec<String> = family.levels.iter().map(|l| l.to_string()).collect();
         std::fs::write(
             &study,
@@ -71,10 +91,9 @@ exact = true
 
 # {why}
 [thresholds]
-mortar = {mortar}
-nts = {nts}
-# LAC: not covered by Theorem 3.1; held to mortar's requirement (Drouet and Hild 2017).
-lac = {mortar}
+mortar = {{ rate = {mortar:?}, source = "{mortar_source}" }}
+nts = {{ rate = {nts:?}, source = "{nts_source}" }}
+{lac}
 tolerance = {tolerance}
 "#,
                 n = family.levels.len(),

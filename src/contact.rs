@@ -43,41 +43,10 @@ impl Method {
     /// Every method, in the order the reports list them.
     pub const ALL: [Method; 3] = [Method::Mortar, Method::Nts, Method::Lac];
 
-    /// Theorem 3.1's rate in h of the error in the theorem norm (||u - u_hk||_H1 +
-    /// ||sigma - sigma_hk||_L2): 3/4 for K_h^pi, 1/2 for K_h^I. The paper does not cover
-    /// LAC; Drouet and Hild prove for it the order of the mortar method, so the harness
-    /// holds it to mortar's 3/4 (the claim "as accurate as mortar" is what is measured).
-    pub fn theorem_rate(self) -> f64 {
-        match self {
-            Method::Mortar | Method::Lac => 0.75,
-            Method::Nts => 0.5,
-        }
-    }
-    /// Where the rate the studies hold the method to comes from, for reports: "Theorem 3.1:
-    /// r", or for lac mortar's rate, which Theorem 3.1 does not give it.
-    pub fn rate_claim(self) -> String {
-        match self {
-            Method::Lac => format!(
-                "not in Theorem 3.1; held to mortar's {}",
-                Method::Mortar.theorem_rate()
-            ),
-            _ => format!("Theorem 3.1: {}", self.theorem_rate()),
-        }
-    }
     /// Whether the pressure is constant on each row's support (LAC's macro-elements)
     /// rather than linear between body-1 nodes.
     pub fn piecewise_constant_pressure(self) -> bool {
         self == Method::Lac
-    }
-    /// Lemma 3.1's exponents of the consistency error in the slave's and the master's mesh
-    /// sizes (h1, h2), the meshes refined independently: K_h^pi h1^(3/4) + h2, K_h^I
-    /// h1^(1/2) (from (h1^(1/2) ||e||)^(1/2) with ||e|| bounded) + h2^(3/4). LAC is held
-    /// to mortar's exponents (the paper's lemma does not cover it; see `theorem_rate`).
-    pub fn lemma_exponents(self) -> [f64; 2] {
-        match self {
-            Method::Mortar | Method::Lac => [0.75, 1.0],
-            Method::Nts => [0.5, 0.75],
-        }
     }
     /// Parse "mortar", "nts" or "lac".
     pub fn parse(s: &str) -> Option<Self> {

@@ -353,9 +353,24 @@ fn study_file_errors_through_the_binary() {
             vec!["study.toml", "methods", "unknown method 'penalty'"],
         ),
         (
-            // lac listed, its required rate not given: Theorem 3.1 does not give one.
-            Box::new(|t| t.replace("lac = 0.75\n", "")),
-            vec!["study.toml", "thresholds.lac", "lac = 0.75"],
+            // lac listed, its threshold entry not given: Theorem 3.1 does not give one.
+            Box::new(|t| {
+                t.lines()
+                    .filter(|l| !l.starts_with("lac = "))
+                    .collect::<Vec<_>>()
+                    .join("\n")
+            }),
+            vec!["study.toml", "thresholds.lac", "lac = { none ="],
+        ),
+        (
+            // A threshold entry with a mistyped key.
+            Box::new(|t| t.replace("lac = { none =", "lac = { nne =")),
+            vec!["study.toml", "thresholds.lac", "unknown key `nne`"],
+        ),
+        (
+            // Both a rate and a reason for none.
+            Box::new(|t| t.replace("lac = { none =", "lac = { rate = 1.0, none =")),
+            vec!["study.toml", "thresholds.lac", "not both"],
         ),
         (
             // Found while planning, before the first solve.

@@ -53,18 +53,97 @@ pub struct ReferenceSpec {
     pub quadrature: usize,
 }
 
-/// Rate thresholds of Theorem 3.1 for the `theorem` quantity.
+/// One method's entry in `[thresholds]`: the rate in h the theorem that covers the method
+/// on this study states, with where it comes from, or no rate and why no theorem covers it
+/// here. Written `mortar = 0.75` (a rate, no source), `mortar = { rate = 0.75, source =
+/// "..." }` or `lac = { none = "why" }`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(try_from = "ClaimFile")]
+pub struct Claim {
+    /// The theorem's rate in h of the threshold quantity (None: the method is reported
+    /// without a threshold).
+    pub rate: Option<f64>,
+    /// The theorem and its hypotheses, or why none applies; empty for a bare rate.
+    pub source: String,
+}
+
+/// How a [`Claim`] is written in a study file.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum ClaimFile {
+    Rate(f64),
+    Table(BTreeMap<String, toml::Value>),
+}
+
+impl TryFrom<ClaimFile> for Claim {
+    type Error = String;
+    fn try_from(c: ClaimFile) -> std::result::Result<Self, String> {
+        let table = match c {
+            ClaimFile::Rate(rate) => {
+                return Ok(Claim {
+                    rate: Some(rate),
+                    source: String::new(),
+                });
+            }
+            ClaimFile::Table(t) => t,
+        };
+        let text = |key: &str| -> std::result::Result<Option<String>, String> {
+            match table.get(key) {
+                None => Ok(None),
+                Some(toml::Value::String(s)) => Ok(Some(s.clone())),
+                Some(v) => Err(format!(
+                    "`{key}` must be a string (its source or reason), got {v}"
+                )),
+            }
+        };
+        if let Some(k) = table
+            .keys()
+            .find(|k| !["rate", "source", "none"].contains(&k.as_str()))
+        {
+            return Err(format!(
+                "unknown key `{k}`: a method's threshold is a rate (0.75), {{ rate = 0.75, source = \"...\" }} or {{ none = \"why no theorem covers it here\" }}"
+            ));
+        }
+        let rate = match table.get("rate") {
+            None => None,
+            Some(toml::Value::Float(v)) => Some(*v),
+            Some(toml::Value::Integer(v)) => Some(*v as f64),
+            Some(v) => return Err(format!("`rate` must be a number (a rate in h), got {v}")),
+        };
+        match (rate, text("source")?, text("none")?) {
+            (Some(rate), source, None) => Ok(Claim {
+                rate: Some(rate),
+                source: source.unwrap_or_default(),
+            }),
+            (None, None, Some(why)) => Ok(Claim {
+                rate: None,
+                source: why,
+            }),
+            (Some(_), _, Some(_)) => Err(
+                "give either `rate` (with its `source`) or `none` (why no theorem covers the method here), not both".into(),
+            ),
+            _ => Err(
+                "give `rate` (with its `source`) or `none = \"why no theorem covers the method here\"`".into(),
+            ),
+        }
+    }
+}
+
+/// The thresholds of the study's threshold quantity (`theorem` by default), each method's
+/// from the theorem that states it within its hypotheses ([`Claim`]).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ThresholdSpec {
-    /// Required rate for mortar (K_h^pi).
-    pub mortar: f64,
-    /// Required rate for nts (K_h^I).
-    pub nts: f64,
-    /// Required rate for lac (LAC); required when the study lists lac. Theorem 3.1 does not
-    /// cover LAC: the study files hold it to mortar's rate, the claim of Drouet and Hild.
+    /// Mortar (K_h^pi): Theorem 3.1's 3/4 where it applies.
     #[serde(default)]
-    pub lac: Option<f64>,
+    pub mortar: Option<Claim>,
+    /// Nts (K_h^I): Theorem 3.1's 1/2 where it applies.
+    #[serde(default)]
+    pub nts: Option<Claim>,
+    /// LAC: not covered by Theorem 3.1; Drouet and Hild's estimate where its hypotheses
+    /// hold, else `none`.
+    #[serde(default)]
+    pub lac: Option<Claim>,
     /// Allowed shortfall below each rate (at most 0.05).
     pub tolerance: f64,
     /// Methods that must reproduce the reference exactly (e.g. mortar on the patch scene):
@@ -94,17 +173,46 @@ fn default_threshold_quantity() -> Quantity {
 pub use super::judge::Threshold;
 
 impl ThresholdSpec {
-    /// The threshold of `method`'s `theorem` error.
-    pub fn of(&self, method: Method) -> Threshold {
+    /// The entry of `method` (None where the file gives none).
+    pub fn claim(&self, method: Method) -> Option<&Claim> {
+        match method {
+            Method::Mortar => self.mortar.as_ref(),
+            Method::Nts => self.nts.as_ref(),
+            Method::Lac => self.lac.as_ref(),
+        }
+    }
+
+    /// The threshold of `method`'s error in the threshold quantity: exactness for the
+    /// `exact` methods, else the claim's rate minus the tolerance; None where the method
+    /// is reported without one (`none`, or no entry).
+    pub fn of(&self, method: Method) -> Option<Threshold> {
         if self.exact.contains(&method) {
-            Threshold::Exact(self.exact_tolerance)
-        } else {
-            let required = match method {
-                Method::Mortar => self.mortar,
-                Method::Nts => self.nts,
-                Method::Lac => self.lac.unwrap_or(self.mortar),
-            };
-            Threshold::Rate(required - self.tolerance)
+            return Some(Threshold::Exact(self.exact_tolerance));
+        }
+        let rate = self.claim(method)?.rate?;
+        Some(Threshold::Rate(rate - self.tolerance))
+    }
+
+    /// What the study holds `method` to, for reports: "h^r (source), threshold t" or
+    /// "exact to t", or "no threshold: why".
+    pub fn describe(&self, method: Method) -> String {
+        if self.exact.contains(&method) {
+            return format!("exact to {:.0e}", self.exact_tolerance);
+        }
+        match self.claim(method) {
+            Some(Claim {
+                rate: Some(r),
+                source,
+            }) => {
+                let from = if source.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({source})")
+                };
+                format!("h^{r}{from}, threshold {:.2}", r - self.tolerance)
+            }
+            Some(Claim { rate: None, source }) => format!("no threshold: {source}"),
+            None => "no threshold".into(),
         }
     }
 }
@@ -142,6 +250,46 @@ pub struct TwoSizeSpec {
     /// The diagonal study on the same family (its report under reports/), whose errors the
     /// grid's equal-level pairs (the same meshes) are compared with in the report.
     pub diagonal: Option<String>,
+    /// Each method's exponents of its consistency error in the slave's and the master's
+    /// mesh size, from the lemma that states them (none for a method no lemma covers).
+    #[serde(default)]
+    pub exponents: ExponentSpec,
+}
+
+/// A method's consistency exponents in (h1, h2), the slave's and the master's mesh size,
+/// with their source.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Exponents {
+    /// Exponent of the slave's size h1.
+    pub slave: f64,
+    /// Exponent of the master's size h2.
+    pub master: f64,
+    /// The lemma and its hypotheses.
+    pub source: String,
+}
+
+/// The `[two_size.exponents]` table: one entry per method a lemma covers.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExponentSpec {
+    /// Mortar (K_h^pi).
+    pub mortar: Option<Exponents>,
+    /// Nts (K_h^I).
+    pub nts: Option<Exponents>,
+    /// LAC.
+    pub lac: Option<Exponents>,
+}
+
+impl ExponentSpec {
+    /// The exponents of `method`, if the file gives them.
+    pub fn of(&self, method: Method) -> Option<&Exponents> {
+        match method {
+            Method::Mortar => self.mortar.as_ref(),
+            Method::Nts => self.nts.as_ref(),
+            Method::Lac => self.lac.as_ref(),
+        }
+    }
 }
 
 /// A study file.
@@ -269,14 +417,17 @@ impl StudyFile {
                 "steps must be at least 1 (the time step k must be positive)".into(),
             );
         }
-        if self.methods.contains(&Method::Lac)
-            && self.thresholds.lac.is_none()
-            && !self.thresholds.exact.contains(&Method::Lac)
+        if let Some(m) = self
+            .methods
+            .iter()
+            .find(|&&m| self.thresholds.claim(m).is_none() && !self.thresholds.exact.contains(&m))
         {
             return bad(
                 path,
-                "thresholds.lac",
-                "the study lists lac: give its required rate (lac = 0.75 holds it to mortar's) or list it in thresholds.exact".into(),
+                &format!("thresholds.{m}"),
+                format!(
+                    "the study lists {m}: give the rate the theorem covering it here states, with its source ({m} = {{ rate = 0.75, source = \"...\" }}), say why none applies ({m} = {{ none = \"...\" }}), or list it in thresholds.exact"
+                ),
             );
         }
         let both = self.methods.contains(&Method::Mortar)

@@ -42,11 +42,6 @@ impl MethodLabel {
             MethodLabel::External(_) => None,
         }
     }
-    /// Theorem 3.1's rate in h of the theorem norm ([`Method::theorem_rate`]); none for a
-    /// code from outside, whose discretization the theorem does not name.
-    pub fn theorem_rate(&self) -> Option<f64> {
-        self.cone().map(Method::theorem_rate)
-    }
 }
 
 impl From<Method> for MethodLabel {

@@ -819,7 +819,7 @@ fn fit_rates(
     let threshold = |m: &MethodLabel, q: Quantity| {
         m.cone()
             .filter(|_| q == sf.thresholds.quantity)
-            .map(|c| sf.thresholds.of(c))
+            .and_then(|c| sf.thresholds.of(c))
     };
     let rules = Rules {
         truth_error,

@@ -652,7 +652,7 @@ fn rates_text() -> String {
         WINDOW_SPREAD, ZERO_RATE_STDERRS,
     };
     format!(
-        "Least-squares slope of log(error) against log(h) over the levels used (± standard error), rate against dofs, and successive rates between neighbouring levels, judged by the rules of docs/studies.md#rates on the judged rates (between levels at least {MIN_RATE_SPAN}x apart in h: neighbours of a halving table). A rate never overstates: errors at round-off (<= {ROUNDOFF:.0e}, the solvers' tolerance) are marked and never fitted (their successive rates are `-`), levels within {TRUTH_MARGIN}x of the truth's own error in that quantity are left out, and a rate needs at least {MIN_FIT_LEVELS} levels. A quantity whose last two judged rates average at most {STALLED}, or whose last is negative, does not converge, and so does one whose fitted rate lies within {ZERO_RATE_STDERRS} standard errors of 0. Where the last three judged rates are strictly monotone and differ by more than {TREND} end to end, the rate is `falling` or `rising` (in transition): no rate is claimed, the last judged rate is given. Otherwise the levels used are the longest trailing window (at least {MIN_FIT_LEVELS} levels) whose judged rates lie within {WINDOW_SPREAD} of each other (`fitted`); without one the fit over every level is shown, flagged `pre-asymptotic`. Only `fitted` supports a rate. A threshold passes where the rate is fitted and both the fit and the last judged rate reach it, fails where the last judged rate is below it (for a falling rate, also its extrapolation to the finest level), and is `unverified` otherwise; only a failure makes the study exit non-zero. A contact resultant fixed by equilibrium is named so and never fitted. Beside the fit, the conventions of ASME V&V 20 (Celik et al. 2008, J. Fluids Eng. 130, 078001) on the last three levels: the observed order p (non-uniform ratio, fixed-point iteration), oscillatory convergence named, the GCI of the finest level (safety factor {GCI_SAFETY} at the observed order, in the units of the error) and the asymptotic ratio GCI_coarse / (r^p GCI_fine) at the rate in h printed (1 where that rate describes the last three levels; at the observed order it would be 1 by construction). The `theorem` quantity is max_n (||u - u_ref||_H1 + ||sigma - sigma_ref||_L2) over both bodies, relative to the reference's; Theorem 3.1 predicts h^(3/4) for mortar (K_h^pi) and h^(1/2) for nts (K_h^I); it does not cover lac (LAC), which the study files hold to mortar's h^(3/4), the order Drouet and Hild prove for it."
+        "Least-squares slope of log(error) against log(h) over the levels used (± standard error), rate against dofs, and successive rates between neighbouring levels, judged by the rules of docs/studies.md#rates on the judged rates (between levels at least {MIN_RATE_SPAN}x apart in h: neighbours of a halving table). A rate never overstates: errors at round-off (<= {ROUNDOFF:.0e}, the solvers' tolerance) are marked and never fitted (their successive rates are `-`), levels within {TRUTH_MARGIN}x of the truth's own error in that quantity are left out, and a rate needs at least {MIN_FIT_LEVELS} levels. A quantity whose last two judged rates average at most {STALLED}, or whose last is negative, does not converge, and so does one whose fitted rate lies within {ZERO_RATE_STDERRS} standard errors of 0. Where the last three judged rates are strictly monotone and differ by more than {TREND} end to end, the rate is `falling` or `rising` (in transition): no rate is claimed, the last judged rate is given. Otherwise the levels used are the longest trailing window (at least {MIN_FIT_LEVELS} levels) whose judged rates lie within {WINDOW_SPREAD} of each other (`fitted`); without one the fit over every level is shown, flagged `pre-asymptotic`. Only `fitted` supports a rate. A threshold passes where the rate is fitted and both the fit and the last judged rate reach it, fails where the last judged rate is below it (for a falling rate, also its extrapolation to the finest level), and is `unverified` otherwise; only a failure makes the study exit non-zero. A contact resultant fixed by equilibrium is named so and never fitted. Beside the fit, the conventions of ASME V&V 20 (Celik et al. 2008, J. Fluids Eng. 130, 078001) on the last three levels: the observed order p (non-uniform ratio, fixed-point iteration), oscillatory convergence named, the GCI of the finest level (safety factor {GCI_SAFETY} at the observed order, in the units of the error) and the asymptotic ratio GCI_coarse / (r^p GCI_fine) at the rate in h printed (1 where that rate describes the last three levels; at the observed order it would be 1 by construction). The `theorem` quantity is max_n (||u - u_ref||_H1 + ||sigma - sigma_ref||_L2) over both bodies, relative to the reference's; Theorem 3.1 predicts h^(3/4) for mortar (K_h^pi) and h^(1/2) for nts (K_h^I) where u is in H^2; it does not cover lac (LAC). Each method's threshold, with the theorem it comes from and its hypotheses, is the study file's (below)."
     )
 }
 
@@ -693,7 +693,20 @@ fn rates_table(doc: &mut Doc, res: &StudyResult) {
             }),
         ]);
     }
-    doc.heading(2, "Rates").paragraph(rates_text()).table(&table);
+    doc.heading(2, "Rates").paragraph(rates_text());
+    let held: Vec<String> = res
+        .file
+        .methods
+        .iter()
+        .map(|&m| format!("{m}: {}", res.file.thresholds.describe(m)))
+        .collect();
+    doc.paragraph(format!(
+        "Thresholds on `{}` (tolerance {}), from the study file: {}.",
+        res.file.thresholds.quantity,
+        res.file.thresholds.tolerance,
+        held.join("; ")
+    ))
+    .table(&table);
 }
 
 /// ## Errors: per cone and level, the mesh, the errors that matter most and the solve.

@@ -76,6 +76,18 @@ pub(crate) const SEPARATES: f64 = 1.5;
 /// An nts rate within this of 1/2 attains K_h^I's h^(1/2).
 pub(crate) const NEAR_HALF: f64 = 0.15;
 
+/// What the study file held a rates.csv row to and the outcome: "threshold 0.70: pass",
+/// "exact to 1e-9: pass", or "no threshold" (none on this quantity, or none the theorems
+/// give the method on this study).
+pub(crate) fn held_to(r: &RateRecord) -> String {
+    match (r.threshold, r.pass) {
+        // An exactness bound is a relative error, far below any rate threshold.
+        (Some(t), Some(p)) if t > 0.0 && t < 1e-3 => format!("exact to {t:.0e}: {}", p.name()),
+        (Some(t), Some(p)) => format!("threshold {t:.2}: {}", p.name()),
+        _ => "no threshold".into(),
+    }
+}
+
 /// "0.981 ± 0.005 (fitted, levels 0 1 2 3 4 5)" where the verdict supports a rate, else
 /// the verdict with the last successive rate ("falling, last successive rate 0.557").
 pub(crate) fn rate_text(r: &RateRecord) -> String {
@@ -319,11 +331,11 @@ pub(crate) fn study_section(doc: &mut Doc, dir: &Path, name: &str, what: &str) -
         .filter_map(|&m| {
             report
                 .rate(m, Quantity::Theorem)
-                .map(|r| format!("{m} {}, {}", rate_text(r), m.rate_claim()))
+                .map(|r| format!("{m} {} ({})", rate_text(r), held_to(r)))
         })
         .collect();
     if !theorem.is_empty() {
-        doc.bullet(format!("Theorem 3.1 norm: {}.", theorem.join("; ")));
+        doc.bullet(format!("Theorem 3.1's norm: {}.", theorem.join("; ")));
     }
     plasticity_and_time(doc, dir)?;
     doc.bullet(format!(

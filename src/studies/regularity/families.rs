@@ -8,8 +8,8 @@ use crate::error::Result;
 use crate::report::markdown::{Doc, Table};
 use crate::studies::convergence::StudyResult;
 use crate::verify::quantity::Quantity;
-use crate::verify::judge::{levels_of, levels_of_errors};
-use crate::verify::rates::{Assessment, LevelError, Verdict, assess, short_text};
+use crate::verify::judge::{Threshold, levels_of, levels_of_errors};
+use crate::verify::rates::{Assessment, LevelError, Outcome, Verdict, assess, short_text};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -58,6 +58,32 @@ pub struct ParityRow {
     pub stderr: Option<f64>,
     /// The last successive rate.
     pub last_rate: Option<f64>,
+    /// The member's threshold on this quantity for this cone (rate threshold), applied to
+    /// this parity's levels as to the whole: c's position alternates with the level, so a
+    /// rate must hold on each parity alone. Empty without one.
+    #[serde(default)]
+    pub threshold: Option<f64>,
+    /// What the threshold makes of this parity's errors.
+    #[serde(default)]
+    pub pass: Option<Outcome>,
+}
+
+impl ParityRow {
+    /// The sentence of a threshold this parity failed (None: it did not fail or has none).
+    pub fn failure(&self) -> Option<String> {
+        (self.pass == Some(Outcome::Fail)).then(|| {
+            format!(
+                "{} {} on {:?} levels: last judged rate {} < {:.3} ({})",
+                self.method,
+                self.quantity,
+                self.levels,
+                crate::io::fmt3(self.last_rate.unwrap_or(f64::NAN)),
+                self.threshold.unwrap_or(f64::NAN),
+                self.verdict.name()
+            )
+            .to_lowercase()
+        })
+    }
 }
 
 /// `res`'s errors of cone `m` in `q` on the levels `keep` admits, judged against the exact
@@ -117,6 +143,18 @@ pub fn parity_rows(reg: &Regularity, quantities: &[Quantity]) -> Vec<ParityRow> 
                         continue;
                     };
                     let fit = a.fit.filter(|_| a.verdict == Verdict::Fitted);
+                    let threshold = res
+                        .rates
+                        .iter()
+                        .find(|r| r.method.cone() == Some(m) && r.quantity == q)
+                        .and_then(|r| r.threshold);
+                    let pass = match (threshold, levels) {
+                        // The whole's outcome is rates.csv's; a parity's is judged here.
+                        (Some(t @ Threshold::Rate(_)), Levels::Even | Levels::Odd) => {
+                            Some(t.outcome(&a, f64::NAN))
+                        }
+                        _ => None,
+                    };
                     rows.push(ParityRow {
                         beta: *beta,
                         method: m,
@@ -126,6 +164,8 @@ pub fn parity_rows(reg: &Regularity, quantities: &[Quantity]) -> Vec<ParityRow> 
                         rate: fit.map(|f| f.rate),
                         stderr: fit.map(|f| f.stderr),
                         last_rate: a.last_rate(),
+                        threshold: pass.and(threshold).map(Threshold::value),
+                        pass,
                     });
                 }
             }

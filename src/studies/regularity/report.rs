@@ -587,10 +587,19 @@ impl KindOutcome for Regularity {
     }
 
     fn failures(&self) -> Vec<String> {
-        self.members
+        let mut out: Vec<String> = self
+            .members
             .iter()
             .flat_map(|(beta, res)| res.failures().into_iter().map(move |f| format!("beta = {beta}: {f}")))
-            .collect()
+            .collect();
+        if self.family.parity {
+            out.extend(
+                super::families::parity_rows(self, &QUANTITIES)
+                    .iter()
+                    .filter_map(|r| Some(format!("beta = {}: {}", r.beta, r.failure()?))),
+            );
+        }
+        out
     }
 
     fn unverified(&self) -> Vec<String> {

@@ -134,9 +134,15 @@ pub struct TwoSizeResult {
     pub steps: usize,
     /// The quantity the thresholds apply to.
     pub threshold_quantity: Quantity,
-    /// The required a1 of mortar, nts and lac, in [`Method::ALL`]'s order (rate threshold
-    /// minus tolerance).
-    pub thresholds: [f64; 3],
+    /// The required a1 of mortar, nts and lac, in [`Method::ALL`]'s order (the study
+    /// file's rate minus its tolerance; None: reported without a threshold).
+    pub thresholds: [Option<f64>; 3],
+    /// What the study file holds each method to, in [`Method::ALL`]'s order
+    /// ([`crate::verify::study_file::ThresholdSpec::describe`]).
+    pub threshold_claims: [String; 3],
+    /// Each method's consistency exponents (h1, h2) from the study file, in
+    /// [`Method::ALL`]'s order, with their source (None: no lemma covers it).
+    pub exponents: [Option<crate::verify::study_file::Exponents>; 3],
     /// Every measured pair.
     pub points: Vec<SizePoint>,
     /// Every fit.
@@ -167,7 +173,7 @@ impl TwoSizeResult {
                 let x = f
                     .fit
                     .filter(|x| rates::fit_identifies(x.se[0], x.rms_log_residual))?;
-                let need = self.thresholds[Method::ALL.iter().position(|&m| m == f.method).expect("a method")];
+                let need = self.threshold(f.method)?;
                 (x.a[0] < need).then(|| {
                     format!(
                         "slave {} {} {}: a1 = {:.3} < {need:.3}",
@@ -176,6 +182,18 @@ impl TwoSizeResult {
                 })
             })
             .collect()
+    }
+
+    /// The required a1 of `method` (None: no threshold).
+    pub fn threshold(&self, method: Method) -> Option<f64> {
+        self.thresholds[index(method)]
+    }
+
+    /// The consistency exponents (h1, h2) of `method` the study file gives.
+    pub fn exponents(&self, method: Method) -> Option<[f64; 2]> {
+        self.exponents[index(method)]
+            .as_ref()
+            .map(|e| [e.slave, e.master])
     }
 
     /// The points of one slave choice, cone and quantity.
@@ -362,7 +380,9 @@ pub fn run(name: &str) -> Result<TwoSizeResult> {
         quantities: sf.quantities.clone(),
         steps: sf.steps,
         threshold_quantity: sf.thresholds.quantity,
-        thresholds: Method::ALL.map(|m| sf.thresholds.of(m).value()),
+        thresholds: Method::ALL.map(|m| sf.thresholds.of(m).map(|t| t.value())),
+        threshold_claims: Method::ALL.map(|m| sf.thresholds.describe(m)),
+        exponents: Method::ALL.map(|m| spec.exponents.of(m).cloned()),
         diagonal: spec.diagonal.clone(),
         slaves,
         points,
@@ -565,4 +585,12 @@ fn fit(
         terms,
         gain_per_dof,
     })
+}
+
+/// The position of `method` in [`Method::ALL`].
+fn index(method: Method) -> usize {
+    Method::ALL
+        .iter()
+        .position(|&m| m == method)
+        .expect("every method is in Method::ALL")
 }

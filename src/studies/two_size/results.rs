@@ -50,11 +50,15 @@ fn two_size_section(doc: &mut Doc, dir: &Path, name: &str, what: &str) -> Result
     };
     let mut slaves: Vec<&str> = fits.iter().map(|f| f.slave.as_str()).collect();
     slaves.dedup();
+    // The expected exponents as the study file gave them (fits.csv's columns).
     let lemma: Vec<String> = CONES
         .iter()
-        .map(|m| {
-            let [a1, a2] = m.lemma_exponents();
-            format!("{m} ({a1}, {a2})")
+        .filter_map(|&m| {
+            let f = fits.iter().find(|f| f.method == m)?;
+            Some(match (f.expected_a1, f.expected_a2) {
+                (Some(a1), Some(a2)) => format!("{m} ({a1}, {a2})"),
+                _ => format!("{m} none stated"),
+            })
         })
         .collect();
     for slave in &slaves {
@@ -71,7 +75,7 @@ fn two_size_section(doc: &mut Doc, dir: &Path, name: &str, what: &str) -> Result
             })
             .collect();
         doc.bullet(format!(
-            "Theorem norm, E = C1 h1^a1 + C2 h2^a2 with slave '{slave}' (Lemma 3.1: {}): {}.",
+            "Theorem norm, E = C1 h1^a1 + C2 h2^a2 with slave '{slave}' (expected, from the study file: {}): {}.",
             lemma.join(", "),
             parts.join("; ")
         ));
