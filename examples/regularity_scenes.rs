@@ -77,7 +77,7 @@ scene = "{scene}"
 methods = ["mortar", "nts", "lac"]
 solver = "newton"
 steps = 1
-quantities = ["theorem", "h1_u", "l2_stress", "band_stress", "l2_pressure", "cone_distance"]
+quantities = ["theorem", "h1_u", "l2_stress", "band_stress", "l2_pressure", "best_l2_pressure", "cone_distance"]
 
 [mesh]
 size_parameter_1 = "h_upper"

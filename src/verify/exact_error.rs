@@ -6,7 +6,8 @@
 //! `abs` changing branch) is split along it and the rule applied on each piece, as the
 //! loads are ([`crate::quadrature::triangle_rule`]): one implementation for both.
 
-use super::field::{P1Field, PressureProfile};
+use super::field::{P1Field, PressureProfile, PressureSpace};
+use super::pressure_l2::{self, SegmentPressure, along};
 use super::norms::SquaredNorms;
 use crate::analytical::Exact;
 use crate::contact::Interface;
@@ -116,7 +117,7 @@ pub struct ExactDifference {
 /// part) at a singular point: the smooth rest times the smooth rest (power 0), the cross
 /// terms (power gamma), the singular parts' product (power 2 gamma).
 #[derive(Debug, Clone, Copy)]
-enum Split {
+pub enum Split {
     /// The whole product (no singular point, or a triangle away from it).
     Whole,
     /// (a - a_s)(b - b_s).
@@ -139,7 +140,8 @@ const SPLIT_PARTS: [(Option<Split>, Option<Split>); 5] = [
 ];
 
 impl Split {
-    fn product(self, (a, a_s): (f64, f64), (b, b_s): (f64, f64)) -> f64 {
+    /// The part `self` of the product a b, each factor as (whole, singular part).
+    pub fn product(self, (a, a_s): (f64, f64), (b, b_s): (f64, f64)) -> f64 {
         match self {
             Split::Whole => a * b,
             Split::Smooth => (a - a_s) * (b - b_s),
@@ -148,13 +150,14 @@ impl Split {
         }
     }
 
-    fn square(self, a: f64, a_s: f64) -> f64 {
+    /// The part `self` of a^2 (a's singular part a_s).
+    pub fn square(self, a: f64, a_s: f64) -> f64 {
         self.product((a, a_s), (a, a_s))
     }
 
     /// `w` times [`Split::square`]; the whole one as (w a) a, the order the exact norms have
     /// always been summed in, so that scenes without a singular part keep their digits.
-    fn weighted_square(self, w: f64, a: f64, a_s: f64) -> f64 {
+    pub fn weighted_square(self, w: f64, a: f64, a_s: f64) -> f64 {
         match self {
             Split::Whole => w * a * a,
             _ => w * self.square(a, a_s),
@@ -312,49 +315,33 @@ impl<'a> ExactComparison<'a> {
         pressure: &PressureProfile,
         t: f64,
     ) -> (f64, f64) {
-        let (mut diff, mut norm) = (0.0, 0.0);
         let kinks = kink_functions(&self.exact.contact_kinks(), t);
-        let singular = self.exact.singular.as_ref();
+        let (mut diff, mut norm) = (0.0, 0.0);
         for (piece, profile) in interface.pieces.iter().zip(pressure) {
-            for w in profile.windows(2) {
-                let ((xa, pa), (xb, pb)) = (w[0], w[1]);
-                if xa == xb {
-                    continue; // a jump of a piecewise-constant pressure: no length
-                }
-                // A segment with the singular point inside is split there (p_h linear).
-                let split = singular
-                    .and_then(|sg| interior_fraction(xa, xb, sg.point).map(|q| (sg.point, q)));
-                let parts = match split {
-                    Some((c, q)) => {
-                        let pc = pa + q * (pb - pa);
-                        vec![((xa, pa), (c, pc)), ((c, pc), (xb, pb))]
-                    }
-                    None => vec![((xa, pa), (xb, pb))],
-                };
-                for (a, b) in parts {
-                    self.segment_pressure(piece.normal, a, b, &kinks, t, (&mut diff, &mut norm));
-                }
-            }
+            let on = ExactOnPiece { cmp: self, normal: piece.normal, kinks: &kinks, t };
+            let (d, n) = pressure_l2::piece_difference(&on, profile, (diff, norm));
+            (diff, norm) = (d, n);
         }
         (diff, norm)
     }
 
-    /// Add (int (p_h - p)^2, int p^2) over one segment a -> b of Gamma_C with outward normal
-    /// `n` to `sums` (point by point, as one running sum over Gamma_C), p_h linear between
-    /// its ends' values; a segment from the singular point splits
-    /// p = p_rest + p_s (p_s ~ r^(beta-1)) and integrates the three parts of each square by
-    /// their own Gauss-Jacobi rules.
-    fn segment_pressure(
+    /// The exact pressure's quadrature on one segment a -> b of Gamma_C with outward normal
+    /// `n` at time `t`: `visit(q, w, p, p_s, part)` at each point a + q (b - a), w its
+    /// weight times the length, p the exact pressure and p_s its singular part, `part` which
+    /// part of a product the rule takes ([`Split`]). Away from the singular point one rule
+    /// takes the whole product (split at the pressure's kinks); a segment from the singular
+    /// point splits p = p_rest + p_s (p_s ~ r^(beta-1)) and each part of a product has its
+    /// own Gauss-Jacobi rule.
+    fn segment_points(
         &self,
         n: [f64; 2],
-        (xa, pa): ([f64; 2], f64),
-        (xb, pb): ([f64; 2], f64),
+        xa: [f64; 2],
+        xb: [f64; 2],
         kinks: &[crate::expr::KinkFunction],
         t: f64,
-        (diff, norm): (&mut f64, &mut f64),
+        visit: &mut dyn FnMut(f64, f64, f64, f64, Split),
     ) {
         let len = (xb[0] - xa[0]).hypot(xb[1] - xa[1]);
-        let at = |q: f64| [xa[0] + q * (xb[0] - xa[0]), xa[1] + q * (xb[1] - xa[1])];
         let exact_at = |x: [f64; 2]| self.exact.pressure_at(n, x[0], x[1], t).unwrap_or(f64::NAN);
         let from_point = self.exact.singular.as_ref().and_then(|sg| {
             let is_c = |x: [f64; 2]| sg.distance(x[0], x[1]) <= 1e-12 * len;
@@ -362,10 +349,7 @@ impl<'a> ExactComparison<'a> {
         });
         let Some((sg, reversed)) = from_point else {
             for &(q, wq) in quadrature::segment_rule(xa, xb, kinks, &self.segment).iter() {
-                let exact = exact_at(at(q));
-                let ph = pa + q * (pb - pa);
-                *diff += wq * len * (ph - exact).powi(2);
-                *norm += wq * len * exact * exact;
+                visit(q, wq * len, exact_at(along(xa, xb, q)), 0.0, Split::Whole);
             }
             return;
         };
@@ -381,25 +365,66 @@ impl<'a> ExactComparison<'a> {
         ] {
             for (r, wq) in quadrature::singular::segment_from(alpha, points) {
                 let q = if reversed { 1.0 - r } else { r };
-                let x = at(q);
-                let (exact, ps) = (exact_at(x), singular_at(x));
-                let ph = pa + q * (pb - pa);
-                *diff += wq * len * part.square(ph - exact, -ps);
-                *norm += wq * len * part.square(exact, ps);
+                let x = along(xa, xb, q);
+                visit(q, wq * len, exact_at(x), singular_at(x), part);
             }
         }
     }
+
+    /// The best approximation of the exact pressure at time `t` in the space of `profile`
+    /// ([`PressureSpace`]): its L2(Gamma_C) projection, as a profile on the same points
+    /// ([`pressure_l2::piece_projection`]).
+    pub fn best_pressure(
+        &self,
+        interface: &Interface,
+        profile: &PressureProfile,
+        space: PressureSpace,
+        t: f64,
+    ) -> PressureProfile {
+        let kinks = kink_functions(&self.exact.contact_kinks(), t);
+        interface
+            .pieces
+            .iter()
+            .zip(profile)
+            .map(|(piece, points)| {
+                let on = ExactOnPiece { cmp: self, normal: piece.normal, kinks: &kinks, t };
+                let x: Vec<[f64; 2]> = points.iter().map(|p| p.0).collect();
+                let values = pressure_l2::piece_projection(&on, &x, space);
+                x.into_iter().zip(values).collect()
+            })
+            .collect()
+    }
+
+    /// ||Pi p - p||^2 in L2(Gamma_C) at time `t`, Pi the projection onto the space of
+    /// `profile` ([`ExactComparison::best_pressure`]).
+    pub fn best_pressure_error(
+        &self,
+        interface: &Interface,
+        profile: &PressureProfile,
+        space: PressureSpace,
+        t: f64,
+    ) -> f64 {
+        let best = self.best_pressure(interface, profile, space, t);
+        self.pressure_difference(interface, &best, t).0
+    }
 }
 
-/// Where `c` lies strictly inside the segment a -> b (within 1e-12 of its length of the
-/// segment, more than that from both ends): its fraction along the segment.
-fn interior_fraction(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> Option<f64> {
-    let ab = [b[0] - a[0], b[1] - a[1]];
-    let len2 = ab[0] * ab[0] + ab[1] * ab[1];
-    let q = ((c[0] - a[0]) * ab[0] + (c[1] - a[1]) * ab[1]) / len2;
-    let off = (a[0] + q * ab[0] - c[0]).hypot(a[1] + q * ab[1] - c[1]);
-    let tol = 1e-12;
-    (off <= tol * len2.sqrt() && q > tol && q < 1.0 - tol).then_some(q)
+/// The exact pressure on one straight piece of Gamma_C (outward normal `normal`) at time
+/// `t`, as the L2 integrals of [`pressure_l2`] read it.
+struct ExactOnPiece<'a> {
+    cmp: &'a ExactComparison<'a>,
+    normal: [f64; 2],
+    kinks: &'a [crate::expr::KinkFunction<'a>],
+    t: f64,
+}
+
+impl SegmentPressure for ExactOnPiece<'_> {
+    fn segment_points(&self, xa: [f64; 2], xb: [f64; 2], visit: &mut dyn FnMut(f64, f64, f64, f64, Split)) {
+        self.cmp.segment_points(self.normal, xa, xb, self.kinks, self.t, visit);
+    }
+    fn singular_point(&self) -> Option<[f64; 2]> {
+        self.cmp.exact.singular.as_ref().map(|sg| sg.point)
+    }
 }
 
 /// The exact pressure and gap along Gamma_C at time `t`, at 401 points per piece:

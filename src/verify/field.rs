@@ -29,6 +29,20 @@ pub struct P1Field<'a> {
     /// The contact pressure; `None` when the solution gives none (its pressure quantities
     /// are then not measured).
     pub pressure: Option<PressureProfile>,
+    /// The space the pressure lies in, between the profile's points.
+    pub pressure_space: PressureSpace,
+}
+
+/// The discrete space of a pressure profile: what its best approximation of a pressure is
+/// taken in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PressureSpace {
+    /// Continuous, linear between consecutive points (the nodal rows' pressure at the
+    /// body-1 trace nodes; a code's nodal pressure).
+    Linear,
+    /// Constant between the two points of each consecutive pair (LAC's pressure on its
+    /// macro-elements, written at each macro-element's two ends).
+    ConstantOnPairs,
 }
 
 /// Why a displacement field cannot be measured.
@@ -63,6 +77,10 @@ impl<'a> P1Field<'a> {
             u: Cow::Borrowed(&s.u),
             stress: Cow::Borrowed(&s.sigma),
             pressure: Some(pressure_profile(p, s)),
+            pressure_space: match p.method.piecewise_constant_pressure() {
+                true => PressureSpace::ConstantOnPairs,
+                false => PressureSpace::Linear,
+            },
         }
     }
 
@@ -121,6 +139,7 @@ impl<'a> P1Field<'a> {
             u: Cow::Owned(u),
             stress: Cow::Owned(stress),
             pressure,
+            pressure_space: PressureSpace::Linear,
         })
     }
 }

@@ -14,6 +14,7 @@ pub mod jobs;
 pub mod judge;
 pub mod kind;
 pub mod norms;
+pub mod pressure_l2;
 pub mod quantity;
 pub mod rates;
 pub mod study_file;

@@ -304,6 +304,7 @@ pub fn norms_of_difference(m: &Model, a: &P1Field, b: &P1Field) -> SquaredNorms 
             .map(|(x, y)| x - y)
             .collect(),
         pressure: None,
+        pressure_space: super::field::PressureSpace::Linear,
     };
     norms(m, &d)
 }

@@ -441,6 +441,13 @@ impl StudyFile {
                 ),
             );
         }
+        if self.quantities.contains(&Quantity::BestL2Pressure) && !self.reference.exact {
+            return bad(
+                path,
+                "quantities",
+                "'best_l2_pressure' projects the exact pressure onto each level's pressure space: measure against the exact solution (reference.exact = true) or leave it out".into(),
+            );
+        }
         if self.quantities.contains(&Quantity::Consistency) && !self.reference.exact {
             return bad(
                 path,
@@ -773,6 +780,7 @@ pub fn needs(q: Quantity) -> &'static [Field] {
         Quantity::MaxPenetration | Quantity::L2Penetration => &[],
         Quantity::L2Stress => &[Field::Stress],
         Quantity::L2Pressure
+        | Quantity::BestL2Pressure
         | Quantity::ContactEdge
         | Quantity::PressureResultant
         | Quantity::PressureWeighted

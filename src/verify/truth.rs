@@ -206,6 +206,22 @@ pub fn exact_errors(
         contact_length: interface.length(),
     };
     let (mut errors, scale) = (differences.relative(), differences.scale());
+    // The best approximation of the exact pressure in the solution's own pressure space,
+    // relative as l2_pressure (max over the steps).
+    let best: Option<Vec<f64>> = history
+        .steps
+        .par_iter()
+        .map(|s| {
+            let profile = s.pressure.as_ref()?;
+            Some(cmp.best_pressure_error(interface, profile, s.pressure_space, s.time))
+        })
+        .collect();
+    if let (Some(best), Some(size)) = (best, scale.pressure) {
+        let value = best.iter().map(|b| b.sqrt()).fold(0.0f64, f64::max);
+        if let Some(v) = crate::verify::rates::relative_to(value, size, scale.theorem) {
+            errors.insert(Quantity::BestL2Pressure, v);
+        }
+    }
     if exact.stress.is_some() {
         let term = history
             .steps

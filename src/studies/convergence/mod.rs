@@ -12,6 +12,7 @@
 //! 5. the rate in time on a fixed mesh;
 //! 6. the provenance.
 
+mod best_report;
 mod distance_report;
 mod lac_report;
 pub use lac_report::best_pressure_rate;

@@ -434,6 +434,7 @@ fn readme(res: &StudyResult) -> String {
     title(&mut doc, res);
     super::distance_report::lead(&mut doc, res);
     super::lac_report::section(&mut doc, res);
+    super::best_report::section(&mut doc, res);
     cones_compared(&mut doc, res);
     super::distance_report::section(&mut doc, res);
     doc.image("error against h", "error_vs_h.png");
