@@ -28,7 +28,11 @@ use nalgebra::{DMatrix, DVector};
 
 /// The least-squares fit of `p` on `points` in `space`, from the weighted sample matrix at
 /// `rule`'s points on every segment (pairs for constants), by QR.
-fn least_squares(points: &[[f64; 2]], space: PressureSpace, p: &dyn Fn([f64; 2]) -> f64) -> Vec<f64> {
+fn least_squares(
+    points: &[[f64; 2]],
+    space: PressureSpace,
+    p: &dyn Fn([f64; 2]) -> f64,
+) -> Vec<f64> {
     let rule = gauss_legendre(12);
     let n = points.len();
     let (mut rows, mut rhs) = (Vec::new(), Vec::new());
@@ -47,7 +51,9 @@ fn least_squares(points: &[[f64; 2]], space: PressureSpace, p: &dyn Fn([f64; 2])
     match space {
         PressureSpace::Linear => {
             for k in 0..n - 1 {
-                sample(points[k], points[k + 1], &|q| vec![(k, 1.0 - q), (k + 1, q)]);
+                sample(points[k], points[k + 1], &|q| {
+                    vec![(k, 1.0 - q), (k + 1, q)]
+                });
             }
         }
         PressureSpace::ConstantOnPairs => {
@@ -64,7 +70,10 @@ fn least_squares(points: &[[f64; 2]], space: PressureSpace, p: &dyn Fn([f64; 2])
     let a = DMatrix::from_fn(rows.len(), keep.len(), |r, c| rows[r][keep[c]]);
     let b = DVector::from_vec(rhs);
     let qr = a.qr();
-    let x = qr.r().solve_upper_triangular(&(qr.q().transpose() * b)).unwrap();
+    let x = qr
+        .r()
+        .solve_upper_triangular(&(qr.q().transpose() * b))
+        .unwrap();
     let mut out = vec![0.0; n];
     for (c, &i) in keep.iter().enumerate() {
         out[i] = x[c];
@@ -90,7 +99,11 @@ fn the_projection_is_the_least_squares_fit_on_a_polynomial_pressure() {
         let best = cmp.best_pressure(interface, &profile, field.pressure_space, state.time);
         for (piece, (points, projected)) in interface.pieces.iter().zip(profile.iter().zip(&best)) {
             let x: Vec<[f64; 2]> = points.iter().map(|p| p.0).collect();
-            let p = |y: [f64; 2]| exact.pressure_at(piece.normal, y[0], y[1], state.time).unwrap();
+            let p = |y: [f64; 2]| {
+                exact
+                    .pressure_at(piece.normal, y[0], y[1], state.time)
+                    .unwrap()
+            };
             let fit = least_squares(&x, field.pressure_space, &p);
             let scale = fit.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             let worst = projected
@@ -98,7 +111,10 @@ fn the_projection_is_the_least_squares_fit_on_a_polynomial_pressure() {
                 .zip(&fit)
                 .map(|(a, b)| (a.1 - b).abs() / scale)
                 .fold(0.0f64, f64::max);
-            println!("{method}: {} values, largest difference to least squares {worst:.2e} of {scale:.3e}", x.len());
+            println!(
+                "{method}: {} values, largest difference to least squares {worst:.2e} of {scale:.3e}",
+                x.len()
+            );
             assert!(worst < 1e-12, "{method}: {worst:e}");
         }
     }
@@ -109,12 +125,21 @@ fn the_projection_is_the_least_squares_fit_on_a_polynomial_pressure() {
 struct Power(f64);
 
 impl SegmentPressure for Power {
-    fn segment_points(&self, xa: [f64; 2], xb: [f64; 2], visit: &mut dyn FnMut(f64, f64, f64, f64, Split)) {
+    fn segment_points(
+        &self,
+        xa: [f64; 2],
+        xb: [f64; 2],
+        visit: &mut dyn FnMut(f64, f64, f64, f64, Split),
+    ) {
         let len = (xb[0] - xa[0]).hypot(xb[1] - xa[1]);
         let at = |q: f64| xa[0] + q * (xb[0] - xa[0]);
         let g = self.0;
         if xa[0] == 0.0 {
-            for (alpha, part) in [(0.0, Split::Smooth), (g, Split::Cross), (2.0 * g, Split::Singular)] {
+            for (alpha, part) in [
+                (0.0, Split::Smooth),
+                (g, Split::Cross),
+                (2.0 * g, Split::Singular),
+            ] {
                 for (q, w) in segment_from(alpha, 20) {
                     let p = at(q).powf(g);
                     visit(q, w * len, p, p, part);
@@ -157,11 +182,15 @@ fn best_constants_of_a_power_on_halving_cells_follow_the_closed_form() {
             let profile: Vec<([f64; 2], f64)> = points.into_iter().zip(values).collect();
             let e = piece_difference(&Power(g), &profile, (0.0, 0.0)).0.sqrt();
             let c = closed_form(g, level);
-            assert!((e - c).abs() <= 1e-9 * c, "g {g} level {level}: {e} against {c}");
+            assert!(
+                (e - c).abs() <= 1e-9 * c,
+                "g {g} level {level}: {e} against {c}"
+            );
             ours.push(e);
             exact.push(c);
         }
-        let rates = |e: &[f64]| -> Vec<f64> { e.windows(2).map(|w| (w[0] / w[1]).log2()).collect() };
+        let rates =
+            |e: &[f64]| -> Vec<f64> { e.windows(2).map(|w| (w[0] / w[1]).log2()).collect() };
         let (r, rc) = (rates(&ours), rates(&exact));
         println!("d^{g}: successive rates {:.4?} (closed form {:.4?})", r, rc);
         for (a, b) in r.iter().zip(&rc) {

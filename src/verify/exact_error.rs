@@ -7,8 +7,8 @@
 //! loads are ([`crate::quadrature::triangle_rule`]): one implementation for both.
 
 use super::field::{P1Field, PressureProfile, PressureSpace};
-use super::pressure_l2::{self, SegmentPressure, along};
 use super::norms::SquaredNorms;
+use super::pressure_l2::{self, SegmentPressure, along};
 use crate::analytical::Exact;
 use crate::contact::Interface;
 use crate::expr::{Expr, Program, compile, kink_functions};
@@ -318,7 +318,12 @@ impl<'a> ExactComparison<'a> {
         let kinks = kink_functions(&self.exact.contact_kinks(), t);
         let (mut diff, mut norm) = (0.0, 0.0);
         for (piece, profile) in interface.pieces.iter().zip(pressure) {
-            let on = ExactOnPiece { cmp: self, normal: piece.normal, kinks: &kinks, t };
+            let on = ExactOnPiece {
+                cmp: self,
+                normal: piece.normal,
+                kinks: &kinks,
+                t,
+            };
             let (d, n) = pressure_l2::piece_difference(&on, profile, (diff, norm));
             (diff, norm) = (d, n);
         }
@@ -387,7 +392,12 @@ impl<'a> ExactComparison<'a> {
             .iter()
             .zip(profile)
             .map(|(piece, points)| {
-                let on = ExactOnPiece { cmp: self, normal: piece.normal, kinks: &kinks, t };
+                let on = ExactOnPiece {
+                    cmp: self,
+                    normal: piece.normal,
+                    kinks: &kinks,
+                    t,
+                };
                 let x: Vec<[f64; 2]> = points.iter().map(|p| p.0).collect();
                 let values = pressure_l2::piece_projection(&on, &x, space);
                 x.into_iter().zip(values).collect()
@@ -419,8 +429,14 @@ struct ExactOnPiece<'a> {
 }
 
 impl SegmentPressure for ExactOnPiece<'_> {
-    fn segment_points(&self, xa: [f64; 2], xb: [f64; 2], visit: &mut dyn FnMut(f64, f64, f64, f64, Split)) {
-        self.cmp.segment_points(self.normal, xa, xb, self.kinks, self.t, visit);
+    fn segment_points(
+        &self,
+        xa: [f64; 2],
+        xb: [f64; 2],
+        visit: &mut dyn FnMut(f64, f64, f64, f64, Split),
+    ) {
+        self.cmp
+            .segment_points(self.normal, xa, xb, self.kinks, self.t, visit);
     }
     fn singular_point(&self) -> Option<[f64; 2]> {
         self.cmp.exact.singular.as_ref().map(|sg| sg.point)

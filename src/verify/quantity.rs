@@ -139,6 +139,12 @@ impl Quantity {
         Self::PRESSURE.contains(&self)
     }
 
+    /// Whether it measures the method's space rather than its solution (the best
+    /// approximation of the exact pressure): no comparison of methods reads it as an error.
+    pub fn is_best_approximation(self) -> bool {
+        self == Quantity::BestL2Pressure
+    }
+
     /// Whether it is a distance between the two cones.
     pub fn is_distance(self) -> bool {
         Self::DISTANCES.contains(&self)

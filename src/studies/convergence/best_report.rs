@@ -7,6 +7,7 @@
 use super::StudyResult;
 use crate::report::markdown::{Doc, Table};
 use crate::verify::quantity::Quantity;
+use crate::verify::rates::ROUNDOFF;
 
 /// The section, where the study measures `best_l2_pressure`.
 pub fn section(doc: &mut Doc, res: &StudyResult) {
@@ -30,7 +31,9 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
             .iter()
             .map(|&l| {
                 match (res.error(m, l, Quantity::L2Pressure), res.error(m, l, Quantity::BestL2Pressure)) {
-                    (Some(e), Some(b)) if b > 0.0 => format!("{:.2}", e / b),
+                    // A best at round-off (the space holds the exact pressure) has no
+                    // ratio worth printing.
+                    (Some(e), Some(b)) if b > ROUNDOFF => format!("{:.2}", e / b),
                     _ => "-".into(),
                 }
             })
@@ -50,6 +53,6 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
         ]);
     }
     doc.heading(2, "The pressure beside its best approximation")
-        .paragraph("Each method's pressure error in L2(Gamma_C) beside the error of the best approximation of the exact pressure in that method's own pressure space on the same level (its L2 projection, `best_l2_pressure`, relative as `l2_pressure`): no pressure in that space does better, so error / best >= 1, and a ratio that stays bounded from level to level is an error of the best approximation's order. The best approximation's own rate is judged by the same rules: a fit over rising successive rates is not its limit.")
+        .paragraph("Each method's pressure error in L2(Gamma_C) beside the error of the best approximation of the exact pressure in that method's own pressure space on the same level (its L2 projection, `best_l2_pressure`, relative as `l2_pressure`): no pressure in that space does better, so error / best >= 1, and a ratio that stays bounded from level to level is an error of the best approximation's order (`-` where the best is at round-off: the space holds the exact pressure). The best approximation's own rate is judged by the same rules: a fit over rising successive rates is not its limit.")
         .table(&table);
 }

@@ -587,7 +587,12 @@ fn quantities_compared(res: &StudyResult) -> (Vec<Quantity>, Vec<String>) {
             .all(|&m| rate_row(res, m, q).is_some_and(|r| r.assessment.verdict.compares_cones()))
     };
     // The distances between the cones have a section of their own.
-    let quantities: Vec<Quantity> = res.file.solution_quantities().collect();
+    // The best approximation measures the space, not the solution: its own section.
+    let quantities: Vec<Quantity> = res
+        .file
+        .solution_quantities()
+        .filter(|q| !q.is_best_approximation())
+        .collect();
     let ordered = quantities
         .iter()
         .filter(|q| q.is_contact())

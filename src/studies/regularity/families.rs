@@ -72,16 +72,19 @@ impl ParityRow {
     /// The sentence of a threshold this parity failed (None: it did not fail or has none).
     pub fn failure(&self) -> Option<String> {
         (self.pass == Some(Outcome::Fail)).then(|| {
+            let levels = match self.levels {
+                Levels::All => "all",
+                Levels::Even => "even",
+                Levels::Odd => "odd",
+            };
             format!(
-                "{} {} on {:?} levels: last judged rate {} < {:.3} ({})",
+                "{} {} on the {levels} levels: threshold {:.3} failed ({}, last judged rate {})",
                 self.method,
                 self.quantity,
-                self.levels,
-                crate::io::fmt3(self.last_rate.unwrap_or(f64::NAN)),
                 self.threshold.unwrap_or(f64::NAN),
-                self.verdict.name()
+                self.verdict.name(),
+                crate::io::fmt3(self.last_rate.unwrap_or(f64::NAN))
             )
-            .to_lowercase()
         })
     }
 }
