@@ -143,6 +143,7 @@ fn nested_meshes_give_the_direct_sum() {
             .map(|(a, b)| a - b)
             .collect(),
         pressure: None,
+        pressure_space: contact_rates::verify::field::PressureSpace::Linear,
     };
     let direct = norms(mf, &d);
     println!("via intersection: {via:?}\ndirect on the fine mesh: {direct:?}");

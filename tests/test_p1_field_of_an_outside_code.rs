@@ -69,14 +69,7 @@ fn an_elastic_solution_given_as_nodal_values_measures_as_the_solver_state() {
         }
         let without = truth.errors(&outside(false));
         for q in Quantity::ALL.into_iter().filter(|q| !q.is_distance()) {
-            let pressure_quantity = matches!(
-                q,
-                Quantity::L2Pressure
-                    | Quantity::PressureWeighted
-                    | Quantity::PressureResultant
-                    | Quantity::PressureOscillation
-                    | Quantity::ContactEdge
-            );
+            let pressure_quantity = q.needs_pressure();
             assert_eq!(
                 without.get(&q).is_some(),
                 !pressure_quantity,

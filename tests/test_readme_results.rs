@@ -89,6 +89,12 @@ fn headline_prints_only_rates_the_verdicts_support() {
                 format!("{se:.3}"),
             ]);
         }
+        // The study file's thresholds, as rates.csv holds them.
+        allowed.extend(
+            rows.iter()
+                .filter_map(|r| r.threshold)
+                .map(|t| format!("{t:.2}")),
+        );
         for r in rows
             .iter()
             .filter(|r| matches!(r.verdict, Verdict::Falling | Verdict::Rising))
@@ -190,11 +196,38 @@ fn row_claims(row: &str) -> Vec<(String, String, String)> {
         };
         // "observed; what the distance to mortar supports" (asymptotes.csv, checked apart).
         let observed = text.split_once("; ").map_or(text, |(o, _)| o);
+        // "... (threshold 0.70: pass)": the study file's threshold, checked apart.
+        let observed = held_apart(observed).0;
         if observed != "not measured" {
             claims.push((method.into(), quantity.into(), observed.into()));
         }
     }
     claims
+}
+
+/// A cell's observed text and its threshold's part in brackets ("threshold 0.70: pass",
+/// "exact to 1e-9: pass", "no threshold"), if it ends with one.
+fn held_apart(text: &str) -> (&str, Option<&str>) {
+    match text.rsplit_once(" (") {
+        Some((observed, held))
+            if ["threshold ", "exact to ", "no threshold"]
+                .iter()
+                .any(|p| held.starts_with(p)) =>
+        {
+            (observed, Some(held.trim_end_matches(')')))
+        }
+        _ => (text, None),
+    }
+}
+
+/// What a headline cell must say of rates.csv row `r`'s threshold, written here apart from
+/// the library: the bound and outcome of rates.csv's `threshold` and `pass` columns.
+fn expected_held(r: &RateRecord) -> String {
+    match (r.threshold, r.pass) {
+        (Some(t), Some(p)) if t > 0.0 && t < 1e-3 => format!("exact to {t:.0e}: {}", p.name()),
+        (Some(t), Some(p)) => format!("threshold {t:.2}: {}", p.name()),
+        _ => "no threshold".into(),
+    }
 }
 
 /// Whether `text` says what the row `r` of rates.csv supports: its rate (and standard
@@ -250,6 +283,30 @@ fn headline_cells_state_their_own_rows_rates() {
             wrong.is_empty(),
             "{name}: not what rates.csv says: {wrong:?}\n{row}"
         );
+        // Each method cell's threshold is its own row's, from rates.csv.
+        let cells: Vec<&str> = row
+            .trim()
+            .trim_matches('|')
+            .split('|')
+            .map(str::trim)
+            .collect();
+        for (method, cell) in [("mortar", cells[3]), ("nts", cells[4]), ("lac", cells[5])] {
+            let (quantity, text) = match cell.strip_prefix('`') {
+                Some(rest) => rest.split_once("` ").unwrap(),
+                None => ("theorem", cell),
+            };
+            let observed = text.split_once("; ").map_or(text, |(o, _)| o);
+            let r = rates
+                .iter()
+                .find(|r| r.method.name() == method && r.quantity.name() == quantity)
+                .expect("the cell's row");
+            assert_eq!(
+                held_apart(observed).1,
+                Some(expected_held(r).as_str()),
+                "{name} {method}: {cell}"
+            );
+            checked += 1;
+        }
         checked += row_claims(row).len();
         // The asymptote after a rate cell's "; " is asymptotes.csv's own sentence.
         let path = root().join("reports").join(name).join("asymptotes.csv");

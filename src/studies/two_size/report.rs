@@ -709,12 +709,13 @@ pub fn console(res: &TwoSizeResult, dir: &Path) -> String {
     for f in res.fits.iter().filter(|f| f.quantity == Quantity::Theorem) {
         let _ = writeln!(
             s,
-            "slave {:6} {:6} theorem: a1 {} a2 {} (expected {:?}); rate in h1 {}; rate in h2 {}",
+            "slave {:6} {:6} theorem: a1 {} a2 {} (expected {}); rate in h1 {}; rate in h2 {}",
             f.slave,
             f.method.name(),
             fmt_fit(f, 0),
             fmt_fit(f, 1),
-            res.exponents(f.method),
+            res.exponents(f.method)
+                .map_or("none stated".into(), |e| format!("({}, {})", e[0], e[1])),
             fmt_sweep(&f.sweeps[0]),
             fmt_sweep(&f.sweeps[1])
         );
