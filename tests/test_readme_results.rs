@@ -158,12 +158,8 @@ fn every_fitted_rate_agrees_with_its_last_successive_rates() {
     assert!(checked > 20);
 }
 
-/// What a headline row states, one (method, quantity, text) per cell part: the contact
-/// quantities that separate the cones ("`l2_pressure` 63x (mortar 1.85, nts not
-/// converging)", "`band_stress` mortar exact (nts 0.60)") and the judged rate of each cone
-/// ("0.981 ± 0.005 fitted" of the theorem norm, "`l2_stress` 0.601 ± 0.032 fitted"), lac's
-/// beside them.
-fn row_claims(row: &str) -> Vec<(String, String, String)> {
+/// The cells of a headline row (6: study, separations, stalls, mortar, nts, lac).
+fn cells(row: &str) -> Vec<&str> {
     let cells: Vec<&str> = row
         .trim()
         .trim_matches('|')
@@ -171,6 +167,32 @@ fn row_claims(row: &str) -> Vec<(String, String, String)> {
         .map(str::trim)
         .collect();
     assert_eq!(cells.len(), 6, "a headline row has 6 cells: {row}");
+    cells
+}
+
+/// Each method's rate cell of a headline row: (method, quantity, the cell after its
+/// quantity), the quantity `theorem` where the cell names none.
+fn method_cells(row: &str) -> Vec<(&'static str, &str, &str)> {
+    let cells = cells(row);
+    [("mortar", cells[3]), ("nts", cells[4]), ("lac", cells[5])]
+        .into_iter()
+        .map(|(method, cell)| {
+            let (quantity, text) = match cell.strip_prefix('`') {
+                Some(rest) => rest.split_once("` ").unwrap(),
+                None => ("theorem", cell),
+            };
+            (method, quantity, text)
+        })
+        .collect()
+}
+
+/// What a headline row states, one (method, quantity, text) per cell part: the contact
+/// quantities that separate the cones ("`l2_pressure` 63x (mortar 1.85, nts not
+/// converging)", "`band_stress` mortar exact (nts 0.60)") and the judged rate of each cone
+/// ("0.981 ± 0.005 fitted" of the theorem norm, "`l2_stress` 0.601 ± 0.032 fitted"), lac's
+/// beside them.
+fn row_claims(row: &str) -> Vec<(String, String, String)> {
+    let cells = cells(row);
     let mut claims = Vec::new();
     if let Some((_, items)) = cells[1].split_once(": ") {
         for item in items.split("), ") {
@@ -189,11 +211,7 @@ fn row_claims(row: &str) -> Vec<(String, String, String)> {
             }
         }
     }
-    for (method, cell) in [("mortar", cells[3]), ("nts", cells[4]), ("lac", cells[5])] {
-        let (quantity, text) = match cell.strip_prefix('`') {
-            Some(rest) => rest.split_once("` ").unwrap(),
-            None => ("theorem", cell),
-        };
+    for (method, quantity, text) in method_cells(row) {
         // "observed; what the distance to mortar supports" (asymptotes.csv, checked apart).
         let observed = text.split_once("; ").map_or(text, |(o, _)| o);
         // "... (threshold 0.70: pass)": the study file's threshold, checked apart.
@@ -284,17 +302,7 @@ fn headline_cells_state_their_own_rows_rates() {
             "{name}: not what rates.csv says: {wrong:?}\n{row}"
         );
         // Each method cell's threshold is its own row's, from rates.csv.
-        let cells: Vec<&str> = row
-            .trim()
-            .trim_matches('|')
-            .split('|')
-            .map(str::trim)
-            .collect();
-        for (method, cell) in [("mortar", cells[3]), ("nts", cells[4]), ("lac", cells[5])] {
-            let (quantity, text) = match cell.strip_prefix('`') {
-                Some(rest) => rest.split_once("` ").unwrap(),
-                None => ("theorem", cell),
-            };
+        for (method, quantity, text) in method_cells(row) {
             let observed = text.split_once("; ").map_or(text, |(o, _)| o);
             let r = rates
                 .iter()
@@ -303,7 +311,7 @@ fn headline_cells_state_their_own_rows_rates() {
             assert_eq!(
                 held_apart(observed).1,
                 Some(expected_held(r).as_str()),
-                "{name} {method}: {cell}"
+                "{name} {method}: {text}"
             );
             checked += 1;
         }
@@ -315,17 +323,8 @@ fn headline_cells_state_their_own_rows_rates() {
         } else {
             Vec::new()
         };
-        let cells: Vec<&str> = row
-            .trim()
-            .trim_matches('|')
-            .split('|')
-            .map(str::trim)
-            .collect();
-        for (method, cell) in [("mortar", cells[3]), ("nts", cells[4]), ("lac", cells[5])] {
-            if let Some((_, said)) = cell.split_once("; ") {
-                let q = cell
-                    .strip_prefix('`')
-                    .map_or("theorem", |r| r.split_once('`').unwrap().0);
+        for (method, q, text) in method_cells(row) {
+            if let Some((_, said)) = text.split_once("; ") {
                 let a = asymptotes
                     .iter()
                     .find(|a| a.method.name() == method && a.quantity.name() == q)

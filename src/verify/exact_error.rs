@@ -324,8 +324,7 @@ impl<'a> ExactComparison<'a> {
                 kinks: &kinks,
                 t,
             };
-            let (d, n) = pressure_l2::piece_difference(&on, profile, (diff, norm));
-            (diff, norm) = (d, n);
+            (diff, norm) = pressure_l2::piece_difference(&on, profile, (diff, norm));
         }
         (diff, norm)
     }

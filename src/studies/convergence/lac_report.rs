@@ -115,37 +115,7 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
             rate(m, Quantity::ConeDistance)
         ));
     }
-    let best = |m: Method| res.error(m, finest, Quantity::BestL2Pressure);
-    if let (Some(bl), Some(bm), Some(el), Some(em)) = (
-        best(Method::Lac),
-        best(Method::Mortar),
-        res.error(Method::Lac, finest, Quantity::L2Pressure),
-        res.error(Method::Mortar, finest, Quantity::L2Pressure),
-    ) && bl > ROUNDOFF
-        && bm > ROUNDOFF
-    {
-        lines.push(format!(
-            "`l2_pressure` beside the best approximation of the exact pressure in each method's own space at level {finest} (measured, `best_l2_pressure`; below): lac's space (constant on each macro-element) {bl:.3e}, its best's rate {}; the cones' (piecewise linear) {bm:.3e}, rate {}; lac's error is {:.2} times its best, mortar's {:.2} times its.",
-            rate(Method::Lac, Quantity::BestL2Pressure),
-            rate(Method::Mortar, Quantity::BestL2Pressure),
-            el / bl,
-            em / bm
-        ));
-    } else if quantities.contains(&Quantity::BestL2Pressure) {
-        lines.push(format!(
-            "`l2_pressure`: the exact pressure lies in lac's space or the cones' (its best approximation's error at level {finest}: lac {}, the cones {}): no best rate to read lac's against.",
-            best(Method::Lac).map_or("-".into(), |b| format!("{b:.1e}")),
-            best(Method::Mortar).map_or("-".into(), |b| format!("{b:.1e}"))
-        ));
-    } else if quantities.contains(&Quantity::L2Pressure) {
-        lines.push(format!(
-            "`l2_pressure`: lac's pressure is constant on each macro-element, so the best rate in h a profile like it can reach here is {:.3} (mortar's and nts's piecewise-linear profiles: {:.3}); lac's rate {}, mortar's {}.",
-            best_pressure_rate(singular_exponent(res), true),
-            best_pressure_rate(singular_exponent(res), false),
-            rate(Method::Lac, Quantity::L2Pressure),
-            rate(Method::Mortar, Quantity::L2Pressure)
-        ));
-    }
+    lines.extend(pressure_line(res, finest));
     let edge = res.rate(Method::Lac, Quantity::ContactEdge);
     if let (Some(r), Some(e)) = (edge, res.error(Method::Lac, finest, Quantity::ContactEdge))
         && r.assessment.verdict == Verdict::NotConverging
@@ -155,4 +125,44 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
         ));
     }
     doc.list(lines);
+}
+
+/// lac's pressure beside what its space allows: the measured best approximations where the
+/// study measures them (`best_l2_pressure`), else the asymptotic best rates.
+fn pressure_line(res: &StudyResult, finest: usize) -> Option<String> {
+    let rate = |m: Method, q: Quantity| res.rate(m, q).map_or("n/a".into(), |r| r.assessment.describe());
+    let listed = |q: Quantity| res.file.quantities.contains(&q);
+    let best = |m: Method| res.error(m, finest, Quantity::BestL2Pressure);
+    if let (Some(bl), Some(bm), Some(el), Some(em)) = (
+        best(Method::Lac),
+        best(Method::Mortar),
+        res.error(Method::Lac, finest, Quantity::L2Pressure),
+        res.error(Method::Mortar, finest, Quantity::L2Pressure),
+    ) && bl > ROUNDOFF
+        && bm > ROUNDOFF
+    {
+        Some(format!(
+            "`l2_pressure` beside the best approximation of the exact pressure in each method's own space at level {finest} (measured, `best_l2_pressure`; below): lac's space (constant on each macro-element) {bl:.3e}, its best's rate {}; the cones' (piecewise linear) {bm:.3e}, rate {}; lac's error is {:.2} times its best, mortar's {:.2} times its.",
+            rate(Method::Lac, Quantity::BestL2Pressure),
+            rate(Method::Mortar, Quantity::BestL2Pressure),
+            el / bl,
+            em / bm
+        ))
+    } else if listed(Quantity::BestL2Pressure) {
+        Some(format!(
+            "`l2_pressure`: the exact pressure lies in lac's space or the cones' (its best approximation's error at level {finest}: lac {}, the cones {}): no best rate to read lac's against.",
+            best(Method::Lac).map_or("-".into(), |b| format!("{b:.1e}")),
+            best(Method::Mortar).map_or("-".into(), |b| format!("{b:.1e}"))
+        ))
+    } else if listed(Quantity::L2Pressure) {
+        Some(format!(
+            "`l2_pressure`: lac's pressure is constant on each macro-element, so the best rate in h a profile like it can reach here is {:.3} (mortar's and nts's piecewise-linear profiles: {:.3}); lac's rate {}, mortar's {}.",
+            best_pressure_rate(singular_exponent(res), true),
+            best_pressure_rate(singular_exponent(res), false),
+            rate(Method::Lac, Quantity::L2Pressure),
+            rate(Method::Mortar, Quantity::L2Pressure)
+        ))
+    } else {
+        None
+    }
 }
