@@ -10,7 +10,9 @@ Solve an exported contact problem with GetFEM's contact bricks and write the sol
 Per level L of EXPORT_DIR (every mesh_L.msh22.msh, or --levels A-B): the mesh imported by
 GetFEM's gmsh importer, P1 Lagrange plane-stress elasticity on each body (GetFEM's isotropic
 linearized elasticity brick with lambda = lambda_star), the supports of problem.toml as
-nodal constraints, the nodal loads of loads_L.csv as an explicit right-hand side, and
+nodal constraints, the loads (--loads exported: the nodal loads of loads_L.csv as an explicit
+right-hand side; --loads getfem: problem.toml's body forces and tractions as GWFL expressions,
+integrated by GetFEM's source term brick with --load-rule, as a user would write them), and
 frictionless unilateral contact between the slave curve (body 1) and the master curve with
 one of GetFEM's contact bricks, solved at every t_n by GetFEM's Newton:
 
@@ -22,6 +24,11 @@ one of GetFEM's contact bricks, solved at every t_n by GetFEM's Newton:
                     multiplier (a nodal force) per slave node, master segments found once in
                     the reference configuration.
 
+With --loads getfem the loads are GetFEM's quadrature of the expressions, not the exported
+integrals: `grade` reads the difference as an equilibrium residual against loads_L.csv and prints
+the energy bound it puts on the error beside each level (docs/verify-your-code.md, "Your own
+load integration").
+
 Each step is checked: GetFEM's Newton, then single Newton iterations until one moves u by
 less than 1e-10 of max |u|, and a backward error below 1e-13; the script exits non-zero
 otherwise. Writes OUT_DIR/level_L.pvd and one .vtu per step with point data `displacement`
@@ -31,6 +38,7 @@ only where the stress is statically determinate, as in `patch`).
 """
 
 import argparse
+import ast
 import sys
 import time
 import tomllib
@@ -76,6 +84,41 @@ NEWTON_TOL, MAX_ITER = 1e-8, 100
 # crossover level 5 (115,000 unknowns), whose pivots failed ("pivot too small").
 LSOLVER = "mumps"
 CHECK_TOL, MAX_CHECK, ETA_TOL = 1e-10, 20, 1e-13
+# --loads getfem: the rule a user would reach for first, the elasticity's own (exact for the
+# product of a linear load and a P1 test function). It does not see the loads' kinks: the
+# exported expressions have abs and signum terms whose discontinuities cross triangles.
+LOAD_RULE = BULK_RULE
+
+# problem.toml's expression syntax as GWFL (GetFEM's weak form language): x, y are X(1), X(2),
+# t is model data, ^ is pow, signum is sign (they differ at 0 only, a set of measure zero).
+GWFL_CALLS = {"sin": "sin", "cos": "cos", "tan": "tan", "exp": "exp", "log": "log", "sqrt": "sqrt",
+              "abs": "abs", "signum": "sign"}
+GWFL_NAMES = {"x": "X(1)", "y": "X(2)", "t": "t", "pi": "pi"}
+
+
+def gwfl(text):
+    """One expression of problem.toml in GWFL, through Python's parser (^ read as a power)."""
+    def emit(node):
+        if isinstance(node, ast.Expression):
+            return emit(node.body)
+        if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)):
+            return repr(float(node.value))
+        if isinstance(node, ast.Name) and node.id in GWFL_NAMES:
+            return GWFL_NAMES[node.id]
+        if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
+            return f"({'-' if isinstance(node.op, ast.USub) else ''}{emit(node.operand)})"
+        if isinstance(node, ast.BinOp):
+            a, b = emit(node.left), emit(node.right)
+            if isinstance(node.op, ast.Pow):
+                return f"pow({a},{b})"
+            op = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/"}.get(type(node.op))
+            if op:
+                return f"({a}{op}{b})"
+        if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+                and node.func.id in GWFL_CALLS and len(node.args) == 1):
+            return f"{GWFL_CALLS[node.func.id]}({emit(node.args[0])})"
+        fail(f"problem.toml: expression {text[:60]!r}...: {ast.dump(node)[:60]} is not in its syntax")
+    return emit(ast.parse(text.replace("^", "**"), mode="eval"))
 
 
 def fail(msg):
@@ -166,11 +209,13 @@ class Level:
         self.mim = gf.MeshIm(self.mesh, gf.Integ(BULK_RULE))
 
 
-def build_model(lv, problem, brick, r):
+def build_model(lv, problem, brick, r, load_source, load_rule):
     """The model: u1, u2 (one per body), their elasticity, constraints and loads, and the
-    contact brick. Returns the model and the explicit-rhs brick index of each body."""
+    contact brick. Returns the model and the explicit-rhs brick index of each body (its
+    right-hand side stays zero with `load_source` "getfem", whose loads are source term bricks)."""
     md = gf.Model("real")
     rhs_brick, fixed = {}, {}
+    md.add_initialized_data("t", [0.0])
     for number, b in lv.bodies.items():
         u = f"u{number}"
         md.add_fem_variable(u, lv.mf[number])
@@ -206,6 +251,8 @@ def build_model(lv, problem, brick, r):
             md.add_variable(f"support{number}", len(fx))
             md.add_constraint_with_multipliers(u, f"support{number}", B, np.zeros(len(fx)))
         rhs_brick[number] = md.add_explicit_rhs(u, np.zeros(ndof))
+    if load_source == "getfem":
+        add_expression_loads(md, lv, problem, load_rule)
 
     contact = problem["contact"]
     slave = lv.names[contact["slave_curve"]][1]
@@ -231,6 +278,22 @@ def build_model(lv, problem, brick, r):
             lv.mim, lv.mim, "u1", "u2", "lambda", "r", slave, master, 1, 0
         )
     return md, rhs_brick, fixed
+
+
+def add_expression_loads(md, lv, problem, load_rule):
+    """problem.toml's body forces and tractions as GWFL expressions in X and the data t, each
+    integrated by GetFEM's source term brick with `load_rule` on its body or its curve (the
+    curve's rule is the triangle rule's face rule)."""
+    mim = gf.MeshIm(lv.mesh, gf.Integ(load_rule))
+    for b in problem["bodies"]:
+        if "body_force" in b:
+            fx, fy = (gwfl(e) for e in b["body_force"])
+            md.add_source_term_brick(mim, f"u{b['number']}", f"[{fx};{fy}]", lv.region_of[b["number"]])
+    for tr in problem.get("tractions", []):
+        if tr["curve"] not in lv.names:
+            fail(f"problem.toml: tractions: curve {tr['curve']!r} is not a physical curve of the mesh")
+        gx, gy = (gwfl(e) for e in tr["traction"])
+        md.add_source_term_brick(mim, f"u{tr['body']}", f"[{gx};{gy}]", lv.names[tr["curve"]][1])
 
 
 def slave_data(lv, problem):
@@ -327,7 +390,7 @@ def write_vtu(path, points, tris, point_data, cell_data):
     )
 
 
-def solve_level(export, out, level, problem, brick):
+def solve_level(export, out, level, problem, brick, load_source, load_rule):
     t0 = time.perf_counter()
     lv = Level(export, level, problem)
     if set(lv.bodies) != {1, 2}:
@@ -340,7 +403,7 @@ def solve_level(export, out, level, problem, brick):
     # then R_FACTOR E / h (h the longest slave edge) from that solution.
     young = float(lv.bodies[1]["young"])
     r = young if brick == "nodal" else R_FACTOR * young / h_slave
-    md, rhs_brick, fixed = build_model(lv, problem, brick, r)
+    md, rhs_brick, fixed = build_model(lv, problem, brick, r, load_source, load_rule)
 
     loads_path = export / f"loads_{level}.csv"
     if not loads_path.is_file():
@@ -370,8 +433,10 @@ def solve_level(export, out, level, problem, brick):
             for c, col in ((0, 3), (1, 4)):
                 np.add.at(F, lv.dof[number][node[at]] + c, rows[at, col])
             F[fixed[number]] = 0.0  # a row at a supported component is ignored
-            md.set_private_rhs(rhs_brick[number], F)
-            f[number] = F
+            f[number] = F  # with --loads getfem only the size of the loads (Newton's scale)
+            if load_source == "exported":
+                md.set_private_rhs(rhs_brick[number], F)
+        md.set_variable("t", [t])
         load = sum(np.abs(F).sum() for F in f.values())
         t1 = time.perf_counter()
         newton = ("max_iter", MAX_ITER, "max_res", NEWTON_TOL * load, "lsolver", LSOLVER)
@@ -458,6 +523,11 @@ def main():
     ap.add_argument("out", type=Path)
     ap.add_argument("--brick", choices=["integral", "nodal"], required=True)
     ap.add_argument("--levels", help="A-B (default: every level in problem.toml)")
+    ap.add_argument("--loads", choices=["exported", "getfem"], default="exported",
+                    help="exported: loads_L.csv's nodal loads; getfem: problem.toml's expressions "
+                         "integrated by GetFEM with --load-rule")
+    ap.add_argument("--load-rule", default=LOAD_RULE,
+                    help=f"GetFEM's integration method for --loads getfem (default {LOAD_RULE})")
     a = ap.parse_args()
     if not (a.export / "problem.toml").is_file():
         fail(f"{a.export}/problem.toml: not found; run `contact-rates export --study ... --out {a.export}` first")
@@ -475,7 +545,7 @@ def main():
     gf.util_trace_level(0)
     a.out.mkdir(parents=True, exist_ok=True)
     for level in levels:
-        solve_level(a.export, a.out, level, problem, a.brick)
+        solve_level(a.export, a.out, level, problem, a.brick, a.loads, a.load_rule)
 
 
 if __name__ == "__main__":

@@ -1,16 +1,37 @@
 //! What `grade` checks of each level before it claims a rate from it: that the file is a
-//! converged solution of this problem, and that its pressure is a pressure.
+//! converged solution of a P1 discretization of this problem, and that its pressure is a
+//! pressure.
 //!
 //! - **Equilibrium.** The residual r = B^T sigma_h - f of the P1 problem on the file's own
 //!   mesh (sigma_h the file's stress, or C eps(u_h) of an elastic body; f the scene's load
 //!   integrals, equal to the bit to an export's loads_L.csv on its meshes), with the
 //!   supports' and Gamma_C's dofs held, measured in energy:
 //!   delta = sqrt(r^T K^-1 r) / ||u_h||_E (K the elastic stiffness with those dofs held).
-//!   A solve stopped early leaves delta at the size of the error it adds; a level where
-//!   delta exceeds 1/20 of its own error is an iteration's state, not a discretization's.
-//! - **Gamma_C.** The reactions r at Gamma_C's nodes are the contact forces: the two sides'
-//!   normal forces balance (action and reaction), a frictionless contact has no tangential
-//!   force, and a unilateral one does not pull on the slave side.
+//!   delta is the energy distance from u_h to u~_h = u_h - K^-1 r, the field with the same
+//!   Gamma_C trace in equilibrium with the exported loads: the bound on what the residual can
+//!   change in the graded error. Two causes leave one:
+//!   - **the code's own load integration**: a code that integrates f and g with its own rule
+//!     is in equilibrium with its loads, not with the exported integrals; its residual is
+//!     their difference, which falls with h as a quadrature error does. grade integrates
+//!     the scene's loads on the file's mesh with the common plain rules of P1 codes
+//!     ([`LoadRule::common`]: no split at the loads' kinks) and takes the largest of their
+//!     residuals, lambda_q, as the size a load rule leaves on that mesh;
+//!   - **a solve stopped before it converged**: its residual is the iteration's, tied to no
+//!     mesh: it does not fall with h as lambda_q does.
+//!
+//!   A level is refused as unconverged where delta exceeds 1/20 of its error (below that, a
+//!   perturbation orthogonal to the error in energy moves it by at most 0.13%) and
+//!   LOAD_MARGIN lambda_q, or its ratio to lambda_q exceeds LOAD_MARGIN times a
+//!   neighbouring level's (it does not fall with h as a load rule's does); and whatever the
+//!   cause where delta exceeds BOUND_SHARE of its error. Otherwise it is graded with delta
+//!   printed beside its error, and where delta exceeds 1/20 of the error, with the key
+//!   error of u~_h beside the file's (`shift`): `grade` judges the key rate of those errors
+//!   too, the rate without the residual.
+//! - **Gamma_C.** The reactions r at Gamma_C's nodes are the contact forces (plus, for a code
+//!   with its own load rule, its loads' difference there): the two sides' normal forces
+//!   balance (action and reaction), a frictionless contact has no tangential force, and a
+//!   unilateral one does not pull on the slave side, each to FORCE_SHARE of the resultant or
+//!   LOAD_MARGIN times the common rules' load difference on Gamma_C's nodes, the larger.
 //! - **The pressure.** Its resultant at T against the exact pressure's (or, where only the
 //!   contact holds a body along Gamma_C's normal, that body's normal load): a negative ratio
 //!   is a sign error, a ratio off 1 by more than 5% and the same to 1% at every level a scale
@@ -18,7 +39,7 @@
 
 use crate::contact::Interface;
 use crate::error::{Error, Result};
-use crate::fe::{FIXED, Model};
+use crate::fe::{FIXED, LoadRule, Model};
 use crate::quadrature::gauss_legendre;
 use crate::solve::linear::SparseSystem;
 use crate::verify::field::P1Field;
@@ -26,13 +47,27 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// A level is not a converged solution where delta exceeds this share of its own error.
+/// Below this share of its own error, delta is no cause for concern: a perturbation d that
+/// is orthogonal in energy to the error adds to it as sqrt(e^2 + d^2), so 1/20 moves it by
+/// 0.13% at most.
 pub const RESIDUAL_SHARE: f64 = 1.0 / 20.0;
 /// delta at or below this is round-off of the assembled sums (the patch test's errors sit at
 /// 1e-13, where 1/20 of the error is no limit a double-precision solve can meet).
 pub const RESIDUAL_FLOOR: f64 = 1e-10;
+/// A residual up to this many times lambda_q, the largest the common plain load rules leave
+/// on the level's mesh, is of a load rule's size: the lumped load (f at the vertices, what a
+/// code that interpolates f at the nodes assembles) has 3 times the centroid rule's error on
+/// a quadratic load (x^2 on the unit triangle: 1/12 against 1/36, of opposite sign).
+pub const LOAD_MARGIN: f64 = 3.0;
+/// The largest delta, relative to the level's error, that is graded whatever its cause.
+/// The correction K^-1 r is orthogonal in energy to the error of u~_h (Galerkin orthogonality
+/// on the interior dofs, where both fields' loads are the exported integrals), so the
+/// squares add: e^2 = e~^2 + delta^2. Up to delta = e/2 the residual carries at most a
+/// quarter of the error's energy, and the error is the discretization's (with its load rule)
+/// more than the residual's; beyond it, not.
+pub const BOUND_SHARE: f64 = 0.5;
 /// Largest imbalance of the two sides' normal forces, tangential force and pulling force,
-/// relative to the contact resultant.
+/// relative to the contact resultant (where the common load rules put less on Gamma_C).
 pub const FORCE_SHARE: f64 = 1e-3;
 /// A pressure resultant off the reference by more than this share at every level...
 pub const SCALE_OFF: f64 = 0.05;
@@ -44,6 +79,18 @@ pub const SCALE_SAME: f64 = 0.01;
 pub struct LevelCheck {
     /// delta: the equilibrium residual in energy relative to ||u_h||_E.
     pub residual: f64,
+    /// lambda_q: the largest delta the common plain load rules leave on this mesh (their
+    /// loads against the exported integrals, in the same norm).
+    pub load_rule_residual: f64,
+    /// The common load rules' largest difference on Gamma_C's nodes, over P (sum of the
+    /// nodal differences' lengths); `None` where nothing touches.
+    pub load_rule_forces: Option<f64>,
+    /// (e(u~_h) - e(u_h)) / e(u_h) in the key quantity, where delta exceeds 1/20 of the
+    /// error (measured by `grade`); `None` where it does not.
+    pub shift: Option<f64>,
+    /// The smallest delta / lambda_q of the graded levels next to this one (set by `grade`
+    /// over the family; `None` for a level graded alone).
+    pub neighbour_ratio: Option<f64>,
     /// |P_1 - P_2| / P, the two sides' normal forces; `None` where nothing touches.
     pub imbalance: Option<f64>,
     /// The tangential forces on Gamma_C over P.
@@ -55,32 +102,127 @@ pub struct LevelCheck {
     pub pressure_ratio: Option<f64>,
 }
 
+/// What the equilibrium residual of a level points to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ResidualCause {
+    /// delta at most 1/20 of the error (or round-off): nothing to tell.
+    None,
+    /// delta of the size the common load rules leave on the mesh: the code's own load
+    /// integration.
+    LoadRule,
+    /// delta above LOAD_MARGIN lambda_q: an iteration's, not a load rule's.
+    Unconverged,
+}
+
+impl ResidualCause {
+    /// Its name in checks.csv.
+    pub fn name(self) -> &'static str {
+        match self {
+            ResidualCause::None => "none",
+            ResidualCause::LoadRule => "load rule",
+            ResidualCause::Unconverged => "unconverged",
+        }
+    }
+}
+
 impl LevelCheck {
+    /// The limit delta is held to where its cause is not a load rule: max(error / 20, 1e-10).
+    pub fn residual_limit(error: f64) -> f64 {
+        (RESIDUAL_SHARE * error).max(RESIDUAL_FLOOR)
+    }
+
+    /// delta / lambda_q: the residual against the largest the common load rules leave on
+    /// this mesh (0 where they leave none).
+    pub fn load_ratio(&self) -> f64 {
+        match self.load_rule_residual > 0.0 {
+            true => self.residual / self.load_rule_residual,
+            false => f64::INFINITY * self.residual.signum().max(0.0),
+        }
+    }
+
+    /// What the residual points to, given the level's key error `error`: a load rule's where
+    /// delta is at most LOAD_MARGIN lambda_q and its ratio delta / lambda_q at most
+    /// LOAD_MARGIN times each neighbour's (a load rule's residual follows the mesh as the
+    /// common rules' do: GetFEM's IM_TRIANGLE(2) and (6) on rates-exact levels 0-4 keep the
+    /// ratio within a factor 2 from level to level; a stopped solve's residual is tied to no
+    /// mesh, and its ratio grows as lambda_q falls). A level whose own ratio is far below its
+    /// neighbours' (a rule that happens to be exact there) makes them look unconverged: the
+    /// rule errs toward refusing.
+    pub fn cause(&self, error: f64) -> ResidualCause {
+        let ratio = self.load_ratio();
+        let follows = self
+            .neighbour_ratio
+            .is_none_or(|n| ratio <= LOAD_MARGIN * n);
+        if self.residual <= Self::residual_limit(error) {
+            ResidualCause::None
+        } else if ratio <= LOAD_MARGIN && follows {
+            ResidualCause::LoadRule
+        } else {
+            ResidualCause::Unconverged
+        }
+    }
+
+    /// The limit of the Gamma_C force checks: FORCE_SHARE, or, where the residual is at most
+    /// a load rule's, LOAD_MARGIN times the load difference it points to on Gamma_C's nodes
+    /// where larger: the common rules' there, scaled by delta / lambda_q (the code's rule
+    /// against theirs in the interior). A converged solve with the exported loads (delta at
+    /// round-off) is held to FORCE_SHARE.
+    pub fn force_limit(&self, error: f64) -> f64 {
+        let scaled = match self.cause(error) {
+            ResidualCause::Unconverged => 0.0,
+            _ => LOAD_MARGIN * self.load_ratio() * self.load_rule_forces.unwrap_or(0.0),
+        };
+        FORCE_SHARE.max(scaled)
+    }
+
     /// Why the level is not a converged solution of the problem, given its error `error`
     /// in the key quantity (empty: it is one).
     pub fn problems(&self, error: f64) -> Vec<String> {
         let mut out = Vec::new();
-        let limit = (RESIDUAL_SHARE * error).max(RESIDUAL_FLOOR);
-        if self.residual > limit {
+        let cause = self.cause(error);
+        if cause == ResidualCause::Unconverged {
+            let ratio = self.load_ratio();
+            let against = match self.neighbour_ratio {
+                Some(n) if ratio > LOAD_MARGIN * n && ratio <= LOAD_MARGIN => format!(
+                    "{ratio:.3} times the {:.3e} the common load rules leave on this mesh, where a level next to it has {n:.3e} times theirs: it does not follow the mesh as a load rule's does",
+                    self.load_rule_residual
+                ),
+                _ => format!(
+                    "{ratio:.3} times the {:.3e} the common load rules leave on this mesh, more than any load rule leaves ({LOAD_MARGIN} times)",
+                    self.load_rule_residual
+                ),
+            };
             out.push(format!(
-                "its equilibrium residual in energy is {:.3e} of ||u_h||_E, above 1/20 of its error {:.3e}: the solve stopped before it converged (tighten the solver's tolerance, or raise its iteration limit)",
-                self.residual, error
+                "its equilibrium residual in energy is {:.3e} of ||u_h||_E, above 1/20 of its error {error:.3e} and {against}: the solve stopped before it converged (tighten the solver's tolerance, or raise its iteration limit)",
+                self.residual
             ));
         }
-        let share = |v: Option<f64>| v.filter(|v| *v > FORCE_SHARE);
+        // An unconverged residual is told above; a load rule's that large is told here.
+        if cause == ResidualCause::LoadRule && self.residual > BOUND_SHARE * error {
+            out.push(format!(
+                "its equilibrium residual in energy is {:.3e} of ||u_h||_E, of the size the common load rules leave on this mesh ({:.3e}) but above 1/2 of its error {error:.3e}: its own load integration, not the contact discretization, makes that error (integrate the loads more finely, split at their kinks, or read them from loads_L.csv)",
+                self.residual, self.load_rule_residual
+            ));
+        }
+        let limit = self.force_limit(error);
+        let share = |v: Option<f64>| v.filter(|v| *v > limit);
+        let beyond = match limit > FORCE_SHARE {
+            true => format!(" (above {limit:.3e}, what its load integration can put there)"),
+            false => String::new(),
+        };
         if let Some(v) = share(self.imbalance) {
             out.push(format!(
-                "the normal contact forces of the two sides differ by {v:.3e} of the resultant: action and reaction do not balance on Gamma_C (an unconverged contact iteration, or a force on one side only)"
+                "the normal contact forces of the two sides differ by {v:.3e} of the resultant{beyond}: action and reaction do not balance on Gamma_C (an unconverged contact iteration, or a force on one side only)"
             ));
         }
         if let Some(v) = share(self.tangential) {
             out.push(format!(
-                "the contact forces on Gamma_C have a tangential part of {v:.3e} of the resultant: the problem is frictionless (is friction or a tied contact on?)"
+                "the contact forces on Gamma_C have a tangential part of {v:.3e} of the resultant{beyond}: the problem is frictionless (is friction or a tied contact on?)"
             ));
         }
         if let Some(v) = share(self.pulling) {
             out.push(format!(
-                "the contact pulls on the slave side, with {v:.3e} of the resultant: unilateral contact only pushes (an active-set or augmented-Lagrangian loop stopped before its last active set)"
+                "the contact pulls on the slave side, with {v:.3e} of the resultant{beyond}: unilateral contact only pushes (an active-set or augmented-Lagrangian loop stopped before its last active set)"
             ));
         }
         out
@@ -94,13 +236,26 @@ pub struct CheckRecord {
     pub h: f64,
     /// The level's error in the key quantity (relative).
     pub error: f64,
-    /// delta, the equilibrium residual in energy relative to ||u_h||_E.
+    /// delta, the equilibrium residual in energy relative to ||u_h||_E: the energy distance
+    /// to the field in equilibrium with the exported loads (Gamma_C held).
     pub residual: f64,
-    /// The limit delta is held to: max(error / 20, 1e-10).
+    /// The limit delta is held to where it is no load rule's: max(error / 20, 1e-10).
     pub residual_limit: f64,
+    /// lambda_q: the largest delta of the common plain load rules on this mesh.
+    #[serde(default)]
+    pub load_rule_residual: Option<f64>,
+    /// What the residual points to: none, load rule, unconverged.
+    #[serde(default)]
+    pub residual_cause: Option<String>,
+    /// The relative change of the key error the residual makes (where delta > error / 20).
+    #[serde(default)]
+    pub error_shift: Option<f64>,
     pub normal_imbalance: Option<f64>,
     pub tangential: Option<f64>,
     pub pulling: Option<f64>,
+    /// The limit of the three force checks.
+    #[serde(default)]
+    pub force_limit: Option<f64>,
     pub pressure_ratio: Option<f64>,
     /// `converged`, or `flagged` (the level gives no rate).
     pub verdict: String,
@@ -115,10 +270,14 @@ impl CheckRecord {
             h,
             error,
             residual: check.residual,
-            residual_limit: (RESIDUAL_SHARE * error).max(RESIDUAL_FLOOR),
+            residual_limit: LevelCheck::residual_limit(error),
+            load_rule_residual: Some(check.load_rule_residual),
+            residual_cause: Some(check.cause(error).name().into()),
+            error_shift: check.shift,
             normal_imbalance: check.imbalance,
             tangential: check.tangential,
             pulling: check.pulling,
+            force_limit: Some(check.force_limit(error)),
             pressure_ratio: check.pressure_ratio,
             verdict: if flagged { "flagged" } else { "converged" }.into(),
         }
@@ -190,14 +349,14 @@ fn factored_stiffness(held: &Model) -> Result<SparseSystem> {
 }
 
 /// The contact forces' balance at one step from the reactions `reaction` (global dofs):
-/// (imbalance, tangential, pulling) over the resultant, or `None` where nothing touches
-/// (resultant below 1e-12 of the load's size `load`).
+/// (imbalance, tangential, pulling) over the resultant, and the resultant; `None` where
+/// nothing touches (resultant below 1e-12 of the load's size `load`).
 fn contact_balance(
     nodes: &ContactNodes,
     model: &Model,
     reaction: &[f64],
     load: f64,
-) -> Option<(f64, f64, f64)> {
+) -> Option<([f64; 3], f64)> {
     let (mut push, mut tangential, mut pulling) = ([0.0f64; 2], 0.0f64, 0.0f64);
     for (&g, &(side, n, corner)) in &nodes.0 {
         // A component a support holds carries the support's reaction, not the contact's.
@@ -217,24 +376,56 @@ fn contact_balance(
     let resultant = push[0].abs().max(push[1].abs());
     (resultant > 1e-12 * load).then(|| {
         (
-            (push[0] - push[1]).abs() / resultant,
-            tangential / resultant,
-            pulling / resultant,
+            [
+                (push[0] - push[1]).abs() / resultant,
+                tangential / resultant,
+                pulling / resultant,
+            ],
+            resultant,
         )
     })
 }
 
-/// The checks of one level's steps on `model`: equilibrium and Gamma_C's forces (maxima
-/// over the steps), and the pressure's resultant at the last step, T.
-pub fn check_level(model: &Model, interface: &Interface, steps: &[P1Field]) -> Result<LevelCheck> {
+/// The sum over Gamma_C's nodes of the length of `force` (global dofs) on their free
+/// components.
+fn on_contact_nodes(nodes: &ContactNodes, model: &Model, force: &[f64]) -> f64 {
+    nodes
+        .0
+        .keys()
+        .map(|&g| {
+            let f = [0, 1].map(|c| match model.equation[2 * g + c] {
+                FIXED => 0.0,
+                _ => force[2 * g + c],
+            });
+            f[0].hypot(f[1])
+        })
+        .sum()
+}
+
+/// One level's checks ([`check_level`]) and, where delta exceeds `error_hint`'s 1/20 (or
+/// round-off), the correction per step: K^-1 r over the global dofs (zero on the held
+/// ones), so that u~_h = u_h - correction is in equilibrium with the exported loads.
+pub struct Checked {
+    pub check: LevelCheck,
+    /// Per step of `steps`, K^-1 r (global dofs; empty where delta is at round-off).
+    pub corrections: Vec<Vec<f64>>,
+}
+
+/// The checks of one level's steps on `model`: equilibrium against the exported loads and
+/// against the common plain load rules, and Gamma_C's forces (maxima over the steps), and
+/// the pressure's resultant at the last step, T.
+pub fn check_level(model: &Model, interface: &Interface, steps: &[P1Field]) -> Result<Checked> {
     let nodes = ContactNodes::new(interface);
     let held = nodes.held(model);
     let system = match held.n_free {
         0 => None,
         _ => Some(factored_stiffness(&held)?),
     };
+    let rules = LoadRule::common();
     let mut out = LevelCheck::default();
+    let mut corrections = Vec::with_capacity(steps.len());
     let mut load = Vec::new();
+    let max = |a: Option<f64>, b: f64| Some(a.map_or(b, |a| a.max(b)));
     for step in steps {
         load = model.load(step.time)?;
         let internal = model.internal_force(&step.stress);
@@ -242,26 +433,48 @@ pub fn check_level(model: &Model, interface: &Interface, steps: &[P1Field]) -> R
         let energy: f64 = dot(
             &model.internal_force(&model.elastic_stresses(&step.u)),
             &step.u,
-        );
-        if let Some(system) = &system {
-            let r = held.restrict(&reaction);
+        )
+        .max(f64::MIN_POSITIVE);
+        // delta of a force over the global dofs, and K^-1 of it over the free ones.
+        let in_energy = |force: &[f64]| -> (f64, Vec<f64>) {
+            let Some(system) = &system else {
+                return (0.0, Vec::new());
+            };
+            let r = held.restrict(force);
             let mut z = r.clone();
             system.solve(&mut z);
-            let delta = (dot(&r, &z).max(0.0) / energy.max(f64::MIN_POSITIVE)).sqrt();
-            out.residual = out.residual.max(delta);
-        }
+            ((dot(&r, &z).max(0.0) / energy).sqrt(), z)
+        };
+        let (delta, z) = in_energy(&reaction);
+        out.residual = out.residual.max(delta);
+        corrections.push(match delta > RESIDUAL_FLOOR {
+            true => held.expand(&z),
+            false => Vec::new(),
+        });
         let size = load.iter().map(|v| v.abs()).sum::<f64>();
-        if let Some((i, t, p)) = contact_balance(&nodes, model, &reaction, size) {
-            let max = |a: Option<f64>, b: f64| Some(a.map_or(b, |a| a.max(b)));
+        let balance = contact_balance(&nodes, model, &reaction, size);
+        if let Some(([i, t, p], _)) = balance {
             out.imbalance = max(out.imbalance, i);
             out.tangential = max(out.tangential, t);
             out.pulling = max(out.pulling, p);
+        }
+        for rule in &rules {
+            let by_rule = model.load_by_rule(step.time, rule)?;
+            let difference: Vec<f64> = by_rule.iter().zip(&load).map(|(a, b)| a - b).collect();
+            out.load_rule_residual = out.load_rule_residual.max(in_energy(&difference).0);
+            if let Some((_, resultant)) = balance {
+                let on_gamma = on_contact_nodes(&nodes, model, &difference) / resultant;
+                out.load_rule_forces = max(out.load_rule_forces, on_gamma);
+            }
         }
     }
     if let Some(last) = steps.last() {
         out.pressure_ratio = pressure_ratio(model, interface, last, &load);
     }
-    Ok(out)
+    Ok(Checked {
+        check: out,
+        corrections,
+    })
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {

@@ -424,7 +424,9 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
     let key = key_quantity(exact);
     let files = level_files(&req.solutions, req.levels.as_deref())?;
     let cones = solve_cones(&family, &files, req.compare)?;
-    let (levels, measured, resultant_fixed) = measure_levels(req, &family, &truth, &files, &cones)?;
+    let (mut levels, measured, resultant_fixed) =
+        measure_levels(req, &family, &truth, key, &files, &cones)?;
+    set_neighbour_ratios(&mut levels);
     check_distinct_h(&levels, &req.solutions)?;
     let ratios: Vec<(usize, &Path, f64)> = levels
         .iter()
@@ -451,9 +453,11 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
     };
     let rates = judge_errors(&errors, &rules)
         .map_err(|e| Error::input(&req.solutions, "levels", e.to_string()))?;
+    let residual_note = residual_note(&label, &levels, &measured, key, &rules);
     let failures = rates.iter().filter_map(RateRow::failure).collect();
     let unverified = rates.iter().filter_map(RateRow::unverified).collect();
-    let notes = notes(&levels, &family, pressure);
+    let mut notes = notes(&levels, &family, pressure);
+    notes.extend(residual_note);
     let command = command_line(req, &files);
     let (checks, flagged) = level_checks(&levels, &measured, key);
     Ok(Graded {
@@ -473,6 +477,87 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
         unverified,
         command,
     })
+}
+
+/// Where a graded level's residual exceeds 1/20 of its error: the key rate of the errors
+/// with the residual taken off (u~_h, [`LevelCheck::shift`]; the other levels' as graded)
+/// beside the file's, judged by the same rules: what the code's own load integration (or
+/// its solver) does to its rate.
+fn residual_note(
+    label: &MethodLabel,
+    levels: &[GradedLevel],
+    measured: &[BTreeMap<Quantity, f64>],
+    key: Quantity,
+    rules: &Rules,
+) -> Option<String> {
+    let graded: Vec<(&GradedLevel, f64)> = levels
+        .iter()
+        .zip(measured)
+        .map(|(l, e)| (l, e[&key]))
+        .filter(|(l, e)| l.problems(*e).is_empty())
+        .collect();
+    if graded.iter().all(|(l, _)| l.check.shift.is_none()) {
+        return None;
+    }
+    let record = |l: &GradedLevel, error: f64| ErrorRecord {
+        method: label.clone(),
+        level: l.level,
+        h: l.h,
+        dofs: l.dofs,
+        steps: l.times.len(),
+        quantity: key,
+        error,
+        wall_s: None,
+        parameter: None,
+    };
+    let fitted = |records: Vec<ErrorRecord>| {
+        let rows = judge_errors(&records, rules).ok()?;
+        rows.into_iter()
+            .find(|r| r.quantity == key)
+            .and_then(|r| r.supported_fit().map(|f| f.rate))
+    };
+    let file = fitted(graded.iter().map(|(l, e)| record(l, *e)).collect());
+    let corrected = fitted(
+        graded
+            .iter()
+            .map(|(l, e)| record(l, e * (1.0 + l.check.shift.unwrap_or(0.0))))
+            .collect(),
+    );
+    let shifts: Vec<String> = graded
+        .iter()
+        .filter_map(|(l, _)| {
+            Some(format!(
+                "level {}: {:+.2}%",
+                l.level,
+                100.0 * l.check.shift?
+            ))
+        })
+        .collect();
+    let rates = match (file, corrected) {
+        (Some(a), Some(b)) => format!(
+            "its {key} rate is {a:.3} as graded and {b:.3} without the residual, a difference of {:+.3}",
+            b - a
+        ),
+        _ => format!("no {key} rate is supported with or without the residual"),
+    };
+    Some(format!(
+        "Equilibrium residuals above 1/20 of the error, each of a load rule's size (the code's own load integration, checks.csv `residual_cause`): the key error of the field in equilibrium with the exported loads (Gamma_C held) differs from the file's by {}; {rates}.",
+        shifts.join(", ")
+    ))
+}
+
+/// Each level's [`LevelCheck::neighbour_ratio`]: the smallest delta / lambda_q of the graded
+/// levels before and after it (in level order).
+fn set_neighbour_ratios(levels: &mut [GradedLevel]) {
+    let ratios: Vec<f64> = levels.iter().map(|l| l.check.load_ratio()).collect();
+    for (i, l) in levels.iter_mut().enumerate() {
+        let near = [i.checked_sub(1), Some(i + 1)];
+        l.check.neighbour_ratio = near
+            .into_iter()
+            .flatten()
+            .filter_map(|j| ratios.get(j).copied())
+            .reduce(f64::min);
+    }
 }
 
 /// checks.csv's rows, and for each level that is no converged solution, why (its errors
@@ -538,6 +623,7 @@ fn measure_levels(
     req: &GradeRequest,
     family: &Family,
     truth: &Truth,
+    key: Quantity,
     files: &BTreeMap<usize, (Storage, PathBuf)>,
     cones: &Cones,
 ) -> Result<(Vec<GradedLevel>, Vec<BTreeMap<Quantity, f64>>, bool)> {
@@ -551,6 +637,7 @@ fn measure_levels(
                 &req.names,
                 family,
                 truth,
+                key,
                 mortar_at(cones, level),
             )
         })
@@ -691,6 +778,7 @@ fn grade_level(
     names: &FieldNames,
     family: &Family,
     truth: &Truth,
+    key: Quantity,
     mortar: Option<(&Case, &Solution)>,
 ) -> Result<(GradedLevel, BTreeMap<Quantity, f64>, bool)> {
     let steps = read_level(storage, path, names, family)?;
@@ -712,7 +800,13 @@ fn grade_level(
     if let Some(mortar) = mortar {
         errors.extend(distance_to_mortar(&history, mortar, &scale));
     }
-    let check = checks::check_level(&outside.model, &outside.interface, &history.steps)?;
+    let checked = checks::check_level(&outside.model, &outside.interface, &history.steps)?;
+    let mut check = checked.check;
+    let error = errors[&key];
+    if check.residual > LevelCheck::residual_limit(error) {
+        check.shift =
+            Some(corrected_error(&history, &checked.corrections, truth, key) / error - 1.0);
+    }
     let graded = GradedLevel {
         check,
         level,
@@ -726,6 +820,52 @@ fn grade_level(
         triangles: outside.model.elements.len(),
     };
     Ok((graded, errors, resultant_fixed))
+}
+
+/// The key error of `history` with each step's `corrections` taken off (u - c, sigma -
+/// C eps(c)): the field in equilibrium with the exported loads, Gamma_C's trace held. Its
+/// pressure is left out (the key quantity is not the pressure's).
+fn corrected_error(
+    history: &P1History,
+    corrections: &[Vec<f64>],
+    truth: &Truth,
+    key: Quantity,
+) -> f64 {
+    let model = history.model;
+    let steps = history
+        .steps
+        .iter()
+        .zip(corrections)
+        .map(|(step, c)| {
+            if c.is_empty() {
+                return P1Field {
+                    pressure: None,
+                    ..step.clone()
+                };
+            }
+            let u: Vec<f64> = step.u.iter().zip(c).map(|(u, c)| u - c).collect();
+            let change = model.elastic_stresses(c);
+            let stress = step
+                .stress
+                .iter()
+                .zip(&change)
+                .map(|(s, d)| s - d)
+                .collect::<Vec<_>>();
+            P1Field {
+                time: step.time,
+                u: u.into(),
+                stress: stress.into(),
+                pressure: None,
+                pressure_space: step.pressure_space,
+            }
+        })
+        .collect();
+    let corrected = P1History {
+        model,
+        interface: history.interface,
+        steps,
+    };
+    truth.measure(&corrected).0[&key]
 }
 
 /// The graded code's label: any name but a cone's.

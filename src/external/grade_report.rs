@@ -293,6 +293,8 @@ impl Graded {
         for m in methods.iter().filter(|m| m.cone().is_some()) {
             header.push(format!("{} / {m}", self.label));
         }
+        header.push(format!("{}: residual bound delta", self.label));
+        header.push(format!("{}: error without it", self.label));
         let mut table = Table::new(header);
         for l in &self.levels {
             let mut row = vec![l.level.to_string(), format!("{:.5}", l.h)];
@@ -302,6 +304,7 @@ impl Graded {
                         .map_or("-".into(), |r| format!("{:.4e}", r.error)),
                 );
             }
+            let check = self.checks.iter().find(|c| c.level == l.level);
             let mine = self.error(&label, l.level, self.key).map(|r| r.error);
             for m in methods.iter().filter(|m| m.cone().is_some()) {
                 let theirs = self.error(m, l.level, self.key).map(|r| r.error);
@@ -310,6 +313,11 @@ impl Graded {
                     _ => "-".into(),
                 });
             }
+            row.push(check.map_or("-".into(), |c| format!("{:.2e}", c.residual)));
+            row.push(match (mine, check.and_then(|c| c.error_shift)) {
+                (Some(e), Some(s)) => format!("{:.4e} ({:+.2}%)", e * (1.0 + s), 100.0 * s),
+                _ => "-".into(),
+            });
             table.row(row);
         }
         table
@@ -395,10 +403,13 @@ impl Graded {
         let mut table = Table::new([
             "level",
             "error",
-            "residual (limit)",
+            "residual delta (limit)",
+            "load rules' lambda_q",
+            "cause",
             "normal imbalance",
             "tangential",
             "pulling",
+            "force limit",
             "pressure resultant / exact",
             "verdict",
         ]);
@@ -408,9 +419,12 @@ impl Graded {
                 c.level.to_string(),
                 format!("{:.4e}", c.error),
                 format!("{:.2e} ({:.2e})", c.residual, c.residual_limit),
+                opt(c.load_rule_residual),
+                c.residual_cause.clone().unwrap_or_else(|| "-".into()),
                 opt(c.normal_imbalance),
                 opt(c.tangential),
                 opt(c.pulling),
+                opt(c.force_limit),
                 c.pressure_ratio.map_or("-".into(), |r| format!("{r:.6}")),
                 c.verdict.clone(),
             ]);
@@ -434,4 +448,4 @@ impl Graded {
     }
 }
 
-const CHECKS_TEXT: &str = "Before a level gives a rate, grade checks that it is a converged solution of this problem: the equilibrium residual r of the P1 problem on the file's mesh (its stress, or C eps(u_h); the scene's loads; the supports' and Gamma_C's dofs held) in energy, sqrt(r^T K^-1 r) / ||u_h||_E, at most 1/20 of the level's error (or 1e-10, round-off); on Gamma_C, the two sides' normal forces equal, no tangential and no pulling force, each to 1e-3 of the resultant. The pressure's resultant at T is read against the exact one's: a negative ratio or a constant factor is refused (docs/verify-your-code.md).";
+const CHECKS_TEXT: &str = "Before a level gives a rate, grade checks that it is a converged solution of a P1 discretization of this problem. The equilibrium residual r of the P1 problem on the file's mesh (its stress, or C eps(u_h); the exported loads; the supports' and Gamma_C's dofs held), in energy, delta = sqrt(r^T K^-1 r) / ||u_h||_E, is the distance to the field in equilibrium with the exported loads (Gamma_C held), whose error it adds to in squares: the bound printed beside each error. A code that integrates the loads with its own rule leaves one, of the size lambda_q the common plain rules leave on the same mesh (centroid, 3 interior points, 3 x 3 Gauss, Dunavant 16, none split at the loads' kinks): a level is refused as unconverged where delta exceeds 1/20 of its error and either 3 lambda_q or 3 times a neighbouring level's delta / lambda_q (a load rule's residual follows the mesh; a stopped solve's does not), and whatever the cause where delta exceeds 1/2 of its error. On Gamma_C, the two sides' normal forces equal, no tangential and no pulling force, each to 1e-3 of the resultant, or to 3 (delta / lambda_q) times the common rules' load difference on Gamma_C's nodes where larger. The pressure's resultant at T is read against the exact one's: a negative ratio or a constant factor is refused (docs/verify-your-code.md).";

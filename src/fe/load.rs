@@ -145,6 +145,53 @@ impl LoadPrograms {
     }
 }
 
+/// A plain quadrature of the load, as another code may integrate it: one rule on every
+/// triangle and one on every traction edge, neither split at the load's kinks nor graded
+/// toward a singular point ([`Model::load_by_rule`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadRule {
+    /// Its name in messages ("centroid", ...).
+    pub name: &'static str,
+    /// The triangles' rule as [`quadrature::triangle`]'s (l1, l2, weight), weights summing to 1.
+    pub triangle: Vec<(f64, f64, f64)>,
+    /// The edges' rule on [0, 1] as (s, weight), weights summing to 1.
+    pub segment: Vec<(f64, f64)>,
+}
+
+impl LoadRule {
+    /// The plain rules of P1 codes, lowest first: the centroid (degree 1, one point; an
+    /// edge's midpoint), three interior points (degree 2, Strang and Fix; 2 Gauss points),
+    /// the collapsed 3 x 3 Gauss rule (degree 4; 3 Gauss points) and Dunavant's degree-8 rule
+    /// (8 Gauss points: the load's own rule without its split at the kinks). All points are
+    /// interior, so a load singular at a vertex is finite at each.
+    pub fn common() -> Vec<LoadRule> {
+        let third = 1.0 / 3.0;
+        let (a, b) = (1.0 / 6.0, 2.0 / 3.0);
+        vec![
+            LoadRule {
+                name: "centroid (degree 1)",
+                triangle: vec![(third, third, 1.0)],
+                segment: quadrature::gauss_legendre(1),
+            },
+            LoadRule {
+                name: "3 interior points (degree 2)",
+                triangle: vec![(a, a, third), (b, a, third), (a, b, third)],
+                segment: quadrature::gauss_legendre(2),
+            },
+            LoadRule {
+                name: "3 x 3 collapsed Gauss (degree 4)",
+                triangle: quadrature::triangle(3),
+                segment: quadrature::gauss_legendre(3),
+            },
+            LoadRule {
+                name: "Dunavant 16 points (degree 8)",
+                triangle: quadrature::dunavant8(),
+                segment: quadrature::gauss_legendre(8),
+            },
+        ]
+    }
+}
+
 /// Forget every load integrated so far (the speed study times a fresh process's work).
 pub fn forget_loads() {
     FIELDS
@@ -164,11 +211,14 @@ impl Model {
     /// [`quadrature::split_triangle`] otherwise). A load t^k g(x, y) is integrated once, at
     /// t = 1, and scaled by t^k (for t > 0).
     pub fn load(&self, t: f64) -> Result<Vec<f64>> {
+        if let Some(rule) = &self.load_rule {
+            return self.load_by_rule(t, rule);
+        }
         let programs = self
             .load_programs
             .get_or_init(|| Arc::new(LoadPrograms::new(self)));
         let Some(k) = programs.time_degree().filter(|_| t > 0.0) else {
-            return Ok(self.integrate_load(programs, t)?.0);
+            return Ok(self.integrate_load(programs, t, None)?.0);
         };
         let key = programs.fingerprint;
         let cached = FIELDS
@@ -180,7 +230,7 @@ impl Model {
         let field = match cached {
             Some(field) => field,
             None => {
-                let field = Arc::new(self.integrate_load(programs, 1.0)?.0);
+                let field = Arc::new(self.integrate_load(programs, 1.0, None)?.0);
                 let mut fields = FIELDS.lock().expect("no thread panics holding the loads");
                 if fields.len() >= FIELDS_KEPT {
                     fields.remove(0);
@@ -197,25 +247,61 @@ impl Model {
     /// cached: the number of quadrature points it took (what `study speed` divides the
     /// time by).
     pub fn integrate_load_from_scratch(&self, t: f64) -> Result<usize> {
-        Ok(self.integrate_load(&LoadPrograms::new(self), t)?.1)
+        Ok(self.integrate_load(&LoadPrograms::new(self), t, None)?.1)
     }
 
-    /// The load at `t`, integrated, and the number of quadrature points.
-    fn integrate_load(&self, programs: &LoadPrograms, t: f64) -> Result<(Vec<f64>, usize)> {
+    /// The load at `t` (force, over global dofs) integrated by the plain rule `rule`: as
+    /// another code may integrate it, one rule per triangle and per traction edge, not split
+    /// at the load's kinks. Not cached.
+    pub fn load_by_rule(&self, t: f64, rule: &LoadRule) -> Result<Vec<f64>> {
+        let programs = self
+            .load_programs
+            .get_or_init(|| Arc::new(LoadPrograms::new(self)));
+        Ok(self.integrate_load(programs, t, Some(rule))?.0)
+    }
+
+    /// The load at `t`, integrated (by `plain`, or with the load's own rules where `None`),
+    /// and the number of quadrature points.
+    fn integrate_load(
+        &self,
+        programs: &LoadPrograms,
+        t: f64,
+        plain: Option<&LoadRule>,
+    ) -> Result<(Vec<f64>, usize)> {
         let mut f = vec![0.0; 2 * self.n_nodes];
-        let mut points = self.add_tractions(programs, t, &mut f)?;
+        let mut points = self.add_tractions(programs, t, plain, &mut f)?;
         for body in 0..2 {
             if let Some(bf) = &programs.body[body] {
-                points += self.add_body_force(bf, body, t, &mut f)?;
+                points += self.add_body_force(bf, body, t, plain, &mut f)?;
             }
         }
         Ok((f, points))
     }
 
-    /// The tractions' share of the load; returns the number of quadrature points.
-    fn add_tractions(&self, programs: &LoadPrograms, t: f64, f: &mut [f64]) -> Result<usize> {
-        let segment = quadrature::gauss_legendre(8);
+    /// The tractions' share of the load (by `plain` where given); returns the number of
+    /// quadrature points.
+    fn add_tractions(
+        &self,
+        programs: &LoadPrograms,
+        t: f64,
+        plain: Option<&LoadRule>,
+        f: &mut [f64],
+    ) -> Result<usize> {
+        let segment = match plain {
+            Some(rule) => rule.segment.clone(),
+            None => quadrature::gauss_legendre(8),
+        };
         let exact = self.scene.exact.as_deref();
+        fn kinks_of<'e>(
+            exprs: &'e [Expr],
+            t: f64,
+            plain: bool,
+        ) -> Vec<crate::expr::KinkFunction<'e>> {
+            match plain {
+                true => Vec::new(),
+                false => kink_functions(&distinct_kinks(exprs), t),
+            }
+        }
         // The kinks at t of each traction's expressions (a derived traction: of the body's
         // stress), built once per call rather than per edge.
         let traction_kinks: Vec<_> = self
@@ -223,12 +309,12 @@ impl Model {
             .tractions
             .iter()
             .map(|tr| match &tr.g {
-                Some(g) => kink_functions(&distinct_kinks(&g.0), t),
+                Some(g) => kinks_of(&g.0, t, plain.is_some()),
                 None => Vec::new(),
             })
             .collect();
         let stress_kinks = [0, 1].map(|b| match exact.and_then(|e| e.stress.as_ref()) {
-            Some(st) => kink_functions(&distinct_kinks(&st[b]), t),
+            Some(st) => kinks_of(&st[b], t, plain.is_some()),
             None => Vec::new(),
         });
         let mut registers = Vec::new();
@@ -294,16 +380,30 @@ impl Model {
     /// Body `body`'s body force share of the load: each triangle's three nodal forces on a
     /// core of its own, added in element order (the same sums for any number of threads).
     /// Returns the number of quadrature points.
-    fn add_body_force(&self, bf: &BodyForce, body: usize, t: f64, f: &mut [f64]) -> Result<usize> {
-        let kinks = kink_functions(&distinct_kinks(&bf.exprs), t);
-        let triangle = quadrature::dunavant8();
+    fn add_body_force(
+        &self,
+        bf: &BodyForce,
+        body: usize,
+        t: f64,
+        plain: Option<&LoadRule>,
+        f: &mut [f64],
+    ) -> Result<usize> {
+        let kinks = match plain {
+            Some(_) => Vec::new(),
+            None => kink_functions(&distinct_kinks(&bf.exprs), t),
+        };
+        let triangle = match plain {
+            Some(rule) => rule.triangle.clone(),
+            None => quadrature::dunavant8(),
+        };
         // A singular part's load r^(beta-2) (times P1, smooth along the rays) and the rest
         // of the load, each with its own rule on the triangles at the point.
         let singular = self
             .scene
             .exact
             .as_deref()
-            .and_then(|e| e.singular.as_ref());
+            .and_then(|e| e.singular.as_ref())
+            .filter(|_| plain.is_none());
         let powers = singular.map_or([0.0; 2], |s| [0.0, s.exponent - 2.0]);
         let point = singular.map(|s| s.point);
         let elements: Vec<&Element> = self.elements.iter().filter(|e| e.body == body).collect();

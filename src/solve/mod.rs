@@ -85,6 +85,10 @@ pub struct Settings {
     pub omega: Option<f64>,
     /// Relaxation rho in (0, 1] of the paper's solver.
     pub rho: f64,
+    /// Newton only: end each step after this many iterations and keep the iterate,
+    /// converged or not (what a code with a fixed iteration count writes: `grade`'s tests
+    /// of unconverged files). `None`: iterate to the tolerance.
+    pub stop_after: Option<usize>,
 }
 
 impl Default for Settings {
@@ -95,6 +99,7 @@ impl Default for Settings {
             max_iterations: 60,
             omega: None,
             rho: 0.5,
+            stop_after: None,
         }
     }
 }

@@ -904,7 +904,11 @@ impl Newton<'_> {
         }
         let (res, compl) = (distance.residual, distance.complementarity);
         let (iterations, factorizations) = (counts.iterations, counts.factorizations);
+        let stopped = self.settings.stop_after == Some(iterations);
         let reason = match iterations {
+            _ if stopped => format!(
+                "stopped after {iterations} iterations (stop_after) at residual {res:.2e}, complementarity {compl:.2e}: not necessarily converged"
+            ),
             0 => format!(
                 "the predictor's residual {res:.2e} and complementarity {compl:.2e} below {:.0e}: no iteration needed",
                 self.settings.tol
@@ -1045,7 +1049,11 @@ impl StepSolver for Newton<'_> {
             // cost a preconditioner solve, a product and a return map each (5 iterations
             // to 2).
             let settled = same_set || counts.iterations == 0;
-            if res <= self.settings.tol && compl <= self.settings.tol && settled {
+            let stopped = self
+                .settings
+                .stop_after
+                .is_some_and(|k| counts.iterations >= k);
+            if stopped || (res <= self.settings.tol && compl <= self.settings.tol && settled) {
                 let iterate = (u, evaluation.sigma, lambda);
                 return Ok(self.converged(t, iterate, &active, &distance, &counts));
             }
