@@ -16,13 +16,16 @@
 //!     the scene's loads on the file's mesh with the common plain rules of P1 codes
 //!     ([`LoadRule::common`]: no split at the loads' kinks) and takes the largest of their
 //!     residuals, lambda_q, as the size a load rule leaves on that mesh;
-//!   - **a solve stopped before it converged**: its residual is the iteration's, tied to no
-//!     mesh: it does not fall with h as lambda_q does.
+//!   - **a solve stopped before it converged**: its residual is the iteration's, tied to
+//!     neither the mesh nor the load. Where the load is t^k times a field of (x, y) (every
+//!     manufactured scene), any rule's integral of it scales as t^k, and so does a load
+//!     rule's residual, to the solver's round-off; an iteration's does not. The residuals of
+//!     the steps are fitted by t_n^k times one vector (least squares in K^-1's norm): the
+//!     part left over, delta_w, is the residual that is no load rule's.
 //!
 //!   A level is refused as unconverged where delta exceeds 1/20 of its error (below that, a
-//!   perturbation orthogonal to the error in energy moves it by at most 0.13%) and
-//!   LOAD_MARGIN lambda_q, or its ratio to lambda_q exceeds LOAD_MARGIN times a
-//!   neighbouring level's (it does not fall with h as a load rule's does); and whatever the
+//!   perturbation orthogonal to the error in energy moves it by at most 0.13%) and either
+//!   delta_w exceeds 1/20 of its error or delta exceeds LOAD_MARGIN lambda_q; and whatever the
 //!   cause where delta exceeds BOUND_SHARE of its error. Otherwise it is graded with delta
 //!   printed beside its error, and where delta exceeds 1/20 of the error, with the key
 //!   error of u~_h beside the file's (`shift`): `grade` judges the key rate of those errors
@@ -88,9 +91,10 @@ pub struct LevelCheck {
     /// (e(u~_h) - e(u_h)) / e(u_h) in the key quantity, where delta exceeds 1/20 of the
     /// error (measured by `grade`); `None` where it does not.
     pub shift: Option<f64>,
-    /// The smallest delta / lambda_q of the graded levels next to this one (set by `grade`
-    /// over the family; `None` for a level graded alone).
-    pub neighbour_ratio: Option<f64>,
+    /// delta_w: the part of the residual (relative as delta, maximum over the steps) that
+    /// does not scale with the load as t^k; `None` with one step, or a load that is not t^k
+    /// times a field of (x, y).
+    pub off_load: Option<f64>,
     /// |P_1 - P_2| / P, the two sides' normal forces; `None` where nothing touches.
     pub imbalance: Option<f64>,
     /// The tangential forces on Gamma_C over P.
@@ -141,21 +145,14 @@ impl LevelCheck {
     }
 
     /// What the residual points to, given the level's key error `error`: a load rule's where
-    /// delta is at most LOAD_MARGIN lambda_q and its ratio delta / lambda_q at most
-    /// LOAD_MARGIN times each neighbour's (a load rule's residual follows the mesh as the
-    /// common rules' do: GetFEM's IM_TRIANGLE(2) and (6) on rates-exact levels 0-4 keep the
-    /// ratio within a factor 2 from level to level; a stopped solve's residual is tied to no
-    /// mesh, and its ratio grows as lambda_q falls). A level whose own ratio is far below its
-    /// neighbours' (a rule that happens to be exact there) makes them look unconverged: the
-    /// rule errs toward refusing.
+    /// delta is at most LOAD_MARGIN lambda_q and its part that does not scale with the load
+    /// (delta_w) is at most 1/20 of the error.
     pub fn cause(&self, error: f64) -> ResidualCause {
-        let ratio = self.load_ratio();
-        let follows = self
-            .neighbour_ratio
-            .is_none_or(|n| ratio <= LOAD_MARGIN * n);
-        if self.residual <= Self::residual_limit(error) {
+        let limit = Self::residual_limit(error);
+        let off_load = self.off_load.is_some_and(|w| w > limit);
+        if self.residual <= limit {
             ResidualCause::None
-        } else if ratio <= LOAD_MARGIN && follows {
+        } else if self.load_ratio() <= LOAD_MARGIN && !off_load {
             ResidualCause::LoadRule
         } else {
             ResidualCause::Unconverged
@@ -181,19 +178,19 @@ impl LevelCheck {
         let mut out = Vec::new();
         let cause = self.cause(error);
         if cause == ResidualCause::Unconverged {
-            let ratio = self.load_ratio();
-            let against = match self.neighbour_ratio {
-                Some(n) if ratio > LOAD_MARGIN * n && ratio <= LOAD_MARGIN => format!(
-                    "{ratio:.3} times the {:.3e} the common load rules leave on this mesh, where a level next to it has {n:.3e} times theirs: it does not follow the mesh as a load rule's does",
-                    self.load_rule_residual
+            let limit = Self::residual_limit(error);
+            let against = match self.off_load {
+                Some(w) if w > limit => format!(
+                    "{w:.3e} of it does not scale with the load from step to step, as a load rule's residual does"
                 ),
                 _ => format!(
-                    "{ratio:.3} times the {:.3e} the common load rules leave on this mesh, more than any load rule leaves ({LOAD_MARGIN} times)",
+                    "it is {:.3} times the {:.3e} the common load rules leave on this mesh, more than a load rule leaves ({LOAD_MARGIN} times)",
+                    self.load_ratio(),
                     self.load_rule_residual
                 ),
             };
             out.push(format!(
-                "its equilibrium residual in energy is {:.3e} of ||u_h||_E, above 1/20 of its error {error:.3e} and {against}: the solve stopped before it converged (tighten the solver's tolerance, or raise its iteration limit)",
+                "its equilibrium residual in energy is {:.3e} of ||u_h||_E, above 1/20 of its error {error:.3e}, and {against}: the solve stopped before it converged (tighten the solver's tolerance, or raise its iteration limit)",
                 self.residual
             ));
         }
@@ -244,6 +241,9 @@ pub struct CheckRecord {
     /// lambda_q: the largest delta of the common plain load rules on this mesh.
     #[serde(default)]
     pub load_rule_residual: Option<f64>,
+    /// delta_w: the residual's part that does not scale with the load from step to step.
+    #[serde(default)]
+    pub residual_off_load: Option<f64>,
     /// What the residual points to: none, load rule, unconverged.
     #[serde(default)]
     pub residual_cause: Option<String>,
@@ -272,6 +272,7 @@ impl CheckRecord {
             residual: check.residual,
             residual_limit: LevelCheck::residual_limit(error),
             load_rule_residual: Some(check.load_rule_residual),
+            residual_off_load: check.off_load,
             residual_cause: Some(check.cause(error).name().into()),
             error_shift: check.shift,
             normal_imbalance: check.imbalance,
@@ -426,6 +427,8 @@ pub fn check_level(model: &Model, interface: &Interface, steps: &[P1Field]) -> R
     let mut corrections = Vec::with_capacity(steps.len());
     let mut load = Vec::new();
     let max = |a: Option<f64>, b: f64| Some(a.map_or(b, |a| a.max(b)));
+    // Per step: the residual over the free dofs, K^-1 of it and ||u_h||_E^2.
+    let mut fitted: Vec<(Vec<f64>, Vec<f64>, f64)> = Vec::with_capacity(steps.len());
     for step in steps {
         load = model.load(step.time)?;
         let internal = model.internal_force(&step.stress);
@@ -447,6 +450,9 @@ pub fn check_level(model: &Model, interface: &Interface, steps: &[P1Field]) -> R
         };
         let (delta, z) = in_energy(&reaction);
         out.residual = out.residual.max(delta);
+        if !z.is_empty() {
+            fitted.push((held.restrict(&reaction), z.clone(), energy));
+        }
         corrections.push(match delta > RESIDUAL_FLOOR {
             true => held.expand(&z),
             false => Vec::new(),
@@ -468,6 +474,10 @@ pub fn check_level(model: &Model, interface: &Interface, steps: &[P1Field]) -> R
             }
         }
     }
+    if let (Some(k), true) = (model.load_time_degree(), fitted.len() >= 2) {
+        let scales: Vec<f64> = steps.iter().map(|s| s.time.powf(k)).collect();
+        out.off_load = Some(off_load(&fitted, &scales));
+    }
     if let Some(last) = steps.last() {
         out.pressure_ratio = pressure_ratio(model, interface, last, &load);
     }
@@ -475,6 +485,31 @@ pub fn check_level(model: &Model, interface: &Interface, steps: &[P1Field]) -> R
         check: out,
         corrections,
     })
+}
+
+/// delta_w: the steps' residuals r_n (with z_n = K^-1 r_n and ||u_h||_E^2 at each) fitted
+/// by s_n rho, s_n = t_n^k (least squares: rho = sum s_n r_n / sum s_n^2, the same in any
+/// norm), and the largest remainder sqrt((r_n - s_n rho)^T K^-1 (r_n - s_n rho)) / ||u_h||_E.
+fn off_load(fitted: &[(Vec<f64>, Vec<f64>, f64)], scales: &[f64]) -> f64 {
+    let norm: f64 = scales.iter().map(|s| s * s).sum();
+    let n = fitted[0].0.len();
+    let (mut rho, mut zeta) = (vec![0.0; n], vec![0.0; n]);
+    for ((r, z, _), s) in fitted.iter().zip(scales) {
+        for i in 0..n {
+            rho[i] += s * r[i] / norm;
+            zeta[i] += s * z[i] / norm;
+        }
+    }
+    fitted
+        .iter()
+        .zip(scales)
+        .map(|((r, z, energy), s)| {
+            let w: f64 = (0..n)
+                .map(|i| (r[i] - s * rho[i]) * (z[i] - s * zeta[i]))
+                .sum();
+            (w.max(0.0) / energy).sqrt()
+        })
+        .fold(0.0, f64::max)
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {

@@ -424,9 +424,8 @@ pub fn grade(req: &GradeRequest) -> Result<Graded> {
     let key = key_quantity(exact);
     let files = level_files(&req.solutions, req.levels.as_deref())?;
     let cones = solve_cones(&family, &files, req.compare)?;
-    let (mut levels, measured, resultant_fixed) =
+    let (levels, measured, resultant_fixed) =
         measure_levels(req, &family, &truth, key, &files, &cones)?;
-    set_neighbour_ratios(&mut levels);
     check_distinct_h(&levels, &req.solutions)?;
     let ratios: Vec<(usize, &Path, f64)> = levels
         .iter()
@@ -544,20 +543,6 @@ fn residual_note(
         "Equilibrium residuals above 1/20 of the error, each of a load rule's size (the code's own load integration, checks.csv `residual_cause`): the key error of the field in equilibrium with the exported loads (Gamma_C held) differs from the file's by {}; {rates}.",
         shifts.join(", ")
     ))
-}
-
-/// Each level's [`LevelCheck::neighbour_ratio`]: the smallest delta / lambda_q of the graded
-/// levels before and after it (in level order).
-fn set_neighbour_ratios(levels: &mut [GradedLevel]) {
-    let ratios: Vec<f64> = levels.iter().map(|l| l.check.load_ratio()).collect();
-    for (i, l) in levels.iter_mut().enumerate() {
-        let near = [i.checked_sub(1), Some(i + 1)];
-        l.check.neighbour_ratio = near
-            .into_iter()
-            .flatten()
-            .filter_map(|j| ratios.get(j).copied())
-            .reduce(f64::min);
-    }
 }
 
 /// checks.csv's rows, and for each level that is no converged solution, why (its errors

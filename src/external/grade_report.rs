@@ -405,6 +405,7 @@ impl Graded {
             "error",
             "residual delta (limit)",
             "load rules' lambda_q",
+            "not scaling with the load",
             "cause",
             "normal imbalance",
             "tangential",
@@ -420,6 +421,7 @@ impl Graded {
                 format!("{:.4e}", c.error),
                 format!("{:.2e} ({:.2e})", c.residual, c.residual_limit),
                 opt(c.load_rule_residual),
+                opt(c.residual_off_load),
                 c.residual_cause.clone().unwrap_or_else(|| "-".into()),
                 opt(c.normal_imbalance),
                 opt(c.tangential),
@@ -448,4 +450,4 @@ impl Graded {
     }
 }
 
-const CHECKS_TEXT: &str = "Before a level gives a rate, grade checks that it is a converged solution of a P1 discretization of this problem. The equilibrium residual r of the P1 problem on the file's mesh (its stress, or C eps(u_h); the exported loads; the supports' and Gamma_C's dofs held), in energy, delta = sqrt(r^T K^-1 r) / ||u_h||_E, is the distance to the field in equilibrium with the exported loads (Gamma_C held), whose error it adds to in squares: the bound printed beside each error. A code that integrates the loads with its own rule leaves one, of the size lambda_q the common plain rules leave on the same mesh (centroid, 3 interior points, 3 x 3 Gauss, Dunavant 16, none split at the loads' kinks): a level is refused as unconverged where delta exceeds 1/20 of its error and either 3 lambda_q or 3 times a neighbouring level's delta / lambda_q (a load rule's residual follows the mesh; a stopped solve's does not), and whatever the cause where delta exceeds 1/2 of its error. On Gamma_C, the two sides' normal forces equal, no tangential and no pulling force, each to 1e-3 of the resultant, or to 3 (delta / lambda_q) times the common rules' load difference on Gamma_C's nodes where larger. The pressure's resultant at T is read against the exact one's: a negative ratio or a constant factor is refused (docs/verify-your-code.md).";
+const CHECKS_TEXT: &str = "Before a level gives a rate, grade checks that it is a converged solution of a P1 discretization of this problem. The equilibrium residual r of the P1 problem on the file's mesh (its stress, or C eps(u_h); the exported loads; the supports' and Gamma_C's dofs held), in energy, delta = sqrt(r^T K^-1 r) / ||u_h||_E, is the distance to the field in equilibrium with the exported loads (Gamma_C held), whose error it adds to in squares: the bound printed beside each error. A code that integrates the loads with its own rule leaves one, of the size lambda_q the common plain rules leave on the same mesh (centroid, 3 interior points, 3 x 3 Gauss, Dunavant 16, none split at the loads' kinks): a load that is t^k times a field of (x, y) makes a load rule's residual scale as t^k from step to step, an iteration's not, and the part that does not, delta_w, is measured. A level is refused as unconverged where delta exceeds 1/20 of its error and either delta_w exceeds 1/20 of its error or delta exceeds 3 lambda_q; and whatever the cause where delta exceeds 1/2 of its error. On Gamma_C, the two sides' normal forces equal, no tangential and no pulling force, each to 1e-3 of the resultant, or to 3 (delta / lambda_q) times the common rules' load difference on Gamma_C's nodes where larger. The pressure's resultant at T is read against the exact one's: a negative ratio or a constant factor is refused (docs/verify-your-code.md).";

@@ -250,6 +250,14 @@ impl Model {
         Ok(self.integrate_load(&LoadPrograms::new(self), t, None)?.1)
     }
 
+    /// The k with the whole load t^k times a field of (x, y) for t > 0, if there is one (then
+    /// any rule's integral of it, and so any difference of two rules', scales as t^k).
+    pub fn load_time_degree(&self) -> Option<f64> {
+        self.load_programs
+            .get_or_init(|| Arc::new(LoadPrograms::new(self)))
+            .time_degree()
+    }
+
     /// The load at `t` (force, over global dofs) integrated by the plain rule `rule`: as
     /// another code may integrate it, one rule per triangle and per traction edge, not split
     /// at the load's kinks. Not cached.
