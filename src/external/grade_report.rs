@@ -410,7 +410,7 @@ impl Graded {
             "normal imbalance",
             "tangential",
             "pulling",
-            "force limit",
+            "force limits",
             "pressure resultant / exact",
             "verdict",
         ]);
@@ -426,7 +426,10 @@ impl Graded {
                 opt(c.normal_imbalance),
                 opt(c.tangential),
                 opt(c.pulling),
-                opt(c.force_limit),
+                match (c.imbalance_limit, c.tangential_limit, c.pulling_limit) {
+                    (Some(a), Some(b), Some(p)) => format!("{a:.1e} / {b:.1e} / {p:.1e}"),
+                    _ => "-".into(),
+                },
                 c.pressure_ratio.map_or("-".into(), |r| format!("{r:.6}")),
                 c.verdict.clone(),
             ]);
@@ -450,4 +453,4 @@ impl Graded {
     }
 }
 
-const CHECKS_TEXT: &str = "Before a level gives a rate, grade checks that it is a converged solution of a P1 discretization of this problem. The equilibrium residual r of the P1 problem on the file's mesh (its stress, or C eps(u_h); the exported loads; the supports' and Gamma_C's dofs held), in energy, delta = sqrt(r^T K^-1 r) / ||u_h||_E, is the distance to the field in equilibrium with the exported loads (Gamma_C held), whose error it adds to in squares: the bound printed beside each error. A code that integrates the loads with its own rule leaves one, of the size lambda_q the common plain rules leave on the same mesh (centroid, 3 interior points, 3 x 3 Gauss, Dunavant 16, none split at the loads' kinks): a load that is t^k times a field of (x, y) makes a load rule's residual scale as t^k from step to step, an iteration's not, and the part that does not, delta_w, is measured. A level is refused as unconverged where delta exceeds 1/20 of its error and either delta_w exceeds 1/20 of its error or delta exceeds 3 lambda_q; and whatever the cause where delta exceeds 1/2 of its error. On Gamma_C, the two sides' normal forces equal, no tangential and no pulling force, each to 1e-3 of the resultant, or to 3 (delta / lambda_q) times the common rules' load difference on Gamma_C's nodes where larger. The pressure's resultant at T is read against the exact one's: a negative ratio or a constant factor is refused (docs/verify-your-code.md).";
+const CHECKS_TEXT: &str = "Before a level gives a rate, grade checks that it is a converged solution of a P1 discretization of this problem. The equilibrium residual r of the P1 problem on the file's mesh (its stress, or C eps(u_h); the exported loads; the supports' and Gamma_C's dofs held), in energy, delta = sqrt(r^T K^-1 r) / ||u_h||_E, is the energy distance to the field in equilibrium with the exported loads (Gamma_C held), whose energy error it adds to in squares: the bound printed beside each error, with, where it exceeds 1/20 of the error, the key error of that field (measured in the key norm). A code that integrates the loads with its own rule leaves one, of the size lambda_q the common plain rules leave on the same mesh (centroid, 3 interior points, 3 x 3 Gauss, Dunavant 16, none split at the loads' kinks): a load that is t^k times a field of (x, y) makes a load rule's residual scale as t^k from step to step, an iteration's not, and the part that does not, delta_w, is measured. A level is refused as unconverged where delta exceeds 1/20 of its error and either delta_w exceeds 1/20 of its error or delta exceeds 3 lambda_q; and whatever the cause where delta exceeds 1/2 of its error. On Gamma_C, the two sides' normal forces equal, no tangential and no pulling force, each to 1e-3 of the resultant, or, where the residual is no iteration's, to 3 (delta / lambda_q) times what the common rules' load differences alone put into that check, where larger. The pressure's resultant at T is read against the exact one's: a negative ratio or a constant factor is refused (docs/verify-your-code.md).";
