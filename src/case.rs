@@ -243,37 +243,59 @@ fn machine_memory() -> Option<f64> {
     Some(kb * 1024.0)
 }
 
-/// Refuse a level whose estimated memory exceeds the machine's, before refining to it: the
-/// dofs of level 0 (meshed, or fetched from the cache) times 4 per level, times
-/// [`BYTES_PER_DOF`]. The message gives the estimate and the largest level that fits.
+/// Refuse a level whose estimated memory exceeds the machine's, before refining to it
+/// ([`memory_refusal`]), naming the scene file.
 fn check_memory(scene: &Scene, params: &[(String, f64)], level: usize) -> Result<()> {
+    match memory_refusal(scene, params, level)? {
+        Some(message) => Err(Error::input(&scene.file, "level", message)),
+        None => Ok(()),
+    }
+}
+
+/// Why `level` of `scene` (with the checked gmsh parameters `params`) does not fit in this
+/// machine's memory, or `None` where it fits (or the memory is unknown): the dofs of level 0
+/// (meshed, or fetched from the cache) times 4 per level, times [`BYTES_PER_DOF`]. The text
+/// gives the estimate and the largest level that fits. Nothing finer than level 0 is meshed.
+pub fn memory_refusal(
+    scene: &Scene,
+    params: &[(String, f64)],
+    level: usize,
+) -> Result<Option<String>> {
     let Some(available) = machine_memory() else {
-        return Ok(());
+        return Ok(None);
     };
+    if level == 0 {
+        return Ok(None);
+    }
     let (_, raw) = mesh_healed(scene, params, 0)?;
     let dofs = |l: usize| 2.0 * raw.nodes.len() as f64 * 4f64.powi(l as i32);
     let bytes = |l: usize| dofs(l) * BYTES_PER_DOF;
     if bytes(level) <= available {
-        return Ok(());
+        return Ok(None);
     }
     let gib = |b: f64| b / (1024.0 * 1024.0 * 1024.0);
     let fits = (0..level)
         .rev()
         .find(|&l| bytes(l) <= available)
         .unwrap_or(0);
-    Err(Error::input(
-        &scene.file,
-        "level",
-        format!(
-            "level {level} needs about {:.1e} dofs and {:.0} GiB ({:.0} KB per dof, measured), more than this machine's {:.1} GiB; the largest level that fits is {fits} ({:.1e} dofs, {:.1} GiB)",
-            dofs(level),
-            gib(bytes(level)),
-            BYTES_PER_DOF / 1e3,
-            gib(available),
-            dofs(fits),
-            gib(bytes(fits)),
-        ),
-    ))
+    Ok(Some(format!(
+        "level {level} needs about {:.1e} dofs and {:.0} GiB ({:.0} KB per dof, measured), more than this machine's {:.1} GiB; the largest level that fits is {fits} ({:.1e} dofs, {:.1} GiB)",
+        dofs(level),
+        gib(bytes(level)),
+        BYTES_PER_DOF / 1e3,
+        gib(available),
+        dofs(fits),
+        gib(bytes(fits)),
+    )))
+}
+
+/// [`memory_refusal`] for `scene` with `params` overriding its gmsh parameters (checked).
+pub fn memory_refusal_of(
+    scene: &Scene,
+    params: &[(String, f64)],
+    level: usize,
+) -> Result<Option<String>> {
+    memory_refusal(scene, &checked_parameters(scene, params)?, level)
 }
 
 /// The mesh of `scene` at `level` and its contents. A cached file that does not parse (a

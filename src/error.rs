@@ -16,6 +16,14 @@ pub enum Error {
         /// What is wrong and how to fix it.
         message: String,
     },
+    /// A bad command-line value: the option as given, what is wrong and how to fix it.
+    #[error("{option}: {message}")]
+    Argument {
+        /// The option and its value, as on the command line.
+        option: String,
+        /// What is wrong and how to fix it.
+        message: String,
+    },
     /// gmsh is missing or failed.
     #[error("gmsh: {0}")]
     Gmsh(String),

@@ -326,6 +326,15 @@ fn study_file_errors_through_the_binary() {
             vec!["study.toml", "mesh.levels", "at least 3 levels, got 0"],
         ),
         (
+            // A level beyond the machine's memory, refused before meshing it (issue 74).
+            Box::new(|t| t.replace("levels = [0, 1, 2]", "levels = [0, 1, 14]")),
+            vec![
+                "study.toml",
+                "mesh.levels",
+                "the largest level that fits is",
+            ],
+        ),
+        (
             // Two levels with the same h: no rate between them (issue 20).
             Box::new(|t| t.replace("levels = [0, 1, 2]", "levels = [0, 1, 1, 2]")),
             vec!["study.toml", "mesh.levels", "same h"],
@@ -527,4 +536,26 @@ fn a_bad_singular_part_names_its_field_and_fix() {
         fails_with(&solve_scene(&f, &out, &[]), &needles);
         assert!(!out.exists(), "no output after a failure");
     }
+}
+
+/// `export` refuses levels beyond the machine's memory before meshing or writing anything
+/// (issue 74: `--levels 0-12` had gmsh at 15 GB refining level 10).
+#[test]
+fn export_of_levels_beyond_memory_is_refused_before_meshing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("export");
+    let run = common::run(
+        &[
+            "export",
+            "--study",
+            "rates-exact",
+            "--levels",
+            "0-14",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    fails_with(&run, &["--levels 0-14", "the largest level that fits is"]);
+    assert!(!out.exists(), "nothing is written");
 }

@@ -98,6 +98,18 @@ pub fn export_mesh(model: &Model, raw: &RawMesh) -> ExportMesh {
 /// Export `source` at `levels` into `out`, all or nothing.
 pub fn export(source: &Source, levels: &[usize], out: &Path) -> Result<Exported> {
     let family = Family::resolve(source)?;
+    // Before anything is meshed or written: the finest level must fit in memory (gmsh alone
+    // took 15 GB refining level 10 of rates-exact).
+    if let Some(&finest) = levels.iter().max() {
+        if let Some(message) =
+            crate::case::memory_refusal_of(&family.scene, &family.params, finest)?
+        {
+            return Err(Error::Argument {
+                option: format!("--levels {}-{finest}", levels.iter().min().unwrap_or(&0)),
+                message: format!("{message}; export at most that level"),
+            });
+        }
+    }
     let (staging, notes) = Staging::begin(out, Output::Export)?;
     for n in notes {
         eprintln!("note: {n}");

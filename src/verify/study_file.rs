@@ -764,6 +764,24 @@ impl LoadedStudy {
         })
     }
 
+    /// Refuse, before anything is meshed past level 0, a study whose finest mesh (its finest
+    /// level, or its reference level) does not fit in this machine's memory, naming this
+    /// study file and the field that asks for it.
+    pub fn check_memory(&self) -> Result<()> {
+        let finest = *self.file.mesh.levels.last().unwrap_or(&0);
+        let mut asks = vec![(finest, "mesh.levels")];
+        if !self.file.reference.exact {
+            asks.push((self.reference_level(), "reference.levels_above"));
+        }
+        let params = self.file.family_parameters();
+        for (level, field) in asks {
+            if let Some(message) = crate::case::memory_refusal_of(&self.scene, &params, level)? {
+                return Err(Error::input(&self.path, field, message));
+            }
+        }
+        Ok(())
+    }
+
     /// The reference level: the finest study level plus `levels_above`.
     pub fn reference_level(&self) -> usize {
         self.file.mesh.levels.last().unwrap() + self.file.reference.levels_above

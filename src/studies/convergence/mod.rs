@@ -1071,6 +1071,7 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
     let t0 = Instant::now();
     // 1. Plan the solves and run them (a shard stores its records and stops there).
     let study = LoadedStudy::load(name)?;
+    study.check_memory()?;
     let sf = &study.file;
     let plan = Plan::new(&study)?;
     let Some(mut solved) = solve_all(&study, &plan, mode)? else {
