@@ -307,7 +307,14 @@ impl Scene {
     /// Load a built-in scene by name, or a scene file by path.
     pub fn load(name_or_path: &str) -> Result<Self> {
         let p = Path::new(name_or_path);
-        let file = if p.extension().is_some_and(|e| e == "toml") || p.exists() {
+        if p.is_dir() && p.extension().is_some_and(|e| e == "toml") {
+            return Err(Error::input(
+                name_or_path,
+                "scene",
+                "is a folder, not a scene file; give the path of a scene's .toml file or a built-in scene's name (`contact-rates scene list`)",
+            ));
+        }
+        let file = if p.extension().is_some_and(|e| e == "toml") || p.is_file() {
             p.to_path_buf()
         } else {
             let f = builtin_dir().join(format!("{name_or_path}.toml"));

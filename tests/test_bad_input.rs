@@ -559,3 +559,27 @@ fn export_of_levels_beyond_memory_is_refused_before_meshing() {
     fails_with(&run, &["--levels 0-14", "the largest level that fits is"]);
     assert!(!out.exists(), "nothing is written");
 }
+
+/// A study file beside a folder named like its scene (an export folder `contact-mms`) reads
+/// the built-in scene, not the folder (issue 74: it failed with "Is a directory").
+#[test]
+fn a_folder_named_like_the_scene_is_not_read_as_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(repo().join("studies/rates-exact-quick.toml")).unwrap();
+    let study = dir.path().join("study.toml");
+    std::fs::write(&study, text).unwrap();
+    std::fs::create_dir(dir.path().join("contact-mms")).unwrap();
+    let out = dir.path().join("report");
+    let run = common::run(
+        &[
+            "study",
+            study.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{err}");
+    assert!(out.join("errors.csv").is_file());
+}

@@ -723,7 +723,9 @@ pub struct LoadedStudy {
 /// A scene named by a study file: a path relative to the study file, else a built-in name.
 fn study_scene(path: &Path, name: &str) -> Result<Scene> {
     let scene_path = path.parent().unwrap_or(Path::new(".")).join(name);
-    if scene_path.exists() {
+    // A file only: a folder beside the study file named like its scene (an export folder)
+    // is not a scene file.
+    if scene_path.is_file() {
         Scene::load(&scene_path.display().to_string())
     } else {
         Scene::load(name)
