@@ -371,7 +371,10 @@ fn judge(req: judge_file::JudgeRequest, out: Option<PathBuf>) -> anyhow::Result<
         .map(judge_file::group_name)
         .collect();
     if !failed.is_empty() {
-        anyhow::bail!("rate below threshold: {}", failed.join(", "));
+        anyhow::bail!(
+            "threshold missed ({}): the line above says by how much",
+            failed.join(", ")
+        );
     }
     Ok(())
 }

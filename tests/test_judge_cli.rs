@@ -108,3 +108,51 @@ fn a_bad_cell_is_one_error_naming_file_row_and_column() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("no column 'error'"), "{err}");
 }
+
+/// Issue 74: every bad table gets one message saying what to fix and a non-zero exit, and a
+/// verdict is one plain line with the numbers that decided it (no `error:` prefix).
+#[test]
+fn bad_tables_say_what_to_fix_and_a_verdict_says_why() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, text, words) in [
+        ("empty.csv", "", "the file is empty"),
+        (
+            "semicolons.csv",
+            "h;error\n0.2;0.1\n0.1;0.05\n0.05;0.025\n",
+            "separated by ';'",
+        ),
+        (
+            "short.csv",
+            "h,error\n0.2,0.1\n0.1\n0.05,0.025\n",
+            "row 2: it has 1 cell(s) and the header 2",
+        ),
+        (
+            "one.csv",
+            "h,error\n0.2,0.1\n",
+            "the table has 1 row(s); a verdict needs at least 3 levels",
+        ),
+    ] {
+        let f = table(dir.path(), name, text);
+        let out = common::run(&["judge", f.to_str().unwrap()], &[]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        println!("{name}: {err}");
+        assert_eq!(out.status.code(), Some(1), "{name}: {err}");
+        assert!(err.contains(name) && err.contains(words), "{name}: {err}");
+    }
+    // e = 0.1 (h/0.2)^p with successive rates 0.943, 0.989, 1.000: fitted below 1.0, last
+    // rate at 1.0: unverified, and the line says so.
+    let f = table(
+        dir.path(),
+        "unverified.csv",
+        "h,error\n0.2,0.1\n0.1,0.052\n0.05,0.0262\n0.025,0.0131\n",
+    );
+    let out = common::run(&["judge", f.to_str().unwrap(), "--threshold", "1.0"], &[]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    println!("{text}");
+    assert!(out.status.success());
+    assert!(!text.starts_with("error"), "{text}");
+    assert!(
+        text.contains("threshold 1.0: unverified, because the fit 0.979 is below it while the last successive rate 1.000 reaches it"),
+        "{text}"
+    );
+}

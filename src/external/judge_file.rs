@@ -11,9 +11,12 @@ use crate::io::csv_bytes;
 use crate::report::folder::{write, write_folder};
 use crate::report::plot::{self, Series};
 use crate::verify::judge::{Threshold, judge_levels, levels_of};
-use crate::verify::rates::{Assessment, Outcome};
+use crate::verify::rates::{Assessment, Outcome, Verdict, outcome_reason};
 use crate::verify::table::{MethodLabel, RateRecord};
 use std::path::{Path, PathBuf};
+
+/// The fewest rows a group may have: the judge fits no fewer levels.
+const MIN_ROWS: usize = 3;
 
 /// One row of the table.
 #[derive(Debug, Clone)]
@@ -32,7 +35,7 @@ struct Row {
 pub struct JudgedGroup {
     /// The method's name ("" where the table has no `method` column).
     pub method: String,
-    /// The quantity's name ("error" where the table has no `quantity` column).
+    /// The quantity's name ("" where the table has no `quantity` column).
     pub quantity: String,
     /// (level, h, error), coarsest first.
     pub errors: Vec<(usize, f64, f64)>,
@@ -90,6 +93,20 @@ pub fn judge_file(req: &JudgeRequest) -> Result<Vec<JudgedGroup>> {
                 .filter(|r| r.method == method && r.quantity == quantity)
                 .collect();
             group.sort_by(|a, b| b.h.total_cmp(&a.h));
+            if group.len() < MIN_ROWS {
+                let which = match (method.is_empty(), quantity.is_empty()) {
+                    (true, true) => "the table".to_string(),
+                    _ => format!("method '{method}', quantity '{quantity}'"),
+                };
+                return Err(Error::input(
+                    &req.file,
+                    "rows",
+                    format!(
+                        "{which} has {} row(s); a verdict needs at least {MIN_ROWS} levels: add the errors of finer (or coarser) meshes",
+                        group.len()
+                    ),
+                ));
+            }
             let levels = levels_of(
                 group
                     .iter()
@@ -139,6 +156,33 @@ fn read_rows(path: &Path) -> Result<Vec<Row>> {
         .headers()
         .map_err(|e| Error::input(path, "header", format!("{e}")))?
         .clone();
+    if headers.iter().all(|h| h.is_empty()) {
+        return Err(Error::input(
+            path,
+            "file",
+            "the file is empty: give a header row h,error (and optionally level, dofs, method, quantity, truth_error) and one row per level",
+        ));
+    }
+    if headers.len() == 1 {
+        if let Some(sep) = [';', '\t', ' ']
+            .into_iter()
+            .find(|c| headers[0].contains(*c))
+        {
+            let name = match sep {
+                ';' => "';'",
+                '\t' => "a tab",
+                _ => "spaces",
+            };
+            return Err(Error::input(
+                path,
+                "header",
+                format!(
+                    "the header is one column, '{}': its cells are separated by {name}; separate them by commas (h,error)",
+                    &headers[0]
+                ),
+            ));
+        }
+    }
     let col = |name: &str| headers.iter().position(|h| h == name);
     let need = |name: &str| {
         col(name).ok_or_else(|| {
@@ -156,8 +200,17 @@ fn read_rows(path: &Path) -> Result<Vec<Row>> {
     let mut rows = Vec::new();
     for (i, record) in reader.records().enumerate() {
         let row = i + 1;
-        let record =
-            record.map_err(|e| Error::input(path, format!("row {row}"), format!("{e}")))?;
+        let record = record.map_err(|e| {
+            let message = match e.kind() {
+                csv::ErrorKind::UnequalLengths {
+                    expected_len, len, ..
+                } => format!(
+                    "it has {len} cell(s) and the header {expected_len}: give every row a value for each column of the header"
+                ),
+                _ => format!("{e}"),
+            };
+            Error::input(path, format!("row {row}"), message)
+        })?;
         let cell = |c: usize| record.get(c).unwrap_or("");
         let number = |name: &str, c: usize, positive: bool| -> Result<f64> {
             let text = cell(c);
@@ -185,7 +238,7 @@ fn read_rows(path: &Path) -> Result<Vec<Row>> {
         };
         rows.push(Row {
             method: col("method").map_or(String::new(), |c| cell(c).to_string()),
-            quantity: col("quantity").map_or("error".into(), |c| cell(c).to_string()),
+            quantity: col("quantity").map_or(String::new(), |c| cell(c).to_string()),
             level: match col("level") {
                 Some(c) => Some(cell(c).parse().map_err(|_| {
                     Error::input(
@@ -278,32 +331,48 @@ pub fn write_report(groups: &[JudgedGroup], file: &Path, dir: &Path) -> Result<(
     })
 }
 
-/// "method quantity", leaving out what the table did not name.
+/// "method quantity", leaving out what the table did not name ("errors" where it names
+/// neither).
 pub fn group_name(g: &JudgedGroup) -> String {
-    match (g.method.is_empty(), g.quantity == "error") {
-        (true, true) => "error".into(),
+    match (g.method.is_empty(), g.quantity.is_empty()) {
+        (true, true) => "errors".into(),
         (true, false) => g.quantity.clone(),
         (false, true) => g.method.clone(),
         (false, false) => format!("{} {}", g.method, g.quantity),
     }
 }
 
-/// One line per group: verdict, rate, successive rates and the threshold's outcome.
-pub fn console(groups: &[JudgedGroup]) -> String {
-    let mut out = String::new();
-    for g in groups {
-        let a = &g.assessment;
-        out.push_str(&format!(
-            "{}: {} (verdict {}; successive rates {})",
-            group_name(g),
-            a.describe().replace("**", ""),
-            a.verdict.name(),
-            a.successive_text()
+/// A group's verdict as one plain line: its rate or why there is none, the successive rates,
+/// and the threshold's outcome with the numbers that decided it. The group's name leads
+/// where the table names methods or quantities.
+pub fn verdict_line(g: &JudgedGroup) -> String {
+    let a = &g.assessment;
+    let successive = a.successive_text().replace(' ', ", ");
+    let rate = match (a.verdict, a.fit) {
+        (Verdict::Fitted, Some(f)) => format!(
+            "rate {:.3} ± {:.3}, fitted (successive rates {successive})",
+            f.rate, f.stderr
+        ),
+        _ => format!(
+            "no rate: {} (successive rates {successive})",
+            a.describe().replace("**", "")
+        ),
+    };
+    let mut line = match g.method.is_empty() && g.quantity.is_empty() {
+        true => rate,
+        false => format!("{}: {rate}", group_name(g)),
+    };
+    if let (Some(t), Some(o)) = (g.threshold, g.outcome) {
+        line.push_str(&format!(
+            "; threshold {t:?}: {}, because {}",
+            o.shouted(),
+            outcome_reason(a, t, o)
         ));
-        if let (Some(t), Some(o)) = (g.threshold, g.outcome) {
-            out.push_str(&format!("; threshold {t}: {}", o.shouted()));
-        }
-        out.push('\n');
     }
-    out
+    line
+}
+
+/// One line per group ([`verdict_line`]).
+pub fn console(groups: &[JudgedGroup]) -> String {
+    groups.iter().map(|g| verdict_line(g) + "\n").collect()
 }

@@ -257,6 +257,39 @@ pub fn threshold_outcome(a: &Assessment, required: f64) -> Outcome {
     }
 }
 
+/// Why [`threshold_outcome`] gave `outcome` for `a` at `required`, as the end of a sentence
+/// ("unverified, because ..."): the numbers the rule compared.
+pub fn outcome_reason(a: &Assessment, required: f64, outcome: Outcome) -> String {
+    let f3 = crate::io::fmt3;
+    let Some(last) = a.last_rate() else {
+        return "there is no successive rate (no two levels at least 1.9 apart in h)".into();
+    };
+    match (outcome, a.verdict, a.fit) {
+        (Outcome::Pass, _, Some(f)) => format!(
+            "the fit {} and the last successive rate {} both reach it",
+            f3(f.rate),
+            f3(last)
+        ),
+        (Outcome::Fail, _, _) if last < required => {
+            format!("the last successive rate {} is below it", f3(last))
+        }
+        (Outcome::Fail, _, _) => format!(
+            "the rate is falling and its extrapolation to the finest level, {}, is below it",
+            f3(a.finest_slope.unwrap_or(f64::NAN))
+        ),
+        (_, Verdict::Fitted, Some(f)) => format!(
+            "the fit {} is below it while the last successive rate {} reaches it",
+            f3(f.rate),
+            f3(last)
+        ),
+        _ => format!(
+            "the verdict, {}, supports no rate, while the last successive rate {} reaches it",
+            a.verdict.name(),
+            f3(last)
+        ),
+    }
+}
+
 /// The one rule behind every word of a report that claims a rate reaches a target
 /// ("follows its best", "tends to mortar's rate", "D falls no slower"): the threshold
 /// rule at `target - slack`, so a supported rate whose fit and last judged rate both reach
