@@ -31,13 +31,18 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Run a convergence study (`study list` lists them) and write reports/NAME/.
+    /// Run a study (`study list` lists them) and write its report to target/reports/NAME/
+    /// (outside version control), or with --publish to the committed reports/NAME/.
     Study {
         /// Study name (studies/NAME.toml), a path to a study file, or `list`.
         name: String,
-        /// Report folder (default: reports/NAME).
-        #[arg(long)]
+        /// Report folder (default: target/reports/NAME; reports/NAME with --publish).
+        #[arg(long, conflicts_with = "publish")]
         out: Option<PathBuf>,
+        /// Write the committed report reports/NAME (what the repository's reports are
+        /// refreshed with; its timings and provenance change the tracked files).
+        #[arg(long)]
+        publish: bool,
         /// Run only the i-th of n slices of the study's solves and store their records
         /// (for a cluster's job array); no report.
         #[arg(long, value_name = "i/n", conflicts_with = "merge")]
@@ -45,7 +50,7 @@ enum Command {
         /// Build the report from the records of all shards.
         #[arg(long)]
         merge: bool,
-        /// Judge the written report (reports/NAME or --out) again from its CSVs and rewrite
+        /// Judge the written report (the report folder as above) again from its CSVs and rewrite
         /// rates.csv, the plots and README.md, without solving (von_mises.png is kept).
         #[arg(long, conflicts_with_all = ["shard", "merge"])]
         rejudge: bool,
@@ -242,10 +247,11 @@ fn run() -> anyhow::Result<()> {
         Command::Study {
             name,
             out,
+            publish,
             shard,
             merge,
             rejudge,
-        } => study(&name, out, shard.as_deref(), merge, rejudge),
+        } => study(&name, out, publish, shard.as_deref(), merge, rejudge),
         Command::Results { headline } => {
             let reports = report::reports_dir();
             if headline {
@@ -306,6 +312,7 @@ fn run() -> anyhow::Result<()> {
 fn study(
     name: &str,
     out: Option<PathBuf>,
+    publish: bool,
     shard: Option<&str>,
     merge: bool,
     rejudge: bool,
@@ -322,7 +329,11 @@ fn study(
         (None, true) => Mode::Merge,
         (None, false) => Mode::All,
     };
-    let dir = out.unwrap_or_else(|| report::reports_dir().join(kind.name()));
+    let dir = match (publish, out) {
+        (true, _) => report::reports_dir().join(kind.name()),
+        (false, Some(dir)) => dir,
+        (false, None) => report::scratch_reports_dir().join(kind.name()),
+    };
     // The report folder is checked before any computing (a shard writes no report).
     if shard.is_none() {
         for n in report::check_writable(&dir, Output::Report)? {

@@ -18,6 +18,16 @@ pub fn reports_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("reports")
 }
 
+/// Where a study writes its report by default: target/reports under the checkout, outside
+/// version control, so that running a study leaves a clean checkout clean (its timings and
+/// provenance differ from run to run). `study NAME --publish` writes the committed report
+/// under [`reports_dir`] instead.
+pub fn scratch_reports_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("target")
+        .join("reports")
+}
+
 /// What kind of output a folder holds, known by a file every such output has: an existing
 /// non-empty folder without it is someone else's and is not replaced.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

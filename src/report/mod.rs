@@ -9,7 +9,9 @@ pub mod markdown;
 pub mod plot;
 pub mod solve_output;
 
-pub use folder::{Output, Staging, check_writable, remove_live, reports_dir, write_folder};
+pub use folder::{
+    Output, Staging, check_writable, remove_live, reports_dir, scratch_reports_dir, write_folder,
+};
 
 /// A study report's opening: the title `Study `name``, the study's description and its
 /// scene's name and description, each a paragraph.
