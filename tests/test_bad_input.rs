@@ -404,6 +404,11 @@ fn study_file_errors_through_the_binary() {
         &common::run(&["study", "nosuch"], &[]),
         &["nosuch", "built-in studies", "rates-quick"],
     );
+    // A typo gets the nearest name (issue 74).
+    fails_with(
+        &common::run(&["study", "rate"], &[]),
+        &["'rate'", "did you mean 'rates'?"],
+    );
 }
 
 #[test]

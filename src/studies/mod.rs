@@ -119,14 +119,28 @@ impl Study {
     }
 }
 
-/// The error for a study name that is neither built in nor a file.
+/// The error for a study name that is neither built in nor a file, with the nearest built-in
+/// names where a typo is likely (at most 2 edits away).
 pub fn unknown_study(name: &str) -> Error {
     let names: Vec<String> = Study::list().into_iter().map(|(n, _)| n).collect();
+    let distances: Vec<usize> = names.iter().map(|n| strsim::levenshtein(name, n)).collect();
+    let best = distances.iter().copied().min().unwrap_or(usize::MAX);
+    let near: Vec<&str> = names
+        .iter()
+        .zip(&distances)
+        .filter(|(_, d)| **d == best && best <= 2)
+        .map(|(n, _)| n.as_str())
+        .collect();
+    let hint = match near.as_slice() {
+        [] => String::new(),
+        [one] => format!("did you mean '{one}'? "),
+        many => format!("did you mean one of {}? ", many.join(", ")),
+    };
     Error::input(
         name,
         "study",
         format!(
-            "no built-in study named '{name}' and no such file; built-in studies: {}",
+            "no built-in study named '{name}' and no such file; {hint}built-in studies: {}",
             names.join(", ")
         ),
     )
