@@ -282,6 +282,7 @@ impl CheckRecord {
     /// The row of `check` at `level` (h, its `error`).
     pub fn new(level: usize, h: f64, error: f64, check: &LevelCheck) -> Self {
         let flagged = !check.problems(error).is_empty();
+        let limits = check.force_limits(error);
         CheckRecord {
             level,
             h,
@@ -295,9 +296,9 @@ impl CheckRecord {
             normal_imbalance: check.imbalance,
             tangential: check.tangential,
             pulling: check.pulling,
-            imbalance_limit: Some(check.force_limits(error)[0]),
-            tangential_limit: Some(check.force_limits(error)[1]),
-            pulling_limit: Some(check.force_limits(error)[2]),
+            imbalance_limit: Some(limits[0]),
+            tangential_limit: Some(limits[1]),
+            pulling_limit: Some(limits[2]),
             pressure_ratio: check.pressure_ratio,
             verdict: if flagged { "flagged" } else { "converged" }.into(),
         }
@@ -416,9 +417,9 @@ fn contact_balance(
     (resultant > 1e-12 * load).then(|| (sums.map(|v| v / resultant), resultant))
 }
 
-/// One level's checks ([`check_level`]) and, where delta exceeds `error_hint`'s 1/20 (or
-/// round-off), the correction per step: K^-1 r over the global dofs (zero on the held
-/// ones), so that u~_h = u_h - correction is in equilibrium with the exported loads.
+/// One level's checks ([`check_level`]) and, where delta is above round-off, the correction
+/// per step: K^-1 r over the global dofs (zero on the held ones), so that
+/// u~_h = u_h - correction is in equilibrium with the exported loads.
 pub struct Checked {
     pub check: LevelCheck,
     /// Per step of `steps`, K^-1 r (global dofs; empty where delta is at round-off).
@@ -442,6 +443,23 @@ pub fn check_level(model: &Model, interface: &Interface, steps: &[P1Field]) -> R
     let max = |a: Option<f64>, b: f64| Some(a.map_or(b, |a| a.max(b)));
     // Per step: the residual over the free dofs, K^-1 of it and ||u_h||_E^2.
     let mut fitted: Vec<(Vec<f64>, Vec<f64>, f64)> = Vec::with_capacity(steps.len());
+    // Each common rule's load minus the exported one at t (global dofs); integrated once, at
+    // t = 1, where the load is t^k times a field of (x, y) and every step is at t > 0.
+    let difference = |rule: &LoadRule, t: f64| -> Result<Vec<f64>> {
+        let exported = model.load(t)?;
+        let by_rule = model.load_by_rule(t, rule)?;
+        Ok(by_rule.iter().zip(&exported).map(|(a, b)| a - b).collect())
+    };
+    let degree = model.load_time_degree();
+    let at_unit_time = match (degree, steps.iter().all(|s| s.time > 0.0)) {
+        (Some(_), true) => Some(
+            rules
+                .iter()
+                .map(|rule| difference(rule, 1.0))
+                .collect::<Result<Vec<_>>>()?,
+        ),
+        _ => None,
+    };
     for step in steps {
         load = model.load(step.time)?;
         let internal = model.internal_force(&step.stress);
@@ -451,25 +469,27 @@ pub fn check_level(model: &Model, interface: &Interface, steps: &[P1Field]) -> R
             &step.u,
         )
         .max(f64::MIN_POSITIVE);
-        // delta of a force over the global dofs, and K^-1 of it over the free ones.
-        let in_energy = |force: &[f64]| -> (f64, Vec<f64>) {
+        // delta of a force over the global dofs, with the force over the free ones and K^-1
+        // of it (both empty without free dofs).
+        let in_energy = |force: &[f64]| -> (f64, Vec<f64>, Vec<f64>) {
             let Some(system) = &system else {
-                return (0.0, Vec::new());
+                return (0.0, Vec::new(), Vec::new());
             };
             let r = held.restrict(force);
             let mut z = r.clone();
             system.solve(&mut z);
-            ((dot(&r, &z).max(0.0) / energy).sqrt(), z)
+            ((dot(&r, &z).max(0.0) / energy).sqrt(), r, z)
         };
-        let (delta, z) = in_energy(&reaction);
+        let (delta, r, z) = in_energy(&reaction);
         out.residual = out.residual.max(delta);
-        if !z.is_empty() {
-            fitted.push((held.restrict(&reaction), z.clone(), energy));
-        }
-        corrections.push(match delta > RESIDUAL_FLOOR {
+        let correction = match delta > RESIDUAL_FLOOR {
             true => held.expand(&z),
             false => Vec::new(),
-        });
+        };
+        if !z.is_empty() {
+            fitted.push((r, z, energy));
+        }
+        corrections.push(correction);
         let size = load.iter().map(|v| v.abs()).sum::<f64>();
         let balance = contact_balance(&nodes, model, &reaction, size);
         if let Some(([i, t, p], _)) = balance {
@@ -477,9 +497,15 @@ pub fn check_level(model: &Model, interface: &Interface, steps: &[P1Field]) -> R
             out.tangential = max(out.tangential, t);
             out.pulling = max(out.pulling, p);
         }
-        for rule in &rules {
-            let by_rule = model.load_by_rule(step.time, rule)?;
-            let difference: Vec<f64> = by_rule.iter().zip(&load).map(|(a, b)| a - b).collect();
+        for (i, rule) in rules.iter().enumerate() {
+            // A load t^k g(x, y): every rule's difference is t^k times its difference at 1.
+            let difference: Vec<f64> = match (degree, &at_unit_time) {
+                (Some(k), Some(at_one)) => {
+                    let scale = step.time.powf(k);
+                    at_one[i].iter().map(|d| scale * d).collect()
+                }
+                _ => difference(rule, step.time)?,
+            };
             out.load_rule_residual = out.load_rule_residual.max(in_energy(&difference).0);
             if let Some((_, resultant)) = balance {
                 let sums = force_sums(&nodes, model, &difference, true).0;
@@ -491,7 +517,7 @@ pub fn check_level(model: &Model, interface: &Interface, steps: &[P1Field]) -> R
             }
         }
     }
-    if let (Some(k), true) = (model.load_time_degree(), fitted.len() >= 2) {
+    if let (Some(k), true) = (degree, fitted.len() >= 2) {
         let scales: Vec<f64> = steps.iter().map(|s| s.time.powf(k)).collect();
         out.off_load = Some(off_load(&fitted, &scales));
     }

@@ -139,19 +139,12 @@ pub fn judge_file(req: &JudgeRequest) -> Result<Vec<JudgedGroup>> {
         .collect()
 }
 
-/// The rows of `path`, every cell checked: one error naming the file, the row (1 = the
-/// first after the header) and the column.
-fn read_rows(path: &Path) -> Result<Vec<Row>> {
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_path(path)
-        .map_err(|e| {
-            Error::input(
-                path,
-                "file",
-                format!("cannot read ({e}); give a CSV file with a header row"),
-            )
-        })?;
+/// The header row of `reader` (the file `path`): refused where the file is empty, or where
+/// it is one cell holding another separator (';', a tab, spaces).
+fn checked_headers(
+    path: &Path,
+    reader: &mut csv::Reader<std::fs::File>,
+) -> Result<csv::StringRecord> {
     let headers = reader
         .headers()
         .map_err(|e| Error::input(path, "header", format!("{e}")))?
@@ -183,6 +176,37 @@ fn read_rows(path: &Path) -> Result<Vec<Row>> {
             ));
         }
     }
+    Ok(headers)
+}
+
+/// A row the CSV reader refused, as one error naming the file and the row: a short or long
+/// row says how many cells it has against the header.
+fn row_error(path: &Path, row: usize, e: &csv::Error) -> Error {
+    let message = match e.kind() {
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => format!(
+            "it has {len} cell(s) and the header {expected_len}: give every row a value for each column of the header"
+        ),
+        _ => format!("{e}"),
+    };
+    Error::input(path, format!("row {row}"), message)
+}
+
+/// The rows of `path`, every cell checked: one error naming the file, the row (1 = the
+/// first after the header) and the column.
+fn read_rows(path: &Path) -> Result<Vec<Row>> {
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_path(path)
+        .map_err(|e| {
+            Error::input(
+                path,
+                "file",
+                format!("cannot read ({e}); give a CSV file with a header row"),
+            )
+        })?;
+    let headers = checked_headers(path, &mut reader)?;
     let col = |name: &str| headers.iter().position(|h| h == name);
     let need = |name: &str| {
         col(name).ok_or_else(|| {
@@ -200,17 +224,7 @@ fn read_rows(path: &Path) -> Result<Vec<Row>> {
     let mut rows = Vec::new();
     for (i, record) in reader.records().enumerate() {
         let row = i + 1;
-        let record = record.map_err(|e| {
-            let message = match e.kind() {
-                csv::ErrorKind::UnequalLengths {
-                    expected_len, len, ..
-                } => format!(
-                    "it has {len} cell(s) and the header {expected_len}: give every row a value for each column of the header"
-                ),
-                _ => format!("{e}"),
-            };
-            Error::input(path, format!("row {row}"), message)
-        })?;
+        let record = record.map_err(|e| row_error(path, row, &e))?;
         let cell = |c: usize| record.get(c).unwrap_or("");
         let number = |name: &str, c: usize, positive: bool| -> Result<f64> {
             let text = cell(c);

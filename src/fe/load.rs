@@ -476,21 +476,7 @@ impl Model {
                 },
             )
             .collect();
-        let mut nodal = Vec::with_capacity(elements.len());
-        for chunk in chunks {
-            nodal.extend(chunk?.into_iter().map(Ok::<_, Error>));
-        }
-        let mut points = 0;
-        for (e, forces) in elements.iter().zip(nodal) {
-            let (forces, n) = forces?;
-            points += n;
-            for a in 0..3 {
-                for c in 0..2 {
-                    f[2 * e.nodes[a] + c] += forces[2 * a + c];
-                }
-            }
-        }
-        Ok(points)
+        add_in_element_order(&elements, chunks, f)
     }
 
     fn body_force_not_finite(
@@ -518,6 +504,27 @@ impl Model {
         );
         bf.exprs[c].not_finite(&self.scene.file, &field, x, y, t)
     }
+}
+
+/// The chunks' nodal forces (per triangle: its six nodal components and its quadrature
+/// points) added into `f` in element order, so the sums are the same for any number of
+/// threads; returns the number of quadrature points, or the first chunk's error.
+fn add_in_element_order(
+    elements: &[&Element],
+    chunks: Vec<Result<Vec<([f64; 6], usize)>>>,
+    f: &mut [f64],
+) -> Result<usize> {
+    let mut points = 0;
+    let nodal = chunks.into_iter().collect::<Result<Vec<_>>>()?;
+    for (e, (forces, n)) in elements.iter().zip(nodal.into_iter().flatten()) {
+        points += n;
+        for a in 0..3 {
+            for c in 0..2 {
+                f[2 * e.nodes[a] + c] += forces[2 * a + c];
+            }
+        }
+    }
+    Ok(points)
 }
 
 /// Triangles whose quadrature points are evaluated in one call of a program (about 500
