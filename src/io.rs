@@ -82,6 +82,24 @@ pub mod finite {
     pub use super::finite_or_empty as serialize;
 }
 
+/// "1 time step", "10 time steps": a count and its noun, plural where the count is not 1
+/// (`noun` is the singular; its plural adds an s).
+pub fn count(n: usize, noun: &str) -> String {
+    match n {
+        1 => format!("1 {noun}"),
+        n => format!("{n} {noun}s"),
+    }
+}
+
+/// A memory size given in GiB, in the unit that shows it: "0.3 MiB", "512 MiB", "5.3 GiB".
+pub fn memory_text(gib: f64) -> String {
+    match gib {
+        g if g >= 1.0 => format!("{g:.1} GiB"),
+        g if g * 1024.0 >= 10.0 => format!("{:.0} MiB", g * 1024.0),
+        g => format!("{:.1} MiB", g * 1024.0),
+    }
+}
+
 /// `{:.3}` of a finite number, "n/a" otherwise.
 pub fn fmt3(v: f64) -> String {
     if v.is_finite() {

@@ -318,9 +318,17 @@ fn study(
     rejudge: bool,
 ) -> anyhow::Result<()> {
     if name == "list" {
+        // The run time of the committed report, where it records one (run.toml).
+        let times = contact_rates::results::wall_times(&report::reports_dir()).unwrap_or_default();
+        println!("{:22} {:>9}  what it measures", "study", "run time");
         for (n, d) in Study::list() {
-            println!("{n:12} {d}");
+            let time = times
+                .iter()
+                .find(|t| t.0 == n)
+                .map_or("-".to_string(), |t| format!("{:.0} s", t.1));
+            println!("{n:22} {time:>9}  {d}");
         }
+        println!("(run time: the committed report's, on 2 cores, after the build; - where its report records none)");
         return Ok(());
     }
     let kind = Study::resolve(name)?;
@@ -350,7 +358,12 @@ fn study(
     for w in outcome.warnings() {
         eprintln!("warning: {w}");
     }
+    let phase = contact_rates::progress::Progress::phase(
+        &kind.name(),
+        &format!("writing the report (tables, plots) to {}", dir.display()),
+    );
     outcome.write(&dir)?;
+    drop(phase);
     print!("{}", outcome.console(&dir));
     for u in outcome.unverified() {
         println!("unverified: {u}");
@@ -551,16 +564,31 @@ fn exit_cleanly_on_signals() -> std::io::Result<()> {
     std::thread::spawn(move || {
         if let Some(signo) = signals.forever().next() {
             let interrupted = report::remove_live();
+            contact_rates::interrupt::remove_temporary_files();
             let name = signal_name(signo).unwrap_or("a signal");
-            for folder in &interrupted.removed {
-                // Not eprintln: after SIGHUP the terminal may be gone, and a panic here
-                // would leave the run going.
-                let _ = writeln!(
-                    std::io::stderr(),
-                    "note: interrupted by {name}; removed {}",
-                    folder.display()
-                );
-            }
+            contact_rates::progress::clear_line();
+            let during = contact_rates::progress::current_phase()
+                .map_or(String::new(), |p| format!(" while {p}"));
+            let removed = match interrupted.removed.is_empty() {
+                true => "no output was written or changed".to_string(),
+                false => {
+                    let folders: Vec<String> = interrupted
+                        .removed
+                        .iter()
+                        .map(|f| f.display().to_string())
+                        .collect();
+                    format!(
+                        "removed its unfinished output {}; what was there before is unchanged",
+                        folders.join(", ")
+                    )
+                }
+            };
+            // Not eprintln: after SIGHUP the terminal may be gone, and a panic here would
+            // leave the run going.
+            let _ = writeln!(
+                std::io::stderr(),
+                "interrupted by {name}{during}: {removed}"
+            );
             std::process::exit(128 + signo);
         }
     });

@@ -36,10 +36,11 @@ pub fn section(reports: &Path) -> Result<String> {
     Ok(page)
 }
 
-/// The wall time of every committed report that records one in its run.toml (`wall_s` at
-/// its top level; a family's members summed), as the page's last part: the one place the
-/// documentation takes a study's run time from.
-fn run_times(reports: &Path) -> Result<String> {
+/// The wall time of every report under `reports` that records one in its run.toml
+/// (`wall_s` at its top level; a family's members summed): (study, seconds, how many
+/// run.toml files were summed), by name. The one place the documentation and `study list`
+/// take a study's run time from.
+pub fn wall_times(reports: &Path) -> Result<Vec<(String, f64, usize)>> {
     let mut rows = Vec::new();
     let mut dirs: Vec<std::path::PathBuf> = std::fs::read_dir(reports)
         .map_err(|e| crate::error::Error::input(reports, "reports", e.to_string()))?
@@ -76,12 +77,23 @@ fn run_times(reports: &Path) -> Result<String> {
         let name = dir
             .file_name()
             .map_or(String::new(), |n| n.to_string_lossy().to_string());
-        let parts = match files.len() {
-            1 => String::new(),
-            n => format!(" ({n} members' run.toml summed)"),
-        };
-        rows.push([format!("`{name}`"), format!("{total:.0} s{parts}")]);
+        rows.push((name, total, files.len()));
     }
+    Ok(rows)
+}
+
+/// The wall times of [`wall_times`] as the page's last part.
+fn run_times(reports: &Path) -> Result<String> {
+    let rows: Vec<[String; 2]> = wall_times(reports)?
+        .into_iter()
+        .map(|(name, total, n)| {
+            let parts = match n {
+                1 => String::new(),
+                n => format!(" ({n} members' run.toml summed)"),
+            };
+            [format!("`{name}`"), format!("{total:.0} s{parts}")]
+        })
+        .collect();
     let mut doc = Doc::new();
     doc.heading(2, "Run times").paragraph(
         "Wall time of each committed report's study on the machine that wrote it (2 cores), read from its run.toml (`wall_s`); the build comes first. Reports without a run.toml print their own time in their README.",

@@ -446,6 +446,7 @@ fn plot_problem(p: &Problem, d: &Path) -> Result<()> {
             line: true,
             color: i,
             thin: m.cone().is_some(),
+            shape: None,
         })
         .collect();
     plot::loglog(

@@ -986,8 +986,8 @@ fn notes(levels: &[GradedLevel], family: &Family, pressure: bool) -> Vec<String>
     let mut out = Vec::new();
     if levels.iter().any(|l| l.storage == Storage::Vtu) {
         out.push(format!(
-            "Levels given as one .vtu are graded at t = T only: their theorem norm is the error at T, not the maximum over the {} steps, and their distance to mortar (a maximum over the steps like mortar's error) is not measured.",
-            family.steps
+            "Levels given as one .vtu are graded at t = T only: their theorem norm is the error at T, not the maximum over the {}, and their distance to mortar (a maximum over the steps like mortar's error) is not measured.",
+            crate::io::count(family.steps, "step")
         ));
     }
     if levels.iter().any(|l| !l.stress_given) {

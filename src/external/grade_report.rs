@@ -70,6 +70,7 @@ impl Graded {
                 line: false,
                 color: i,
                 thin: false,
+                shape: None,
             });
             if let Some((legend, rate, intercept, hs)) =
                 self.rate(m, self.key).and_then(|r| r.line(&rows))

@@ -11,7 +11,7 @@ use crate::io::csv_bytes;
 use crate::report::folder::{write, write_folder};
 use crate::report::plot::{self, Series};
 use crate::verify::judge::{Threshold, judge_levels, levels_of};
-use crate::verify::rates::{Assessment, Outcome, Verdict, outcome_reason};
+use crate::verify::rates::{Assessment, Outcome};
 use crate::verify::table::{MethodLabel, RateRecord};
 use std::path::{Path, PathBuf};
 
@@ -318,6 +318,7 @@ pub fn write_report(groups: &[JudgedGroup], file: &Path, dir: &Path) -> Result<(
                 line: false,
                 color: i,
                 thin: false,
+                shape: None,
             });
             if let Some(f) = g
                 .assessment
@@ -360,30 +361,13 @@ pub fn group_name(g: &JudgedGroup) -> String {
 /// and the threshold's outcome with the numbers that decided it. The group's name leads
 /// where the table names methods or quantities.
 pub fn verdict_line(g: &JudgedGroup) -> String {
-    let a = &g.assessment;
-    let successive = a.successive_text().replace(' ', ", ");
-    let rate = match (a.verdict, a.fit) {
-        (Verdict::Fitted, Some(f)) => format!(
-            "rate {:.3} ± {:.3}, fitted (successive rates {successive})",
-            f.rate, f.stderr
-        ),
-        _ => format!(
-            "no rate: {} (successive rates {successive})",
-            a.describe().replace("**", "")
-        ),
-    };
-    let mut line = match g.method.is_empty() && g.quantity.is_empty() {
-        true => rate,
-        false => format!("{}: {rate}", group_name(g)),
-    };
-    if let (Some(t), Some(o)) = (g.threshold, g.outcome) {
-        line.push_str(&format!(
-            "; threshold {t:?}: {}, because {}",
-            o.shouted(),
-            outcome_reason(a, t, o)
-        ));
+    let line = g
+        .assessment
+        .verdict_line(g.threshold.zip(g.outcome));
+    match g.method.is_empty() && g.quantity.is_empty() {
+        true => line,
+        false => format!("{}: {line}", group_name(g)),
     }
-    line
 }
 
 /// One line per group ([`verdict_line`]).

@@ -56,13 +56,24 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
 /// Run gmsh with `args`; on failure return its error lines. `out` must exist afterwards.
 fn run_gmsh(args: &[String], out: &Path, what: &Path) -> Result<()> {
     let cmd = gmsh_command();
-    let output = Command::new(&cmd).args(args).output().map_err(|e| {
+    let start_error = |e: std::io::Error| {
         if e.kind() == std::io::ErrorKind::NotFound {
             missing_gmsh(&cmd)
         } else {
             Error::Gmsh(format!("could not start `{cmd}`: {e}"))
         }
-    })?;
+    };
+    let child = Command::new(&cmd)
+        .args(args)
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .map_err(start_error)?;
+    // An interrupted run ends gmsh before it removes the file gmsh writes.
+    let registered = crate::interrupt::RunningChild::new(child.id());
+    let output = child.wait_with_output().map_err(start_error)?;
+    drop(registered);
     let text = String::from_utf8_lossy(&output.stdout).to_string()
         + &String::from_utf8_lossy(&output.stderr);
     let has_errors = text.lines().any(|l| l.starts_with("Error"));
@@ -144,6 +155,8 @@ fn produce(
     (what, bad, fix): (&str, &str, &str),
 ) -> Result<()> {
     let spinner = crate::progress::Progress::spinner(&format!("gmsh: {what}"));
+    // An interrupted run removes the partial mesh instead of leaving it in the cache.
+    let _registered = crate::interrupt::TemporaryFile::new(tmp);
     let ran = run_gmsh(args, tmp, geo);
     spinner.finish();
     ran?;

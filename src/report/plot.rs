@@ -12,6 +12,8 @@ use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, ValueFormatter}
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
+use plotters::element::{Drawable, PointCollection};
+use plotters_backend::{BackendCoord, DrawingErrorKind};
 use std::path::Path;
 use std::sync::Once;
 
@@ -877,6 +879,142 @@ pub struct Series {
     pub color: usize,
     /// Dashed (thin) line.
     pub thin: bool,
+    /// The markers' shape; None: the shape of the colour index ([`Shape::of`]), so that
+    /// series told apart by colour are told apart by shape as well.
+    pub shape: Option<Shape>,
+}
+
+/// A marker's shape.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Shape {
+    /// A disc.
+    Circle,
+    /// A triangle pointing up.
+    Triangle,
+    /// A square.
+    Square,
+    /// A diamond.
+    Diamond,
+    /// A triangle pointing down.
+    InvertedTriangle,
+    /// A cross.
+    Cross,
+}
+
+impl Shape {
+    /// The shapes in order of colour index.
+    pub const ALL: [Shape; 6] = [
+        Shape::Circle,
+        Shape::Triangle,
+        Shape::Square,
+        Shape::Diamond,
+        Shape::InvertedTriangle,
+        Shape::Cross,
+    ];
+
+    /// Its name in a plot's title ("mortar: circle").
+    pub fn name(self) -> &'static str {
+        match self {
+            Shape::Circle => "circle",
+            Shape::Triangle => "triangle",
+            Shape::Square => "square",
+            Shape::Diamond => "diamond",
+            Shape::InvertedTriangle => "inverted triangle",
+            Shape::Cross => "cross",
+        }
+    }
+
+    /// The shape of colour index `i` (mortar, nts, lac, then the codes in report order).
+    pub fn of(i: usize) -> Shape {
+        Shape::ALL[i % Shape::ALL.len()]
+    }
+
+    /// Its outline around (0, 0), `r` pixels from the centre to the corners (the disc's
+    /// as a 20-gon); a cross is two strokes.
+    fn vertices(self, r: i32) -> Vec<(i32, i32)> {
+        // About the disc's area: a square of side 1.8 r, a triangle of side 2.7 r.
+        let q = (0.9 * r as f64).round() as i32;
+        let t = (1.35 * r as f64).round() as i32;
+        match self {
+            Shape::Circle => (0..20)
+                .map(|k| {
+                    let a = std::f64::consts::TAU * k as f64 / 20.0;
+                    ((r as f64 * a.cos()).round() as i32, (r as f64 * a.sin()).round() as i32)
+                })
+                .collect(),
+            Shape::Square => vec![(-q, -q), (q, -q), (q, q), (-q, q)],
+            Shape::Diamond => vec![(0, -t), (t, 0), (0, t), (-t, 0)],
+            Shape::Triangle => vec![(0, -t), (t, 4 * t / 5), (-t, 4 * t / 5)],
+            Shape::InvertedTriangle => vec![(0, t), (t, -4 * t / 5), (-t, -4 * t / 5)],
+            Shape::Cross => vec![(-q, -q), (q, q), (0, 0), (q, -q), (-q, q)],
+        }
+    }
+
+    /// The marker at `at` ([`Mark`]).
+    fn at<C>(self, at: C, r: i32, color: RGBColor, ring: Option<u32>, line: Option<ShapeStyle>) -> Mark<C> {
+        Mark {
+            at,
+            shape: self,
+            r,
+            color,
+            ring,
+            line,
+        }
+    }
+}
+
+/// A marker drawn at one point: its shape `r` pixels from the centre to the corners,
+/// filled or an outline `ring` pixels wide, and, in a legend entry of a series drawn with a
+/// line, a 24-pixel stroke of `line` through it. An element of its own (plotters composes
+/// elements only for one backend's lifetime, and a legend entry must outlive it).
+struct Mark<C> {
+    at: C,
+    shape: Shape,
+    r: i32,
+    color: RGBColor,
+    ring: Option<u32>,
+    line: Option<ShapeStyle>,
+}
+
+impl<'a, C> PointCollection<'a, C> for &'a Mark<C> {
+    type Point = &'a C;
+    type IntoIter = std::iter::Once<&'a C>;
+    fn point_iter(self) -> Self::IntoIter {
+        std::iter::once(&self.at)
+    }
+}
+
+impl<C, DB: DrawingBackend> Drawable<DB> for Mark<C> {
+    fn draw<I: Iterator<Item = BackendCoord>>(
+        &self,
+        mut points: I,
+        backend: &mut DB,
+        _: (u32, u32),
+    ) -> std::result::Result<(), DrawingErrorKind<DB::ErrorType>> {
+        let Some((x, y)) = points.next() else {
+            return Ok(());
+        };
+        if let Some(line) = self.line {
+            backend.draw_line((x - 12, y), (x + 12, y), &line)?;
+        }
+        let pts: Vec<(i32, i32)> = self
+            .shape
+            .vertices(self.r)
+            .into_iter()
+            .map(|(dx, dy)| (x + dx, y + dy))
+            .collect();
+        match (self.shape, self.ring) {
+            (Shape::Cross, ring) => {
+                backend.draw_path(pts, &self.color.stroke_width(ring.unwrap_or(2)))
+            }
+            (_, Some(w)) => {
+                let mut closed = pts.clone();
+                closed.push(pts[0]);
+                backend.draw_path(closed, &self.color.stroke_width(w))
+            }
+            (_, None) => backend.fill_polygon(pts, &self.color.filled()),
+        }
+    }
 }
 
 /// The fitted line exp(intercept) x^rate drawn across the span of `xs` (the fitted levels'
@@ -905,6 +1043,7 @@ pub fn fit_line(
         line: true,
         color,
         thin: false,
+        shape: None,
     })
 }
 
@@ -948,10 +1087,11 @@ fn legend_labels(series: &[Series]) -> Vec<&str> {
         .collect()
 }
 
-/// Draw every series (lines with their legend entry, markers of `radius` pixels, a marker
-/// legend entry for marker-only series) on a chart with (f64, f64) data coordinates. A
-/// series whose every marker lands within 2 pixels of an earlier series' markers (equal
-/// data) gets open rings 3 pixels wider instead of dots, so that both show.
+/// Draw every series (a line, markers of `radius` pixels in the series' shape, or both), one
+/// legend entry each. A series whose every point lands within 2 pixels of an earlier
+/// series' points is drawn with outlined markers 3 pixels wider (so both show), and its
+/// legend says which one it coincides with and to what relative difference
+/// ([`coincidence`]).
 fn draw_series<'b, CT>(
     chart: &mut ChartContext<'_, BitMapBackend<'b>, CT>,
     series: &[Series],
@@ -970,17 +1110,17 @@ where
                 .collect()
         })
         .collect();
-    let covered = |i: usize| {
-        let near =
-            |p: &(i32, i32), q: &(i32, i32)| (p.0 - q.0).abs() <= 2 && (p.1 - q.1).abs() <= 2;
-        series[i].markers
-            && !pixels[i].is_empty()
-            && (0..i).any(|j| {
-                series[j].markers
-                    && pixels[i]
-                        .iter()
-                        .all(|p| pixels[j].iter().any(|q| near(p, q)))
-            })
+    let near = |p: &(i32, i32), q: &(i32, i32)| (p.0 - q.0).abs() <= 2 && (p.1 - q.1).abs() <= 2;
+    let covered_by = |i: usize| {
+        // Markers against markers, lines against lines (a fit line lies on its own points).
+        (0..i).find(|&j| {
+            series[j].markers == series[i].markers
+                && series[j].line == series[i].line
+                && !pixels[i].is_empty()
+                && pixels[i]
+                    .iter()
+                    .all(|p| pixels[j].iter().any(|q| near(p, q)))
+        })
     };
     for (i, s) in series.iter().enumerate() {
         let c = COLORS[s.color % COLORS.len()];
@@ -989,28 +1129,73 @@ where
         } else {
             c.stroke_width(2)
         };
+        let shape = s.shape.unwrap_or(Shape::of(s.color));
+        let covered = covered_by(i);
+        // Half or more of its points under a later series' (drawn over it).
+        let partly_under = (i + 1..series.len()).find(|&k| {
+            series[k].markers == s.markers
+                && series[k].line == s.line
+                && 2 * pixels[i]
+                    .iter()
+                    .filter(|p| pixels[k].iter().any(|q| near(p, q)))
+                    .count()
+                    >= pixels[i].len().max(1)
+        });
+        let label = match (covered, partly_under) {
+            (Some(j), _) => format!("{}{}", s.label, coincidence(s, &series[j])),
+            (None, Some(k)) => format!("{} (partly under {})", s.label, first_word(&series[k].label)),
+            (None, None) => s.label.clone(),
+        };
+        let (r, ring) = match covered {
+            Some(_) => ((radius + 3) as i32, Some(2)),
+            None => (radius as i32, None),
+        };
         if s.line {
-            chart
+            let a = chart
                 .draw_series(LineSeries::new(s.points.iter().copied(), style))
-                .map_err(err(path))?
-                .label(s.label.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+                .map_err(err(path))?;
+            if !s.markers {
+                a.label(label.clone())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+            }
         }
         if s.markers {
-            let (r, mark) = match covered(i) {
-                true => (radius + 3, c.stroke_width(2)),
-                false => (radius, c.filled()),
-            };
+            let line = s.line.then_some(style);
             let a = chart
-                .draw_series(s.points.iter().map(|&p| Circle::new(p, r, mark)))
+                .draw_series(s.points.iter().map(|&p| shape.at(p, r, c, ring, None)))
                 .map_err(err(path))?;
-            if !s.line {
-                a.label(s.label.clone())
-                    .legend(move |(x, y)| Circle::new((x + 10, y), r, mark));
-            }
+            a.label(label)
+                .legend(move |(x, y)| shape.at((x + 10, y), r, c, ring, line));
         }
     }
     Ok(())
+}
+
+/// A legend label's first word: the method or code it names.
+fn first_word(label: &str) -> &str {
+    label.split([' ', ':', '(']).next().unwrap_or("")
+}
+
+/// What a series that lies on `under` adds to its legend: " (= mortar to 1e-4)", the first
+/// word of `under`'s label and the largest relative difference of their values at the same
+/// abscissae, rounded up to a power of ten; " (under mortar)" where the abscissae differ.
+fn coincidence(s: &Series, under: &Series) -> String {
+    let name = first_word(&under.label);
+    let mut largest: Option<f64> = Some(0.0);
+    for p in &s.points {
+        match under.points.iter().find(|q| (q.0 - p.0).abs() <= 1e-12 * p.0.abs().max(1.0)) {
+            Some(q) => {
+                let d = (p.1 - q.1).abs() / p.1.abs().max(q.1.abs()).max(f64::MIN_POSITIVE);
+                largest = largest.map(|l| l.max(d));
+            }
+            None => largest = None,
+        }
+    }
+    match largest {
+        Some(d) if d == 0.0 => format!(" (= {name})"),
+        Some(d) => format!(" (= {name} to {:.0e})", 10f64.powf(d.log10().ceil())),
+        None => format!(" (under {name})"),
+    }
 }
 
 /// The legend at `pos`, labels `font_px` high on white of the given opacity, framed black.

@@ -60,7 +60,9 @@ struct ContactCsv {
     time: f64,
     /// Piece of Gamma_C (from 0).
     piece: usize,
-    /// Arc length along the piece from its start (length).
+    /// Arc length along the piece from its end of smaller x (of smaller y where x is the
+    /// same) (length): a plot against it reads left to right whichever way body 1's
+    /// boundary runs.
     arc_length: f64,
     x: f64,
     y: f64,
@@ -70,6 +72,22 @@ struct ContactCsv {
     normal_jump: f64,
     /// Whether the node's constraint holds as an equality.
     active: bool,
+}
+
+/// One piece's nodes from its end of smaller x (smaller y where x is the same), each with
+/// its distance along the piece from that end (a piece is straight, so the distance is the
+/// arc length).
+fn reading_order(piece: &[ContactNode]) -> Vec<(f64, &ContactNode)> {
+    let key = |c: &ContactNode| (c.position[0], c.position[1]);
+    let Some(start) = piece.iter().min_by(|a, b| key(a).partial_cmp(&key(b)).unwrap()) else {
+        return Vec::new();
+    };
+    let distance = |c: &ContactNode| {
+        (c.position[0] - start.position[0]).hypot(c.position[1] - start.position[1])
+    };
+    let mut out: Vec<(f64, &ContactNode)> = piece.iter().map(|c| (distance(c), c)).collect();
+    out.sort_by(|a, b| a.0.total_cmp(&b.0));
+    out
 }
 
 /// The time series of a `solve` run: every `every`-th step and the last as
@@ -219,19 +237,23 @@ impl<'a> Series<'a> {
         Some((name, n == steps, state.clone(), nodes))
     }
 
-    /// Record a written step: its time and file, and its contact rows.
+    /// Record a written step: its time and file, and its contact rows, each piece's in
+    /// reading order ([`reading_order`]).
     fn record(&mut self, time: f64, nodes: &[ContactNode], file: String) {
         self.written.push((time, file));
-        self.contact.extend(nodes.iter().map(|c| ContactCsv {
-            time,
-            piece: c.piece,
-            arc_length: c.arc_length,
-            x: c.position[0],
-            y: c.position[1],
-            pressure: c.pressure,
-            normal_jump: c.normal_jump,
-            active: c.active,
-        }));
+        for piece in nodes.chunk_by(|a, b| a.piece == b.piece) {
+            self.contact
+                .extend(reading_order(piece).into_iter().map(|(arc_length, c)| ContactCsv {
+                    time,
+                    piece: c.piece,
+                    arc_length,
+                    x: c.position[0],
+                    y: c.position[1],
+                    pressure: c.pressure,
+                    normal_jump: c.normal_jump,
+                    active: c.active,
+                }));
+        }
     }
 
     /// Write solution.pvd, contact.csv and summary.csv; `wall_s` is the whole run's wall
@@ -286,14 +308,14 @@ pub fn console(run: &RunSummary, wall_s: f64, written: &Written, dir: &Path) -> 
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{} {} {} level {}: h = {:.4}, {} dofs, {} steps, {} iterations (max {} per step), {:.3} s; max penetration {:.3e}, contact fraction {:.3}, plastic fraction {:.3}",
+        "{} {} {} level {}: h = {:.4}, {} dofs, {}, {} iterations (max {} per step), {:.3} s; max penetration {:.3e}, contact fraction {:.3}, plastic fraction {:.3}",
         run.scene,
         run.method,
         run.solver,
         run.level,
         run.h,
         run.dofs,
-        run.steps,
+        crate::io::count(run.steps, "step"),
         run.iterations,
         run.max_step_iterations,
         wall_s,
@@ -308,7 +330,7 @@ pub fn console(run: &RunSummary, wall_s: f64, written: &Written, dir: &Path) -> 
     };
     let _ = writeln!(
         s,
-        "  mesh {:.3} s, model {:.3} s, solver set-up (pattern, symbolic) {:.3} s; time loop {:.3} s{floor}: {} factorizations {:.3} s, solves {:.3} s, assembly {:.3} s, constitutive {:.3} s, contact {:.3} s; {} active-set changes; peak RSS {} GiB",
+        "  mesh {:.3} s, model {:.3} s, solver set-up (pattern, symbolic) {:.3} s; time loop {:.3} s{floor}: {} factorizations {:.3} s, solves {:.3} s, assembly {:.3} s, constitutive {:.3} s, contact {:.3} s; {} active-set changes; peak RSS {}",
         run.mesh_s,
         run.model_s,
         t.setup_s,
@@ -321,8 +343,7 @@ pub fn console(run: &RunSummary, wall_s: f64, written: &Written, dir: &Path) -> 
         t.contact_s,
         run.active_set_changes,
         run.peak_rss_gib
-            .map(|g| format!("{g:.1}"))
-            .unwrap_or_default()
+            .map_or("not measured".into(), crate::io::memory_text)
     );
     let _ = writeln!(
         s,

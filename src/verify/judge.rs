@@ -139,6 +139,22 @@ impl RateRow {
         let a = &self.assessment;
         rates::short_text(a.verdict, a.fit.map(|f| f.rate), a.last_rate())
     }
+    /// "method quantity: " and the verdict as one plain line ([`Assessment::verdict_line`]),
+    /// with the threshold's outcome and why (an exactness bound: the largest error against
+    /// it).
+    pub fn verdict_line(&self) -> String {
+        let a = &self.assessment;
+        let line = match (self.threshold, self.outcome) {
+            (Some(Threshold::Rate(t)), Some(o)) => a.verdict_line(Some((t, o))),
+            (Some(Threshold::Exact(t)), Some(o)) => format!(
+                "{}; every error at most {t:.0e}: {}",
+                a.verdict_line(None),
+                o.shouted()
+            ),
+            _ => a.verdict_line(None),
+        };
+        format!("{} {}: {line}", self.method, self.quantity)
+    }
     /// The row of rates.csv.
     pub fn record(&self) -> RateRecord {
         RateRecord::from_parts(

@@ -897,6 +897,37 @@ impl Assessment {
         self.judged.last().map(|r| r.rate)
     }
 
+    /// The verdict as one plain line, as `judge`, `grade` and `study` print it: the rate or
+    /// why there is none, the fitted levels, the successive rates, and, given a threshold
+    /// and its outcome, the outcome with the numbers that decided it ([`outcome_reason`]).
+    pub fn verdict_line(&self, threshold: Option<(f64, Outcome)>) -> String {
+        let successive = match self.successive.iter().any(Option::is_some) {
+            true => format!(" (successive rates {})", self.successive_text().replace(' ', ", ")),
+            false => String::new(),
+        };
+        let mut line = match (self.verdict, self.fit) {
+            (Verdict::Fitted, Some(f)) => format!(
+                "rate {:.3} ± {:.3}, fitted over levels {}{successive}",
+                f.rate,
+                f.stderr,
+                crate::verify::table::join(&self.used)
+            ),
+            (Verdict::PreAsymptotic, Some(f)) => format!(
+                "no rate: pre-asymptotic (the fit over every level, {:.3} ± {:.3}, is not supported){successive}",
+                f.rate, f.stderr
+            ),
+            _ => format!("no rate: {}{successive}", self.describe().replace("**", "")),
+        };
+        if let Some((t, o)) = threshold {
+            line.push_str(&format!(
+                "; threshold {t:?}: {}, because {}",
+                o.shouted(),
+                outcome_reason(self, t, o)
+            ));
+        }
+        line
+    }
+
     /// The judged rate with its standard error, or the verdict that replaces it, as reports
     /// write it.
     pub fn describe(&self) -> String {

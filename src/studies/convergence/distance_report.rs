@@ -318,6 +318,7 @@ pub fn plot(res: &StudyResult, d: &Path) -> Result<()> {
             line: row.is_none(),
             color,
             thin: row.is_none(),
+            shape: None,
         });
         if let (Some(fit), Some(row)) = (supported_fit(row), row) {
             let used: Vec<f64> = res

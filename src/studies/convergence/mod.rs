@@ -1081,13 +1081,25 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
     let truth = truth(&study, &plan, &mut solved);
     // 3. Every level of every cone against it.
     let profile_level = sf.mesh.levels[sf.mesh.levels.len() / 2];
+    let phase = Progress::phase(&study.name, &measuring(plan.levels.len(), &truth));
     let measured = measure_levels(sf, &plan, &mut solved, &truth, profile_level)?;
+    drop(phase);
     // 4. The rates and their thresholds, and the variant families'.
     let fixed = measured.resultant_fixed;
     let rates = fit_rates(sf, &study.path, &measured.errors, &|q| truth.quantity_error(q), fixed)?;
+    let phase = (!plan.variants.is_empty()).then(|| {
+        let n = plan.variants.iter().map(|v| v.1.len()).sum();
+        Progress::phase(&study.name, &format!("{} of the variant families", measuring(n, &truth)))
+    });
     let variants = measure_variants(sf, &study.path, &plan, &mut solved, &truth, fixed)?;
+    drop(phase);
     // 5. The rate in time on a fixed mesh.
+    let phase = plan
+        .time
+        .is_some()
+        .then(|| Progress::phase(&study.name, "measuring the time study's errors"));
     let time_study = time_study(&study, &plan, &mut solved, sf.reference.quadrature)?;
+    drop(phase);
     // 6. The provenance, with the mesh the truth was measured on.
     let (reference, exact_quadrature, mesh, warnings) = match &truth {
         Truth::Solved(r) => (
@@ -1132,6 +1144,15 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
         kept_from: None,
         file: study.file,
     }))
+}
+
+/// "measuring 24 solutions against the reference (level 7)": the phase of step 3.
+fn measuring(solutions: usize, truth: &Truth) -> String {
+    let against = match truth {
+        Truth::Solved(r) => format!("the reference (level {}, the error integrals over the meshes' intersection)", r.facts.level),
+        Truth::Exact(..) => "the exact solution".to_string(),
+    };
+    format!("measuring {} against {against}", crate::io::count(solutions, "solution"))
 }
 
 /// Every job of the plan in `mode`: all of them, one shard's (records only: None), or the

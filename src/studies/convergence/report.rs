@@ -228,6 +228,7 @@ fn error_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
             line: false,
             color: i,
             thin: false,
+            shape: None,
         });
         // The study's fitted line over the levels used, from the fit itself.
         if let Some((legend, rate, intercept, hs)) = rate.line(&rows) {
@@ -249,6 +250,7 @@ fn error_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
                 line: true,
                 color: i,
                 thin: true,
+                shape: None,
             });
         }
     }
@@ -256,7 +258,12 @@ fn error_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
         &d.join("error_vs_h.png"),
         &format!("{}: error against h", res.name),
         "h (max element diameter)",
-        &format!("relative error ({})", quantity_label(key)),
+        // The pressure's error is drawn too: the legend says which is which.
+        match series.iter().any(|s| s.thin) {
+            true => "relative error (legend: which quantity)".to_string(),
+            false => format!("relative error ({})", quantity_label(key)),
+        }
+        .as_str(),
         &series,
         &[(0.5, "1/2"), (0.75, "3/4"), (1.0, "1")],
     )
@@ -271,6 +278,7 @@ fn error_vs_k(res: &StudyResult, ts: &TimeStudy, d: &Path) -> Result<()> {
         line: false,
         color: 0,
         thin: false,
+        shape: None,
     }];
     let a = &ts.assessment;
     let used: Vec<f64> = a.used.iter().map(|&i| ts.runs[i].k).collect();
@@ -316,6 +324,7 @@ fn error_vs_time(res: &StudyResult, d: &Path) -> Result<()> {
             line: true,
             color: i,
             thin: false,
+            shape: None,
         })
         .collect();
     plot::loglog(
@@ -373,6 +382,7 @@ fn profiles(res: &StudyResult, d: &Path) -> Result<()> {
                     // The reference's colour follows the methods' (2 beside two of them).
                     color: if reference { res.file.methods.len().max(2) } else { i },
                     thin: reference,
+                    shape: None,
                 }
             })
             .collect();
@@ -459,12 +469,12 @@ fn readme(res: &StudyResult) -> String {
 fn title(doc: &mut Doc, res: &StudyResult) {
     crate::report::study_heading(doc, &res.name, &res.description, &res.scene);
     doc.paragraph(format!(
-            "Regenerate with `cargo run --release -- study {}` ({:.0} s on this machine, {} cores). Solver `{}`, {} uniform time steps over [0, {}].",
+            "Regenerate with `cargo run --release -- study {}` ({:.0} s on this machine, {} cores). Solver `{}`, {} over [0, {}].",
             res.name,
             res.wall_s,
             res.provenance.get("cores").cloned().unwrap_or_default(),
             res.file.solver,
-            res.file.steps,
+            crate::io::count(res.file.steps, "uniform time step"),
             res.scene.final_time
         ));
 }
@@ -1010,23 +1020,7 @@ fn provenance(doc: &mut Doc, res: &StudyResult) {
 pub fn console(res: &StudyResult, dir: &Path) -> String {
     let mut s = String::new();
     for r in &res.rates {
-        let _ = writeln!(
-            s,
-            "{:7} {:16} rate {:>6} +- {} (levels {}) {}{}",
-            r.method.name(),
-            r.quantity.name(),
-            fmt3(r.rate()),
-            fmt3(r.stderr()),
-            join(&r.assessment.used),
-            r.assessment.verdict.name(),
-            r.threshold
-                .map(|t| format!(
-                    " threshold {}: {}",
-                    threshold_text(t, 3),
-                    r.outcome.map_or("-", rates::Outcome::shouted)
-                ))
-                .unwrap_or_default()
-        );
+        let _ = writeln!(s, "{}", r.verdict_line());
     }
     for e in res
         .errors
@@ -1053,17 +1047,20 @@ pub fn console(res: &StudyResult, dir: &Path) -> String {
             );
         }
         let a = &ts.assessment;
+        let steps: Vec<usize> = a.used.iter().map(|&i| ts.runs[i].steps).collect();
+        let verdict = match (a.verdict, a.fit) {
+            (Verdict::Fitted, Some(f)) => format!(
+                "rate in k {:.3} ± {:.3}, fitted over {} steps",
+                f.rate,
+                f.stderr,
+                steps.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(", ")
+            ),
+            _ => format!("no rate in k: {}", a.describe().replace("**", "")),
+        };
         let _ = writeln!(
             s,
-            "time study rate in k {:>6} +- {} (steps {}) {}",
-            fmt3(a.fit.map_or(f64::NAN, |f| f.rate)),
-            fmt3(a.fit.map_or(f64::NAN, |f| f.stderr)),
-            a.used
-                .iter()
-                .map(|&i| ts.runs[i].steps.to_string())
-                .collect::<Vec<_>>()
-                .join(" "),
-            a.verdict.name()
+            "time study: {verdict} (successive rates {})",
+            a.successive_text().replace(' ', ", ")
         );
     }
     match res.reference {
@@ -1110,14 +1107,16 @@ fn contact_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
                     .iter()
                     .find(|r| r.method == m && r.quantity == q)
                     .map_or("n/a".into(), RateRow::short_text);
+                let method_index = Method::ALL.iter().position(|&x| x == m).unwrap_or(0);
                 series.push(Series {
                     label: format!("{m} {q}: {rate}"),
                     points,
-                    // Colour: the quantity; style: the method (lac without markers).
-                    markers: m != Method::Lac,
+                    // Colour: the quantity; marker: the method (nts's line thin).
+                    markers: true,
                     line: true,
                     color: c,
                     thin: m == Method::Nts,
+                    shape: Some(plot::Shape::of(method_index)),
                 });
             }
         }
@@ -1128,12 +1127,15 @@ fn contact_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
     plot::loglog(
         &d.join("contact_vs_h.png"),
         &format!(
-            "{}: contact quantities against h ({})",
+            "{}: contact quantities against h (colour: quantity; {})",
             res.name,
-            match res.file.methods.contains(&Method::Lac) {
-                true => "thin: nts, no dots: lac",
-                false => "thick: mortar, thin: nts",
-            }
+            Method::ALL
+                .iter()
+                .enumerate()
+                .filter(|(_, m)| res.file.methods.contains(m))
+                .map(|(i, m)| format!("{m} {}", plot::Shape::of(i).name()))
+                .collect::<Vec<_>>()
+                .join(", ")
         ),
         "h (max element diameter)",
         "relative error",

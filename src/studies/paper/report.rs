@@ -97,6 +97,7 @@ fn pressure_plot(path: &Path, title: &str, runs: &[&Run]) -> Result<()> {
             line: true,
             color: i,
             thin: false,
+            shape: None,
         })
         .collect();
     plot::lines(

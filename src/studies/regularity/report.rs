@@ -475,6 +475,7 @@ impl Regularity {
                         line: true,
                         color: i,
                         thin: false,
+                        shape: None,
                     });
                 }
             }
@@ -499,6 +500,7 @@ impl Regularity {
                                 line: false,
                                 color: i,
                                 thin: true,
+                                shape: None,
                             });
                         }
                     }
@@ -516,6 +518,7 @@ impl Regularity {
                     line: true,
                     color: 2,
                     thin: true,
+                    shape: None,
                 });
             }
             plot::lines(

@@ -254,6 +254,7 @@ fn work_precision(res: &SpeedResult, d: &Path) -> Result<()> {
             line: true,
             color: *c,
             thin: *so == SolverKind::Paper,
+            shape: None,
         })
         .filter(|s| !s.points.is_empty())
         .collect();
@@ -283,6 +284,7 @@ fn time_vs_dofs(res: &SpeedResult, d: &Path) -> Result<()> {
                 line: true,
                 color: 3 * f + k,
                 thin: false,
+                shape: None,
             });
         }
         let floor: Vec<(f64, f64)> = family_runs(res, family, Method::Mortar, SolverKind::Newton)
@@ -295,6 +297,7 @@ fn time_vs_dofs(res: &SpeedResult, d: &Path) -> Result<()> {
             line: true,
             color: 3 * f,
             thin: true,
+            shape: None,
         });
     }
     plot::loglog(
@@ -623,7 +626,7 @@ fn fill(newton: usize, floor: usize) -> String {
 }
 
 fn gib(v: Option<f64>) -> String {
-    v.map(|g| format!("{g:.1}")).unwrap_or_default()
+    v.map_or("-".into(), crate::io::memory_text)
 }
 
 /// The table of every run: cost split, floor, memory and error.
@@ -645,7 +648,7 @@ fn runs_table(res: &SpeedResult) -> Table {
         "assembly (s)",
         "constitutive (s)",
         "fill, newton / floor (entries of L)",
-        "peak RSS (GiB)",
+        "peak RSS",
         "error",
     ]);
     for r in &res.rows {

@@ -51,6 +51,7 @@ fn sweep_plots(res: &StabilityResult, d: &Path) -> Result<()> {
                     line: true,
                     color: i,
                     thin: false,
+                    shape: None,
                 });
             }
             let pe: Vec<(f64, f64)> = rows
@@ -66,6 +67,7 @@ fn sweep_plots(res: &StabilityResult, d: &Path) -> Result<()> {
                     line: true,
                     color: i,
                     thin: false,
+                    shape: None,
                 });
             }
         }

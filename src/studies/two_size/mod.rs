@@ -359,7 +359,19 @@ pub fn run(name: &str) -> Result<TwoSizeResult> {
     let truths = truths(&study, &plan, &scenes, &mut solved);
     // Step 3: every pair against its truth.
     let runs = plan.pair_runs(&mut solved);
+    let phase = crate::progress::Progress::phase(
+        &study.name,
+        &format!(
+            "measuring {} against {}",
+            crate::io::count(runs.len(), "pair"),
+            match truths.first() {
+                Some(Truth::Solved(_)) => "the references (the error integrals over the meshes' intersection)",
+                _ => "the exact solution",
+            }
+        ),
+    );
     let points = measure(&study, &slaves, &runs, &truths)?;
+    drop(phase);
     // Step 4: the fits.
     let fits = fit_all(&study, spec, &slaves, &points, &truths)?;
     let references = truths

@@ -282,6 +282,7 @@ fn sweeps(res: &TwoSizeResult, slave: &str, d: &Path) -> Result<()> {
                 line: true,
                 color: 2 * i + b,
                 thin: b == 1,
+                shape: None,
             });
         }
     }
@@ -484,9 +485,9 @@ fn diagonal(doc: &mut Doc, res: &TwoSizeResult) {
     }
     doc.heading(2, format!("The diagonal against `{name}`"))
         .paragraph(format!(
-            "Where both bodies have the same level the mesh is the diagonal study's (each body split from the same gmsh level-0 mesh; slave '{}'), so its errors must agree with [`reports/{name}`](../{name}/README.md) to the solver tolerance (this study's {} time steps against its own; a quantity taken as the max over the steps may differ where they do). Largest relative difference per quantity over both cones and levels {}:",
+            "Where both bodies have the same level the mesh is the diagonal study's (each body split from the same gmsh level-0 mesh; slave '{}'), so its errors must agree with [`reports/{name}`](../{name}/README.md) to the solver tolerance (this study's {} against its own; a quantity taken as the max over the steps may differ where they do). Largest relative difference per quantity over both cones and levels {}:",
             res.scene.bodies[0].surface,
-            res.steps,
+            crate::io::count(res.steps, "time step"),
             join(&res.levels)
         ))
         .table(&table);
@@ -521,13 +522,13 @@ fn readme(res: &TwoSizeResult) -> String {
 fn title(doc: &mut Doc, res: &TwoSizeResult) {
     crate::report::study_heading(doc, &res.name, &res.description, &res.scene);
     doc.paragraph(format!(
-            "Regenerate with `cargo run --release -- study {}` ({:.0} s on this machine, {} cores). Grid: every pair of levels {} of the slave (body 1) and the master (body 2); one-sided sweeps: each body over those levels with the other at level {fixed}; and (level {fixed}, level {fixed}) as their floor. Slave choices: {}. {} time steps.",
+            "Regenerate with `cargo run --release -- study {}` ({:.0} s on this machine, {} cores). Grid: every pair of levels {} of the slave (body 1) and the master (body 2); one-sided sweeps: each body over those levels with the other at level {fixed}; and (level {fixed}, level {fixed}) as their floor. Slave choices: {}. {}.",
             res.name,
             res.wall_s,
             res.provenance.get("cores").cloned().unwrap_or_default(),
             join(&res.levels),
             res.slaves.join(", "),
-            res.steps,
+            crate::io::count(res.steps, "time step"),
             fixed = res.fixed
         ));
 }
