@@ -7,6 +7,9 @@ Solve an exported contact problem with GetFEM's contact bricks and write the sol
     /usr/bin/python3 examples/grade_getfem.py EXPORT_DIR OUT_DIR --brick integral   # or nodal
     contact-rates grade --study rates-exact --solutions OUT_DIR --levels 0-4 --name getfem-integral
 
+(`contact-rates` is the project's binary: `cargo install --path .` puts it on PATH, or
+use `cargo run --release --` in its place from the checkout.)
+
 Per level L of EXPORT_DIR (every mesh_L.msh22.msh, or --levels A-B): the mesh imported by
 GetFEM's gmsh importer, P1 Lagrange plane-stress elasticity on each body (GetFEM's isotropic
 linearized elasticity brick with lambda = lambda_star), the supports of problem.toml as

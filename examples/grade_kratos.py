@@ -7,6 +7,9 @@ Lagrangian method, frictionless) and write the solutions `grade` reads.
     OMP_NUM_THREADS=1 python3 examples/grade_kratos.py EXPORT_DIR OUT_DIR [--levels A-B]
     contact-rates grade --study rates-exact --solutions OUT_DIR --levels 0-4 --name kratos-alm
 
+(`contact-rates` is the project's binary: `cargo install --path .` puts it on PATH, or
+use `cargo run --release --` in its place from the checkout.)
+
 Per level L of EXPORT_DIR, the model part is built here in Python from mesh_L.msh22.msh:
 - elements: P1 triangles, SmallDisplacementElement2D3N, LinearElasticPlaneStress2DLaw with E and
   nu of problem.toml and thickness 1;

@@ -5,6 +5,9 @@
     python3 examples/grade_skfem.py EXPORT_DIR OUT_DIR
     contact-rates grade --study rates-exact --solutions OUT_DIR --levels 0-4 --name skfem
 
+(`contact-rates` is the project's binary: `cargo install --path .` puts it on PATH, or
+use `cargo run --release --` in its place from the checkout.)
+
 Per level L of EXPORT_DIR (every mesh_L.msh): P1 plane-stress elasticity assembled by
 scikit-fem on both bodies, the nodal loads of loads_L.csv, the supports of problem.toml
 as Dirichlet conditions, and frictionless unilateral contact discretized node-to-segment

@@ -60,8 +60,12 @@ enum Command {
     /// speed, stability).
     Results {
         /// Print instead README.md's headline table (between its `headline` markers).
-        #[arg(long)]
+        #[arg(long, conflicts_with = "glossary")]
         headline: bool,
+        /// Print instead the glossary of every quantity (docs/studies.md, between its
+        /// `glossary` markers; every grade report prints the part it names).
+        #[arg(long)]
+        glossary: bool,
     },
     /// The built-in scenes (`scene list`).
     Scene {
@@ -241,9 +245,35 @@ fn parse_sets(set: &[String]) -> anyhow::Result<Vec<(String, f64)>> {
         .collect()
 }
 
+/// The command line, or clap's message and exit 2. clap's tip for an unknown option after a
+/// positional argument ("to pass '--levle' as a value, use '-- --levle'") would send a user
+/// of `study NAME --levle 3` the wrong way: a study takes no options for its levels, its
+/// study file sets them, and the tip says so instead.
+fn parse_cli() -> Cli {
+    let e = match Cli::try_parse() {
+        Ok(cli) => return cli,
+        Err(e) => e,
+    };
+    let text = e.render().to_string();
+    let in_study = std::env::args().nth(1).as_deref() == Some("study");
+    if e.kind() == clap::error::ErrorKind::UnknownArgument && in_study && text.contains("-- ") {
+        let tip = "  tip: `study NAME` takes --out, --publish, --shard, --merge and --rejudge; its levels, methods, solver and steps are set in the study file (studies/NAME.toml: [mesh] levels, methods, solver, steps; docs/studies.md)";
+        let fixed: Vec<String> = text
+            .lines()
+            .map(|l| match l.trim_start().starts_with("tip: to pass") {
+                true => tip.to_string(),
+                false => l.to_string(),
+            })
+            .collect();
+        eprintln!("{}", fixed.join("\n"));
+        std::process::exit(2);
+    }
+    e.exit()
+}
+
 fn run() -> anyhow::Result<()> {
     contact_rates::init();
-    match Cli::parse().command {
+    match parse_cli().command {
         Command::Study {
             name,
             out,
@@ -252,9 +282,16 @@ fn run() -> anyhow::Result<()> {
             merge,
             rejudge,
         } => study(&name, out, publish, shard.as_deref(), merge, rejudge),
-        Command::Results { headline } => {
+        Command::Results { headline, glossary } => {
             let reports = report::reports_dir();
-            if headline {
+            if glossary {
+                print!(
+                    "{}",
+                    contact_rates::verify::quantity::glossary(
+                        &contact_rates::verify::quantity::Quantity::ALL
+                    )
+                );
+            } else if headline {
                 print!("{}", contact_rates::results::headline(&reports)?);
             } else {
                 print!("{}", contact_rates::results::section(&reports)?);
@@ -320,13 +357,15 @@ fn study(
     if name == "list" {
         // The run time of the committed report, where it records one (run.toml).
         let times = contact_rates::results::wall_times(&report::reports_dir()).unwrap_or_default();
-        println!("{:22} {:>9}  what it measures", "study", "run time");
-        for (n, d) in Study::list() {
+        let studies = Study::list();
+        let width = studies.iter().map(|s| s.0.len()).max().unwrap_or(5);
+        println!("{:width$} {:>9}  what it measures", "study", "run time");
+        for (n, d) in studies {
             let time = times
                 .iter()
                 .find(|t| t.0 == n)
                 .map_or("-".to_string(), |t| format!("{:.0} s", t.1));
-            println!("{n:22} {time:>9}  {d}");
+            println!("{n:width$} {time:>9}  {d}");
         }
         println!("(run time: the committed report's, on 2 cores, after the build; - where its report records none)");
         return Ok(());

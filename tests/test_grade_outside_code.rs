@@ -139,6 +139,18 @@ fn round_trip_of_this_projects_solves_gives_the_study_errors() {
             (x, y) => assert_eq!(x, y, "{q}"),
         }
     }
+    // The console's verdict lines and the summary of what differs (issue 74): the graded
+    // solution is mortar's, so it sides with mortar, every compared ratio 1.000.
+    let console = g.console(dir.path());
+    println!("{console}");
+    let first = console.lines().next().unwrap();
+    assert!(first.starts_with("outside theorem: rate "), "{first}");
+    assert!(
+        console.contains("it agrees with mortar within 1.5x in all")
+            && console.contains("(furthest: a ratio of 1.000)")
+            && console.contains("It sides with mortar"),
+        "{console}"
+    );
 }
 
 #[test]

@@ -145,8 +145,9 @@ fn interrupted_solve(signo: c_int) {
     let err = assert_exit(child, signo);
 
     assert!(
-        err.contains("removed ./.o.staging-"),
-        "a note names the folder removed: {err}"
+        err.contains("interrupted by SIG")
+            && err.contains("removed its unfinished output ./.o.staging-"),
+        "one line says so and names the folder removed: {err}"
     );
     assert_eq!(
         debris(cwd, "o"),
@@ -229,7 +230,12 @@ fn an_interrupted_study_leaves_nothing_and_the_previous_report() {
     // The study computes for over a second before its report folder is staged.
     std::thread::sleep(Duration::from_millis(400));
     kill(&child, libc::SIGTERM);
-    assert_exit(child, libc::SIGTERM);
+    let err = assert_exit(child, libc::SIGTERM);
+    assert!(
+        err.contains("interrupted by SIGTERM while patch: ")
+            && err.contains("no output was written or changed"),
+        "one line says what the run was doing and that nothing was written: {err}"
+    );
     assert_eq!(debris(cwd, "rep"), Vec::<PathBuf>::new());
     assert_eq!(snapshot(&rep), before, "the previous report, byte for byte");
 }
@@ -260,4 +266,52 @@ fn a_report_being_written_is_removed_on_interrupt() {
     assert!(!seen.unwrap().exists(), "the staging folder removed");
     assert_eq!(debris(dir.path(), "rep"), Vec::<PathBuf>::new());
     assert_eq!(snapshot(&rep), before);
+}
+
+/// A run interrupted while gmsh refines its meshes ends gmsh and leaves no temporary mesh
+/// in the cache (issue 74: a `.tmp.msh` was left there), and a later run still finds
+/// the cached levels it completed.
+#[test]
+fn an_interrupted_refinement_leaves_no_temporary_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = dir.path().join("cache");
+    let mut c = Command::new(BIN);
+    c.args(["solve", "--scene", "rates", "--level", "6", "--steps", "1", "--out", "o"])
+        .current_dir(dir.path())
+        .env("CONTACT_RATES_CACHE", &cache)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped());
+    // SAFETY: signal() is async-signal-safe, as a pre_exec hook must be.
+    unsafe {
+        c.pre_exec(|| {
+            libc::signal(libc::SIGINT, libc::SIG_DFL);
+            Ok(())
+        });
+    }
+    let mut child = c.spawn().unwrap();
+    let cached = |level: usize| {
+        std::fs::read_dir(&cache).into_iter().flatten().flatten().any(|e| {
+            e.file_name()
+                .to_string_lossy()
+                .ends_with(&format!("-L{level}.msh"))
+        })
+    };
+    // Level 4 cached: gmsh is refining level 5 (a few seconds on 2 cores).
+    wait_until(&mut child, "level 4 in the mesh cache", || cached(4));
+    kill(&child, libc::SIGINT);
+    let err = assert_exit(child, libc::SIGINT);
+    assert!(err.contains("interrupted by SIGINT"), "{err}");
+    let temporary = || -> Vec<String> {
+        std::fs::read_dir(&cache)
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().to_string())
+            .filter(|n| n.ends_with(".tmp.msh"))
+            .collect()
+    };
+    assert_eq!(temporary(), Vec::<String>::new(), "{err}");
+    // gmsh was ended, not orphaned: nothing appears later either.
+    std::thread::sleep(Duration::from_millis(1500));
+    assert_eq!(temporary(), Vec::<String>::new(), "a temporary mesh written after the exit");
+    assert!(cached(4), "the completed levels stay cached");
 }

@@ -228,6 +228,7 @@ fn figures_render() {
             line: true,
             color: 0,
             thin: false,
+            shape: None,
         },
         Series {
             label: "nts".into(),
@@ -236,6 +237,7 @@ fn figures_render() {
             line: true,
             color: 1,
             thin: true,
+            shape: None,
         },
     ];
     let slopes = [(0.5, "1/2"), (1.0, "1")];
@@ -283,4 +285,28 @@ fn figures_render() {
         let bytes = std::fs::read(&f).unwrap();
         assert_eq!(&bytes[1..4], b"PNG", "{}", f.display());
     }
+}
+
+/// Reference: issue 74 (no line hidden under another without saying so in the legend).
+/// Goal: a series that lies on an earlier one says which, and to what relative difference
+/// (rounded up to one significant digit); equal data say "="; other abscissae say "under".
+#[test]
+fn a_hidden_series_says_what_it_lies_on() {
+    let at = |points: Vec<(f64, f64)>, label: &str| Series {
+        label: label.into(),
+        points,
+        markers: true,
+        line: false,
+        color: 0,
+        thin: false,
+        shape: None,
+    };
+    let hs = [0.1, 0.05, 0.025];
+    let mortar = at(hs.iter().map(|&h| (h, h)).collect(), "mortar (theorem norm)");
+    let close = at(hs.iter().map(|&h| (h, h * (1.0 + 3e-5))).collect(), "nts");
+    let same = at(hs.iter().map(|&h| (h, h)).collect(), "lac");
+    let shifted = at(hs.iter().map(|&h| (1.01 * h, h)).collect(), "code");
+    assert_eq!(plot::coincidence(&close, &mortar), " (= mortar to 3e-5)");
+    assert_eq!(plot::coincidence(&same, &mortar), " (= mortar)");
+    assert_eq!(plot::coincidence(&shifted, &mortar), " (under mortar)");
 }

@@ -384,3 +384,23 @@ fn regularity_table_marks_the_theorem_rows_by_beta() {
         assert_eq!(dagger, !theorem, "row {row}: † must mark beta <= 1 only");
     }
 }
+
+/// Reference: issue 74 (a glossary shared by docs/studies.md and the grade reports).
+/// Goal: docs/studies.md's glossary, between its `glossary` markers, is the one
+/// `contact-rates results --glossary` prints, and names every quantity.
+#[test]
+fn docs_studies_glossary_is_the_one_the_reports_print() {
+    use contact_rates::verify::quantity::{Quantity, glossary};
+    let studies = std::fs::read_to_string(root().join("docs/studies.md")).unwrap();
+    let (start, end) = ("<!-- glossary:start -->\n", "<!-- glossary:end -->");
+    let from = studies.find(start).expect("docs/studies.md has glossary markers") + start.len();
+    let to = from + studies[from..].find(end).expect("a glossary end marker");
+    let expected = glossary(&Quantity::ALL);
+    assert!(
+        studies[from..to] == expected,
+        "docs/studies.md's glossary differs; replace the text between its glossary markers with the output of `cargo run --release -- results --glossary`:\n{expected}"
+    );
+    for q in Quantity::ALL {
+        assert!(expected.contains(&format!("`{}`", q.name())), "{q} has no entry");
+    }
+}

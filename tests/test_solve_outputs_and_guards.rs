@@ -99,6 +99,27 @@ fn solve_writes_contact_csv_and_a_paraview_time_series() {
                 "{method} t = {t}: resultant {resultant} against the load {load}"
             );
         }
+        // Each piece's rows in reading order: arc length from 0 at the end of smaller x (of
+        // smaller y on a vertical piece), increasing, and the distance from that end.
+        let first = rows.iter().filter(|r| f(r, 0) == 1.0);
+        let mut by_piece: std::collections::BTreeMap<String, Vec<&csv::StringRecord>> =
+            Default::default();
+        for r in first {
+            by_piece.entry(r[1].to_string()).or_default().push(r);
+        }
+        for (piece, at) in by_piece {
+            assert_eq!(f(at[0], 2), 0.0, "{method} piece {piece} starts at 0");
+            for w in at.windows(2) {
+                let (a, b) = (w[0], w[1]);
+                assert!(f(b, 2) > f(a, 2), "{method} piece {piece}: arc length increases");
+                assert!(
+                    (f(b, 3), f(b, 4)) > (f(a, 3), f(a, 4)),
+                    "{method} piece {piece}: reading order"
+                );
+                let d = (f(b, 3) - f(at[0], 3)).hypot(f(b, 4) - f(at[0], 4));
+                assert!((d - f(b, 2)).abs() <= 1e-12, "{method} piece {piece}: arc length");
+            }
+        }
         // The .pvd and its VTU files.
         let pvd = std::fs::read_to_string(out.join("solution.pvd")).unwrap();
         let sets: Vec<(f64, PathBuf)> = pvd

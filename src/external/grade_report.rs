@@ -10,9 +10,21 @@ use crate::report::markdown::{Doc, Table};
 use crate::report::plot::{self, Series};
 use crate::verify::judge::RateRow;
 use crate::verify::quantity::Quantity;
+use crate::verify::judge::SEPARATES;
 use crate::verify::rates::Verdict;
 use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord, methods_in_order};
 use std::path::Path;
+
+/// How a graded code's finest errors compare with one cone's ([`Graded::differences`]).
+struct ConeDifference {
+    cone: MethodLabel,
+    /// The quantities beyond [`SEPARATES`]: (quantity, graded / cone), furthest from 1 first.
+    beyond: Vec<(Quantity, f64)>,
+    /// The ratio furthest from 1 over every compared quantity.
+    furthest: f64,
+    /// How many quantities were compared.
+    compared: usize,
+}
 
 impl Graded {
     /// The methods in the order of the report: the graded code first.
@@ -30,6 +42,118 @@ impl Graded {
         self.errors
             .iter()
             .find(|r| &r.method == method && r.level == level && r.quantity == q)
+    }
+
+    /// A method's colour and marker in the plots: a cone's as in every study's plots
+    /// (mortar, nts, lac), the graded code the next.
+    fn style_index(method: &MethodLabel) -> usize {
+        match method.cone() {
+            Some(m) => crate::contact::Method::ALL
+                .iter()
+                .position(|&x| x == m)
+                .unwrap_or(0),
+            None => crate::contact::Method::ALL.len(),
+        }
+    }
+
+    /// The quantities the graded code and the cones are compared in at the finest level:
+    /// measured for all of them, the verdicts of all of them plain enough to compare
+    /// ([`Verdict::compares_cones`]), not a distance or a best approximation.
+    fn compared_quantities(&self) -> Vec<Quantity> {
+        let methods = self.methods();
+        Quantity::ALL
+            .into_iter()
+            .filter(|q| !q.is_distance() && !q.is_best_approximation())
+            .filter(|&q| {
+                methods.iter().all(|m| {
+                    self.rate(m, q)
+                        .is_some_and(|r| r.assessment.verdict.compares_cones())
+                })
+            })
+            .collect()
+    }
+
+    /// Per cone, the quantities whose error at the finest level differs from the graded
+    /// code's by more than [`SEPARATES`] either way: (cone, [(quantity, graded / cone)],
+    /// the largest ratio of any compared quantity either way), ratios furthest from 1 first.
+    fn differences(&self) -> Option<(usize, Vec<ConeDifference>)> {
+        let level = self.levels.last()?.level;
+        let label = MethodLabel::External(self.label.clone());
+        let quantities = self.compared_quantities();
+        let mut out = Vec::new();
+        for cone in self.methods().into_iter().filter(|m| m.cone().is_some()) {
+            let mut ratios: Vec<(Quantity, f64)> = quantities
+                .iter()
+                .filter_map(|&q| {
+                    let mine = self.error(&label, level, q)?.error;
+                    let theirs = self.error(&cone, level, q)?.error;
+                    (mine > 0.0 && theirs > 0.0).then(|| (q, mine / theirs))
+                })
+                .collect();
+            ratios.sort_by(|a, b| b.1.ln().abs().total_cmp(&a.1.ln().abs()));
+            let furthest = ratios.first().map_or(1.0, |r| r.1);
+            ratios.retain(|r| !(1.0 / SEPARATES..=SEPARATES).contains(&r.1));
+            out.push(ConeDifference {
+                cone,
+                beyond: ratios,
+                furthest,
+                compared: quantities.len(),
+            });
+        }
+        Some((level, out))
+    }
+
+    /// The report's first paragraph: where the graded code differs from each cone at the
+    /// finest level, and which cone it sides with.
+    fn summary(&self) -> Option<String> {
+        let (level, cones) = self.differences()?;
+        if cones.is_empty() {
+            return None;
+        }
+        // Three significant digits: 179x, 18.6x, 1.86x.
+        let times = |r: f64| match r {
+            r if r >= 100.0 => format!("{r:.0}x"),
+            r if r >= 10.0 => format!("{r:.1}x"),
+            r => format!("{r:.2}x"),
+        };
+        let ratio = |r: f64| match r >= 1.0 {
+            true => format!("{} larger", times(r)),
+            false => format!("{} smaller", times(1.0 / r)),
+        };
+        let mut parts = Vec::new();
+        for c in &cones {
+            parts.push(match c.beyond.is_empty() {
+                true => format!(
+                    "it agrees with {} within {SEPARATES}x in all {} quantities compared (furthest: a ratio of {:.3})",
+                    c.cone, c.compared, c.furthest
+                ),
+                false => format!(
+                    "it differs from {} in {} of {}: {}",
+                    c.cone,
+                    c.beyond.len(),
+                    c.compared,
+                    c.beyond
+                        .iter()
+                        .map(|(q, r)| format!("`{q}` {}", ratio(*r)))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            });
+        }
+        let sides: Vec<String> = cones
+            .iter()
+            .filter(|c| c.beyond.is_empty())
+            .map(|c| c.cone.to_string())
+            .collect();
+        let sides = match sides.len() {
+            0 => "It sides with none of the cones.".to_string(),
+            _ => format!("It sides with {}.", sides.join(" and ")),
+        };
+        Some(format!(
+            "**What differs.** At the finest level ({level}), in the quantities where every method's verdict allows a comparison (an error ratio beyond {SEPARATES}x either way separates two methods), `{}`: {}. {sides} The second plot shows the contact quantities that differ most; the glossary at the end defines each quantity.",
+            self.label,
+            parts.join("; ")
+        ))
     }
 
     /// Write the report folder `dir`, all or nothing.
@@ -53,7 +177,7 @@ impl Graded {
     /// The key quantity's error against h per method, with each fitted slope.
     fn plot(&self, d: &Path) -> Result<()> {
         let mut series = Vec::new();
-        for (i, m) in self.methods().iter().enumerate() {
+        for m in &self.methods() {
             let rows: Vec<&ErrorRecord> = self
                 .errors
                 .iter()
@@ -63,6 +187,7 @@ impl Graded {
                 Some(r) if r.supported_fit().is_none() => format!(": {}", r.short_text()),
                 _ => String::new(),
             };
+            let i = Self::style_index(m);
             series.push(Series {
                 label: format!("{m}{verdict}"),
                 points: rows.iter().map(|r| (r.h, r.error)).collect(),
@@ -91,6 +216,58 @@ impl Graded {
             &format!("relative error ({})", self.key),
             &series,
             &[(0.5, "1/2"), (0.75, "3/4"), (1.0, "1")],
+        )?;
+        self.plot_differences(d)
+    }
+
+    /// The quantities where the graded code differs most from a cone (up to 4, ratio
+    /// furthest from 1 first), every method's errors against h: colour the quantity, marker
+    /// the method. Nothing where no quantity differs.
+    fn plot_differences(&self, d: &Path) -> Result<()> {
+        let Some((_, cones)) = self.differences() else {
+            return Ok(());
+        };
+        let mut shown: Vec<(Quantity, f64)> = cones.iter().flat_map(|c| c.beyond.clone()).collect();
+        shown.sort_by(|a, b| b.1.ln().abs().total_cmp(&a.1.ln().abs()));
+        let mut quantities: Vec<Quantity> = Vec::new();
+        // The contact quantities (where contact conditions differ), three at most so that
+        // the legend leaves the data visible.
+        for (q, _) in shown.into_iter().filter(|s| s.0.is_contact()) {
+            if !quantities.contains(&q) && quantities.len() < 3 {
+                quantities.push(q);
+            }
+        }
+        if quantities.is_empty() {
+            return Ok(());
+        }
+        let mut series = Vec::new();
+        for (c, &q) in quantities.iter().enumerate() {
+            for m in &self.methods() {
+                let points: Vec<(f64, f64)> = self
+                    .errors
+                    .iter()
+                    .filter(|r| &r.method == m && r.quantity == q && r.error > 0.0)
+                    .map(|r| (r.h, r.error))
+                    .collect();
+                let rate = self.rate(m, q).map_or("-".into(), RateRow::short_text);
+                series.push(Series {
+                    label: format!("{m} {q}: {rate}"),
+                    points,
+                    markers: true,
+                    line: true,
+                    color: c,
+                    thin: m.cone().is_some(),
+                    shape: Some(plot::Shape::of(Self::style_index(m))),
+                });
+            }
+        }
+        plot::loglog(
+            &d.join("contact_vs_h.png"),
+            &format!("where {} differs from the cones (colour: quantity)", self.label),
+            "h (max element diameter)",
+            "relative error",
+            &series,
+            &[(0.5, "1/2"), (1.0, "1"), (2.0, "2")],
         )
     }
 
@@ -102,6 +279,9 @@ impl Graded {
             None => format!("scene `{}`", self.scene),
         };
         doc.heading(1, format!("Grade of `{}` on {what}", self.label));
+        if let Some(summary) = self.summary() {
+            doc.paragraph(summary);
+        }
         doc.paragraph(self.lead());
         if !self.flagged.is_empty() {
             doc.paragraph(format!(
@@ -121,10 +301,17 @@ impl Graded {
                 self.unverified.join("; ")
             ));
         }
+        doc.image("error against h", "error_vs_h.png");
+        if self.differences().is_some_and(|(_, c)| c.iter().any(|c| !c.beyond.is_empty())) {
+            doc.image("where the errors differ", "contact_vs_h.png");
+        }
+        doc.heading(2, "Rates");
+        doc.paragraph("Each quantity judged as the studies judge it (docs/studies.md#rates): a rate only over a trailing window of levels whose successive rates agree; otherwise the verdict says why there is none (glossary below). The fitted levels and successive rates of every cell are in rates.csv.");
+        doc.table(&self.rate_table());
         if self.compared {
             if let Some(table) = self.contact_table() {
                 doc.paragraph(format!(
-                    "On Gamma_C, where mortar and nts differ, at the finest level ({}):",
+                    "On Gamma_C, where the cones differ, the errors at the finest level ({}):",
                     self.levels.last().map_or(0, |l| l.level)
                 ));
                 doc.table(&table);
@@ -136,17 +323,19 @@ impl Graded {
         }
         doc.list(&self.notes);
         doc.paragraph(format!("Graded with `{}`.", self.command));
-        doc.image("error against h", "error_vs_h.png");
         doc.heading(2, format!("{} per level", self.key));
         doc.table(&self.key_table());
-        doc.heading(2, "Rates");
-        doc.paragraph("Every quantity judged as the studies judge it (docs/studies.md): a rate only over a trailing window of levels whose successive rates agree; `falling` and `rising` (a rate in transition), `pre-asymptotic`, `too few levels` and `not converging` say why a rate is flagged or missing.");
-        doc.table(&self.rate_table());
         doc.heading(2, "The graded files");
         doc.table(&self.level_table());
         doc.heading(2, "Checks");
         doc.paragraph(CHECKS_TEXT);
         doc.table(&self.check_table());
+        doc.heading(2, "Glossary");
+        let named: Vec<Quantity> = Quantity::ALL
+            .into_iter()
+            .filter(|&q| self.errors.iter().any(|e| e.quantity == q))
+            .collect();
+        doc.line(crate::verify::quantity::glossary(&named));
         doc.finish()
     }
 
@@ -324,35 +513,31 @@ impl Graded {
         table
     }
 
+    /// One row per quantity, one column per method: the rate or what replaces it
+    /// ([`RateRow::short_text`]), with the threshold's outcome where one applies.
     fn rate_table(&self) -> Table {
-        let mut table = Table::new([
-            "method",
-            "quantity",
-            "rate in h",
-            "verdict",
-            "levels fitted",
-            "successive rates",
-            "threshold",
-        ]);
-        for r in &self.rates {
-            let a = &r.assessment;
-            table.row([
-                format!("{}", r.method),
-                format!("{}", r.quantity),
-                a.fit
-                    .map_or("-".into(), |f| format!("{:.3} ± {:.3}", f.rate, f.stderr)),
-                a.verdict.name().to_string(),
-                if a.used.is_empty() {
-                    "-".into()
-                } else {
-                    crate::verify::table::join(&a.used)
-                },
-                a.successive_text(),
-                match (r.threshold, r.outcome) {
-                    (Some(t), Some(o)) => format!(">= {}: {}", t.value(), o.shouted()),
-                    _ => "-".into(),
-                },
-            ]);
+        let methods = self.methods();
+        let mut header = vec!["quantity".to_string()];
+        header.extend(methods.iter().map(|m| m.to_string()));
+        let mut table = Table::new(header);
+        for q in Quantity::ALL {
+            if !self.rates.iter().any(|r| r.quantity == q) {
+                continue;
+            }
+            let mut row = vec![format!("`{q}`")];
+            for m in &methods {
+                row.push(self.rate(m, q).map_or("-".into(), |r| {
+                    let cell = match r.supported_fit() {
+                        Some(f) => format!("{:.3} ± {:.3}", f.rate, f.stderr),
+                        None => r.short_text(),
+                    };
+                    match (r.threshold, r.outcome) {
+                        (Some(t), Some(o)) => format!("{cell} (>= {}: {})", t.value(), o.shouted()),
+                        _ => cell,
+                    }
+                }));
+            }
+            table.row(row);
         }
         table
     }
@@ -441,8 +626,17 @@ impl Graded {
     /// The console summary.
     pub fn console(&self, dir: &Path) -> String {
         let mut out = String::new();
-        out.push_str(&self.lead());
-        out.push('\n');
+        // One line per method's verdict in the key quantity, the graded code first.
+        for m in self.methods() {
+            if let Some(r) = self.rate(&m, self.key) {
+                out.push_str(&r.verdict_line());
+                out.push('\n');
+            }
+        }
+        if let Some(summary) = self.summary() {
+            out.push_str(&summary.replace("**", ""));
+            out.push('\n');
+        }
         for f in &self.flagged {
             out.push_str(&format!("NOT CONVERGED: {f}\n"));
         }
@@ -454,4 +648,4 @@ impl Graded {
     }
 }
 
-const CHECKS_TEXT: &str = "Before a level gives a rate, grade checks that it is a converged solution of a P1 discretization of this problem. The equilibrium residual r of the P1 problem on the file's mesh (its stress, or C eps(u_h); the exported loads; the supports' and Gamma_C's dofs held), in energy, delta = sqrt(r^T K^-1 r) / ||u_h||_E, is the energy distance to the field in equilibrium with the exported loads (Gamma_C held), whose energy error it adds to in squares: the bound printed beside each error, with, where it exceeds 1/20 of the error, the key error of that field (measured in the key norm). A code that integrates the loads with its own rule leaves one, of the size lambda_q the common plain rules leave on the same mesh (centroid, 3 interior points, 3 x 3 Gauss, Dunavant 16, none split at the loads' kinks): a load that is t^k times a field of (x, y) makes a load rule's residual scale as t^k from step to step, an iteration's not, and the part that does not, delta_w, is measured. A level is refused as unconverged where delta exceeds 1/20 of its error and either delta_w exceeds 1/20 of its error or delta exceeds 3 lambda_q; and whatever the cause where delta exceeds 1/2 of its error. On Gamma_C, the two sides' normal forces equal, no tangential and no pulling force, each to 1e-3 of the resultant, or, where the residual is no iteration's, to 3 (delta / lambda_q) times what the common rules' load differences alone put into that check, where larger. The pressure's resultant at T is read against the exact one's: a negative ratio or a constant factor is refused (docs/verify-your-code.md).";
+const CHECKS_TEXT: &str = "Before a level gives a rate, grade checks that it is a converged P1 solution of this problem. Equilibrium: the residual of the P1 problem on the file's mesh with the exported loads, in energy, delta (at most how much it moves the error; printed beside each error), told apart from a load rule's residual (lambda_q, what the common plain rules leave on the same mesh) and from an unconverged solve (delta_w, its part that does not scale with the load): refused where delta exceeds 1/20 of the error and is an iteration's, and where it exceeds 1/2 of the error whatever the cause. Gamma_C: the two sides' normal forces equal, no tangential and no pulling force, to 1e-3 of the resultant (wider, in proportion, for a code's own load rule). The pressure's resultant against the exact one's: a negative ratio or a constant factor is refused. The rules and why: docs/verify-your-code.md, section 3.";

@@ -28,7 +28,7 @@ pub fn export_readme(
     );
     let _ = writeln!(
         out,
-        "{}\n\nSolve it with your own contact code on these meshes (or any P1 triangle meshes of the same bodies), write the solutions as below, and grade them:\n\n```sh\ncontact-rates grade {} {} --solutions SOLUTIONS --levels {first}-{last} --name mycode\n```\n\nThe report gives your code's errors against the exact solution, fitted rates and verdicts, beside this project's mortar (K_h^pi) and node-on-segment (K_h^I) on the same meshes.\n",
+        "{}\n\nSolve it with your own contact code on these meshes (or any P1 triangle meshes of the same bodies), write the solutions as below, and grade them:\n\n```sh\ncontact-rates grade {} {} --solutions SOLUTIONS --levels {first}-{last} --name mycode\n```\n\n(`contact-rates` is this project's binary: `cargo install --path .` in its checkout puts it on PATH; or write `cargo run --release --` in its place, from the checkout.)\n\nThe report gives your code's errors against the exact solution, fitted rates and verdicts, beside this project's mortar (K_h^pi) and node-on-segment (K_h^I) on the same meshes.\n",
         scene.description,
         family.option,
         family.study.as_deref().unwrap_or(&scene.name),

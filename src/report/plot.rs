@@ -1132,8 +1132,10 @@ where
         let shape = s.shape.unwrap_or(Shape::of(s.color));
         let covered = covered_by(i);
         // Half or more of its points under a later series' (drawn over it).
+        // (Not where the later one lies wholly on this one: its legend says so.)
         let partly_under = (i + 1..series.len()).find(|&k| {
-            series[k].markers == s.markers
+            covered_by(k) != Some(i)
+                && series[k].markers == s.markers
                 && series[k].line == s.line
                 && 2 * pixels[i]
                     .iter()
@@ -1178,8 +1180,8 @@ fn first_word(label: &str) -> &str {
 
 /// What a series that lies on `under` adds to its legend: " (= mortar to 1e-4)", the first
 /// word of `under`'s label and the largest relative difference of their values at the same
-/// abscissae, rounded up to a power of ten; " (under mortar)" where the abscissae differ.
-fn coincidence(s: &Series, under: &Series) -> String {
+/// abscissae, rounded up to one significant digit; " (under mortar)" where the abscissae differ.
+pub fn coincidence(s: &Series, under: &Series) -> String {
     let name = first_word(&under.label);
     let mut largest: Option<f64> = Some(0.0);
     for p in &s.points {
@@ -1193,7 +1195,12 @@ fn coincidence(s: &Series, under: &Series) -> String {
     }
     match largest {
         Some(d) if d == 0.0 => format!(" (= {name})"),
-        Some(d) => format!(" (= {name} to {:.0e})", 10f64.powf(d.log10().ceil())),
+        Some(d) => {
+            // Rounded up to one significant digit: "to 3e-5", never below the difference.
+            let e = d.log10().floor();
+            let m = (d / 10f64.powf(e)).ceil();
+            format!(" (= {name} to {:.0e})", m * 10f64.powf(e))
+        }
         None => format!(" (under {name})"),
     }
 }

@@ -38,6 +38,10 @@ impl Threshold {
     }
 }
 
+/// A ratio of two methods' errors at the finest level beyond this (either way) separates
+/// them: one rule for every study's lead and every grade report's.
+pub const SEPARATES: f64 = 1.5;
+
 /// The judge's level records of any table: (level, h, dofs, error) rows, coarsest first.
 /// The one place a table becomes what [`rates::assess`] reads.
 pub fn levels_of(rows: impl IntoIterator<Item = (usize, f64, f64, f64)>) -> Vec<LevelError> {

@@ -1127,15 +1127,8 @@ fn contact_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
     plot::loglog(
         &d.join("contact_vs_h.png"),
         &format!(
-            "{}: contact quantities against h (colour: quantity; {})",
-            res.name,
-            Method::ALL
-                .iter()
-                .enumerate()
-                .filter(|(_, m)| res.file.methods.contains(m))
-                .map(|(i, m)| format!("{m} {}", plot::Shape::of(i).name()))
-                .collect::<Vec<_>>()
-                .join(", ")
+            "{}: contact quantities against h (colour: quantity, marker: method)",
+            res.name
         ),
         "h (max element diameter)",
         "relative error",

@@ -70,8 +70,7 @@ pub const HEADLINE: [(&str, &str); 5] = [
 /// The cones, in the order the pages name them.
 pub(crate) const CONES: [Method; 3] = Method::ALL;
 
-/// A ratio of the cones' errors at the finest level beyond this (either way) separates them.
-pub(crate) const SEPARATES: f64 = 1.5;
+pub(crate) use crate::verify::judge::SEPARATES;
 
 /// An nts rate within this of 1/2 attains K_h^I's h^(1/2).
 pub(crate) const NEAR_HALF: f64 = 0.15;
