@@ -267,11 +267,26 @@ pub fn memory_refusal(
     if level == 0 {
         return Ok(None);
     }
+    // A refusal leaves the mesh cache as it found it: the coarsest mesh meshed here to
+    // count its nodes goes again.
+    let cached = |dir: &std::path::Path| -> std::collections::BTreeSet<std::path::PathBuf> {
+        std::fs::read_dir(dir)
+            .into_iter()
+            .flatten()
+            .flatten()
+            .map(|e| e.path())
+            .collect()
+    };
+    let cache = gmsh::cache_dir();
+    let before = cached(&cache);
     let (_, raw) = mesh_healed(scene, params, 0)?;
     let dofs = |l: usize| 2.0 * raw.nodes.len() as f64 * 4f64.powi(l as i32);
     let bytes = |l: usize| dofs(l) * BYTES_PER_DOF;
     if bytes(level) <= available {
         return Ok(None);
+    }
+    for new in cached(&cache).difference(&before) {
+        let _ = std::fs::remove_file(new);
     }
     let gib = |b: f64| b / (1024.0 * 1024.0 * 1024.0);
     let fits = (0..level)

@@ -549,6 +549,7 @@ fn a_bad_singular_part_names_its_field_and_fix() {
 fn export_of_levels_beyond_memory_is_refused_before_meshing() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("export");
+    let cache = dir.path().join("cache");
     let run = common::run(
         &[
             "export",
@@ -559,10 +560,15 @@ fn export_of_levels_beyond_memory_is_refused_before_meshing() {
             "--out",
             out.to_str().unwrap(),
         ],
-        &[],
+        &[("CONTACT_RATES_CACHE", cache.to_str().unwrap())],
     );
     fails_with(&run, &["--levels 0-14", "the largest level that fits is"]);
     assert!(!out.exists(), "nothing is written");
+    // The coarsest mesh, meshed to count its nodes, is not left behind either.
+    let left: Vec<_> = std::fs::read_dir(&cache)
+        .map(|d| d.flatten().map(|e| e.file_name()).collect())
+        .unwrap_or_default();
+    assert!(left.is_empty(), "the mesh cache as it was: {left:?}");
 }
 
 /// A study file beside a folder named like its scene (an export folder `contact-mms`) reads
