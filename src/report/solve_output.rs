@@ -330,25 +330,25 @@ pub fn console(run: &RunSummary, wall_s: f64, written: &Written, dir: &Path) -> 
     };
     let _ = writeln!(
         s,
-        "  mesh {:.3} s, model {:.3} s, solver set-up (pattern, symbolic) {:.3} s; time loop {:.3} s{floor}: {} factorizations {:.3} s, solves {:.3} s, assembly {:.3} s, constitutive {:.3} s, contact {:.3} s; {} active-set changes; peak RSS {}",
+        "  mesh {:.3} s, model {:.3} s, solver set-up (pattern, symbolic) {:.3} s; time loop {:.3} s{floor}: {} {:.3} s, solves {:.3} s, assembly {:.3} s, constitutive {:.3} s, contact {:.3} s; {}; peak RSS {}",
         run.mesh_s,
         run.model_s,
         t.setup_s,
         run.time_loop_s,
-        t.factorizations,
+        crate::io::count(t.factorizations, "factorization"),
         t.factor_s,
         t.solve_s,
         t.assembly_s,
         t.constitutive_s,
         t.contact_s,
-        run.active_set_changes,
+        crate::io::count(run.active_set_changes, "active-set change"),
         run.peak_rss_gib
             .map_or("not measured".into(), crate::io::memory_text)
     );
     let _ = writeln!(
         s,
-        "wrote {} step files ({:.1} MB, binary zlib VTU) in {:.3} s {}, {:.3} s of it waited for; {} and {}",
-        written.files,
+        "wrote {} ({:.1} MB, binary zlib VTU) in {:.3} s {}, {:.3} s of it waited for; {} and {}",
+        crate::io::count(written.files, "step file"),
         written.bytes as f64 / 1e6,
         written.seconds,
         if written.on_solve_thread {
