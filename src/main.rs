@@ -557,7 +557,7 @@ fn solve_one(req: &SolveRequest) -> anyhow::Result<()> {
         eprintln!("warning: {w}");
     }
     let mut series = report::solve_output::Series::new(staging.path(), &case.problem, req.every);
-    let progress = Progress::new(steps as u64, "solve");
+    let progress = Progress::new(steps as u64, "solve", "time step");
     let memory = PeakMemory::start();
     let solved = series.write_during(|on_step| {
         solve::solve_observed(
@@ -603,13 +603,23 @@ fn exit_cleanly_on_signals() -> std::io::Result<()> {
     std::thread::spawn(move || {
         if let Some(signo) = signals.forever().next() {
             let interrupted = report::remove_live();
-            contact_rates::interrupt::remove_temporary_files();
+            let meshes = contact_rates::interrupt::remove_temporary_files();
             let name = signal_name(signo).unwrap_or("a signal");
             contact_rates::progress::clear_line();
             let during = contact_rates::progress::current_phase()
                 .map_or(String::new(), |p| format!(" while {p}"));
+            let gmsh = match meshes {
+                0 => String::new(),
+                n => format!(
+                    "gmsh ended and {} removed from the mesh cache; ",
+                    match n {
+                        1 => "its unfinished mesh".to_string(),
+                        n => format!("{n} unfinished meshes"),
+                    }
+                ),
+            };
             let removed = match interrupted.removed.is_empty() {
-                true => "no output was written or changed".to_string(),
+                true => format!("{gmsh}no output was written or changed"),
                 false => {
                     let folders: Vec<String> = interrupted
                         .removed
@@ -617,7 +627,7 @@ fn exit_cleanly_on_signals() -> std::io::Result<()> {
                         .map(|f| f.display().to_string())
                         .collect();
                     format!(
-                        "removed its unfinished output {}; what was there before is unchanged",
+                        "{gmsh}removed its unfinished output {}; what was there before is unchanged",
                         folders.join(", ")
                     )
                 }

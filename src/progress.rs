@@ -37,8 +37,8 @@ pub fn clear_line() {
 pub struct Progress(indicatif::ProgressBar, bool);
 
 impl Progress {
-    /// A bar of `n` units named `name`.
-    pub fn new(n: u64, name: &str) -> Self {
+    /// A bar of `n` units (`unit`, singular: "job", "time step") named `name`.
+    pub fn new(n: u64, name: &str, unit: &str) -> Self {
         let pb = if std::io::stderr().is_terminal() {
             indicatif::ProgressBar::new(n)
         } else {
@@ -52,7 +52,7 @@ impl Progress {
             .progress_chars("=> "),
         );
         pb.set_prefix(name.to_string());
-        set_phase(&format!("{name}: solving {n} jobs"));
+        set_phase(&format!("{name}: solving {}", crate::io::count(n as usize, unit)));
         Progress(pb, true)
     }
 
@@ -69,8 +69,13 @@ impl Progress {
     }
 
     /// A spinner saying `message` (redrawn every 0.2 s) until finished.
+    /// Between phases (`solve` meshing before its bar), it is the phase until finished.
     pub fn spinner(message: &str) -> Self {
-        Progress(spinner_bar(message), false)
+        let owns = current_phase().is_none();
+        if owns {
+            set_phase(message);
+        }
+        Progress(spinner_bar(message), owns)
     }
 
     /// One unit done, labelled `label`.

@@ -65,9 +65,12 @@ impl Graded {
             .into_iter()
             .filter(|q| !q.is_distance() && !q.is_best_approximation())
             .filter(|&q| {
+                // Round-off errors are no discretization's: their ratios are noise.
                 methods.iter().all(|m| {
-                    self.rate(m, q)
-                        .is_some_and(|r| r.assessment.verdict.compares_cones())
+                    self.rate(m, q).is_some_and(|r| {
+                        r.assessment.verdict.compares_cones()
+                            && r.assessment.verdict != Verdict::RoundOff
+                    })
                 })
             })
             .collect()
@@ -92,12 +95,13 @@ impl Graded {
                 .collect();
             ratios.sort_by(|a, b| b.1.ln().abs().total_cmp(&a.1.ln().abs()));
             let furthest = ratios.first().map_or(1.0, |r| r.1);
+            let compared = ratios.len();
             ratios.retain(|r| !(1.0 / SEPARATES..=SEPARATES).contains(&r.1));
             out.push(ConeDifference {
                 cone,
                 beyond: ratios,
                 furthest,
-                compared: quantities.len(),
+                compared,
             });
         }
         Some((level, out))
@@ -107,7 +111,7 @@ impl Graded {
     /// finest level, and which cone it sides with.
     fn summary(&self) -> Option<String> {
         let (level, cones) = self.differences()?;
-        if cones.is_empty() {
+        if cones.is_empty() || cones.iter().any(|c| c.compared == 0) {
             return None;
         }
         // Three significant digits: 179x, 18.6x, 1.86x.
@@ -149,8 +153,12 @@ impl Graded {
             0 => "It sides with none of the cones.".to_string(),
             _ => format!("It sides with {}.", sides.join(" and ")),
         };
+        let plot = match self.plotted_quantities().is_empty() {
+            true => "",
+            false => " The second plot shows the contact quantities that differ most.",
+        };
         Some(format!(
-            "**What differs.** At the finest level ({level}), in the quantities where every method's verdict allows a comparison (an error ratio beyond {SEPARATES}x either way separates two methods), `{}`: {}. {sides} The second plot shows the contact quantities that differ most; the glossary at the end defines each quantity.",
+            "**What differs.** At the finest level ({level}), in the quantities where every method's verdict allows a comparison (an error ratio beyond {SEPARATES}x either way separates two methods), `{}`: {}. {sides}{plot} The glossary at the end defines each quantity.",
             self.label,
             parts.join("; ")
         ))
@@ -220,23 +228,28 @@ impl Graded {
         self.plot_differences(d)
     }
 
-    /// The quantities where the graded code differs most from a cone (up to 4, ratio
-    /// furthest from 1 first), every method's errors against h: colour the quantity, marker
-    /// the method. Nothing where no quantity differs.
-    fn plot_differences(&self, d: &Path) -> Result<()> {
+    /// The contact quantities (where contact conditions differ) beyond [`SEPARATES`] from
+    /// some cone, furthest from 1 first, three at most so that the legend leaves the data
+    /// visible: what contact_vs_h.png draws.
+    fn plotted_quantities(&self) -> Vec<Quantity> {
         let Some((_, cones)) = self.differences() else {
-            return Ok(());
+            return Vec::new();
         };
         let mut shown: Vec<(Quantity, f64)> = cones.iter().flat_map(|c| c.beyond.clone()).collect();
         shown.sort_by(|a, b| b.1.ln().abs().total_cmp(&a.1.ln().abs()));
         let mut quantities: Vec<Quantity> = Vec::new();
-        // The contact quantities (where contact conditions differ), three at most so that
-        // the legend leaves the data visible.
         for (q, _) in shown.into_iter().filter(|s| s.0.is_contact()) {
             if !quantities.contains(&q) && quantities.len() < 3 {
                 quantities.push(q);
             }
         }
+        quantities
+    }
+
+    /// The quantities of [`Graded::plotted_quantities`], every method's errors against h:
+    /// colour the quantity, marker the method. Nothing where no contact quantity differs.
+    fn plot_differences(&self, d: &Path) -> Result<()> {
+        let quantities = self.plotted_quantities();
         if quantities.is_empty() {
             return Ok(());
         }
@@ -302,7 +315,7 @@ impl Graded {
             ));
         }
         doc.image("error against h", "error_vs_h.png");
-        if self.differences().is_some_and(|(_, c)| c.iter().any(|c| !c.beyond.is_empty())) {
+        if !self.plotted_quantities().is_empty() {
             doc.image("where the errors differ", "contact_vs_h.png");
         }
         doc.heading(2, "Rates");

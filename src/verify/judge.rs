@@ -144,16 +144,19 @@ impl RateRow {
         rates::short_text(a.verdict, a.fit.map(|f| f.rate), a.last_rate())
     }
     /// "method quantity: " and the verdict as one plain line ([`Assessment::verdict_line`]),
-    /// with the threshold's outcome and why (an exactness bound: the largest error against
-    /// it).
+    /// with the threshold's outcome and why (an exactness bound: whether every level's error
+    /// is within it).
     pub fn verdict_line(&self) -> String {
         let a = &self.assessment;
         let line = match (self.threshold, self.outcome) {
             (Some(Threshold::Rate(t)), Some(o)) => a.verdict_line(Some((t, o))),
             (Some(Threshold::Exact(t)), Some(o)) => format!(
-                "{}; every error at most {t:.0e}: {}",
+                "{}; exactness bound {t:.0e}: {}",
                 a.verdict_line(None),
-                o.shouted()
+                match o {
+                    Outcome::Pass => "pass, every level's error is at most it",
+                    _ => "FAIL, a level's error is above it",
+                }
             ),
             _ => a.verdict_line(None),
         };

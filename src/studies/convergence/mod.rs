@@ -1158,7 +1158,7 @@ fn measuring(solutions: usize, truth: &Truth) -> String {
 /// Every job of the plan in `mode`: all of them, one shard's (records only: None), or the
 /// records of all shards.
 fn solve_all(study: &LoadedStudy, plan: &Plan, mode: Mode) -> Result<Option<Solved>> {
-    let progress = Progress::new(plan.jobs.len() as u64, &study.name);
+    let progress = Progress::new(plan.jobs.len() as u64, &study.name, "job");
     let scenes: Vec<&Scene> = std::iter::once(&study.scene)
         .chain(study.time_scene.as_ref())
         .collect();

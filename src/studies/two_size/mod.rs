@@ -420,7 +420,7 @@ fn slave_choices(study: &LoadedStudy, spec: &TwoSizeSpec) -> Vec<String> {
 
 /// Every planned solve, with progress on the console.
 fn solve_all(study: &LoadedStudy, plan: &Plan, scenes: &[Scene]) -> Result<jobs::Solved> {
-    let progress = Progress::new(plan.jobs.len() as u64, &study.name);
+    let progress = Progress::new(plan.jobs.len() as u64, &study.name, "job");
     let scene_refs: Vec<&Scene> = scenes.iter().collect();
     let outputs = jobs::execute(
         &plan.jobs,
