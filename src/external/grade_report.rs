@@ -11,7 +11,7 @@ use crate::report::plot::{self, Series};
 use crate::verify::judge::RateRow;
 use crate::verify::quantity::Quantity;
 use crate::verify::judge::SEPARATES;
-use crate::verify::rates::Verdict;
+use crate::verify::rates::{ROUNDOFF, Verdict};
 use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord, methods_in_order};
 use std::path::Path;
 
@@ -259,19 +259,17 @@ impl Graded {
                 let points: Vec<(f64, f64)> = self
                     .errors
                     .iter()
-                    .filter(|r| &r.method == m && r.quantity == q && r.error > 0.0)
+                    .filter(|r| &r.method == m && r.quantity == q && r.error > ROUNDOFF)
                     .map(|r| (r.h, r.error))
                     .collect();
                 let rate = self.rate(m, q).map_or("-".into(), RateRow::short_text);
-                series.push(Series {
-                    label: format!("{m} {q}: {rate}"),
+                series.push(Series::of_quantity(
+                    format!("{m} {q}: {rate}"),
                     points,
-                    markers: true,
-                    line: true,
-                    color: c,
-                    thin: m.cone().is_some(),
-                    shape: Some(plot::Shape::of(Self::style_index(m))),
-                });
+                    c,
+                    Self::style_index(m),
+                    m.cone().is_some(),
+                ));
             }
         }
         plot::loglog(

@@ -884,6 +884,29 @@ pub struct Series {
     pub shape: Option<Shape>,
 }
 
+impl Series {
+    /// One method's errors in one quantity on a plot of several quantities: colour the
+    /// quantity (colour index `quantity`), marker the method (`method`, the method's colour
+    /// index on the plots of one quantity), a line through the points, thin where `thin`.
+    pub fn of_quantity(
+        label: String,
+        points: Vec<(f64, f64)>,
+        quantity: usize,
+        method: usize,
+        thin: bool,
+    ) -> Series {
+        Series {
+            label,
+            points,
+            markers: true,
+            line: true,
+            color: quantity,
+            thin,
+            shape: Some(Shape::of(method)),
+        }
+    }
+}
+
 /// A marker's shape.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Shape {

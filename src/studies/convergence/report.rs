@@ -1108,16 +1108,13 @@ fn contact_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
                     .find(|r| r.method == m && r.quantity == q)
                     .map_or("n/a".into(), RateRow::short_text);
                 let method_index = Method::ALL.iter().position(|&x| x == m).unwrap_or(0);
-                series.push(Series {
-                    label: format!("{m} {q}: {rate}"),
+                series.push(Series::of_quantity(
+                    format!("{m} {q}: {rate}"),
                     points,
-                    // Colour: the quantity; marker: the method (nts's line thin).
-                    markers: true,
-                    line: true,
-                    color: c,
-                    thin: m == Method::Nts,
-                    shape: Some(plot::Shape::of(method_index)),
-                });
+                    c,
+                    method_index,
+                    m == Method::Nts,
+                ));
             }
         }
     }
