@@ -23,6 +23,22 @@ pub fn current_phase() -> Option<String> {
     (!p.is_empty()).then(|| p.clone())
 }
 
+/// The run's phase, set without drawing anything (the bars and spinners inside it draw),
+/// for as long as the value lives ([`during`]).
+pub struct During;
+
+/// Name the phase `what` ("rates: meshing and planning") until the value is dropped.
+pub fn during(what: &str) -> During {
+    set_phase(what);
+    During
+}
+
+impl Drop for During {
+    fn drop(&mut self) {
+        set_phase("");
+    }
+}
+
 /// Clear the line a bar or spinner is drawn on (a run about to exit in the middle of one
 /// leaves the prompt on a clean line); nothing when stderr is not a terminal.
 pub fn clear_line() {

@@ -1071,9 +1071,11 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
     let t0 = Instant::now();
     // 1. Plan the solves and run them (a shard stores its records and stops there).
     let study = LoadedStudy::load(name)?;
+    let planning = crate::progress::during(&format!("{}: meshing and planning", study.name));
     study.check_memory()?;
     let sf = &study.file;
     let plan = Plan::new(&study)?;
+    drop(planning);
     let Some(mut solved) = solve_all(&study, &plan, mode)? else {
         return Ok(None);
     };

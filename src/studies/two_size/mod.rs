@@ -339,6 +339,7 @@ struct PairRun {
 pub fn run(name: &str) -> Result<TwoSizeResult> {
     let t0 = Instant::now();
     let study = LoadedStudy::load(name)?;
+    let _planning = crate::progress::during(&format!("{}: meshing and planning", study.name));
     study.check_memory()?;
     let spec = study.file.two_size.as_ref().ok_or_else(|| {
         Error::input(
