@@ -48,10 +48,7 @@ impl Graded {
     /// (mortar, nts, lac), the graded code the next.
     fn style_index(method: &MethodLabel) -> usize {
         match method.cone() {
-            Some(m) => crate::contact::Method::ALL
-                .iter()
-                .position(|&x| x == m)
-                .unwrap_or(0),
+            Some(m) => plot::method_style(m),
             None => crate::contact::Method::ALL.len(),
         }
     }
@@ -153,7 +150,7 @@ impl Graded {
             0 => "It sides with none of the cones.".to_string(),
             _ => format!("It sides with {}.", sides.join(" and ")),
         };
-        let plot = match self.plotted_quantities().is_empty() {
+        let plot = match Self::plotted(&cones).is_empty() {
             true => "",
             false => " The second plot shows the contact quantities that differ most.",
         };
@@ -232,9 +229,12 @@ impl Graded {
     /// some cone, furthest from 1 first, three at most so that the legend leaves the data
     /// visible: what contact_vs_h.png draws.
     fn plotted_quantities(&self) -> Vec<Quantity> {
-        let Some((_, cones)) = self.differences() else {
-            return Vec::new();
-        };
+        self.differences()
+            .map_or(Vec::new(), |(_, cones)| Self::plotted(&cones))
+    }
+
+    /// [`Graded::plotted_quantities`] of the comparisons `cones`.
+    fn plotted(cones: &[ConeDifference]) -> Vec<Quantity> {
         let mut shown: Vec<(Quantity, f64)> = cones.iter().flat_map(|c| c.beyond.clone()).collect();
         shown.sort_by(|a, b| b.1.ln().abs().total_cmp(&a.1.ln().abs()));
         let mut quantities: Vec<Quantity> = Vec::new();

@@ -6,6 +6,7 @@
 //! out with) and keep only tick sets whose labels leave a gap between them along the axis's
 //! length in pixels. Legends and slope triangles go to the corner that hides the fewest data.
 
+use crate::contact::Method;
 use crate::error::{Error, Result};
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, ValueFormatter};
@@ -907,6 +908,13 @@ impl Series {
     }
 }
 
+/// A method's colour and marker index on every plot of one quantity: its place in
+/// [`Method::ALL`] (mortar, nts, lac), so a method looks the same in every report; a graded
+/// code takes the next index.
+pub fn method_style(method: Method) -> usize {
+    Method::ALL.iter().position(|&m| m == method).unwrap_or(0)
+}
+
 /// A marker's shape.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Shape {
@@ -934,18 +942,6 @@ impl Shape {
         Shape::InvertedTriangle,
         Shape::Cross,
     ];
-
-    /// Its name in a plot's title ("mortar: circle").
-    pub fn name(self) -> &'static str {
-        match self {
-            Shape::Circle => "circle",
-            Shape::Triangle => "triangle",
-            Shape::Square => "square",
-            Shape::Diamond => "diamond",
-            Shape::InvertedTriangle => "inverted triangle",
-            Shape::Cross => "cross",
-        }
-    }
 
     /// The shape of colour index `i` (mortar, nts, lac, then the codes in report order).
     pub fn of(i: usize) -> Shape {

@@ -235,6 +235,7 @@ fn error_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
             series.extend(plot::fit_line(format!("{m} {legend}"), rate, intercept, &hs, i));
         }
     }
+    let mut pressure_drawn = false;
     for (i, &m) in res.file.methods.iter().enumerate() {
         let pts: Vec<(f64, f64)> = res
             .errors
@@ -243,6 +244,7 @@ fn error_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
             .map(|r| (r.h, r.error))
             .collect();
         if !pts.is_empty() {
+            pressure_drawn = true;
             series.push(Series {
                 label: format!("{m} (contact pressure, L2(Gamma_C))"),
                 points: pts,
@@ -258,8 +260,8 @@ fn error_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
         &d.join("error_vs_h.png"),
         &format!("{}: error against h", res.name),
         "h (max element diameter)",
-        // The pressure's error is drawn too: the legend says which is which.
-        match series.iter().any(|s| s.thin) {
+        // With the pressure's error drawn too, the legend says which is which.
+        match pressure_drawn {
             true => "relative error (legend: which quantity)".to_string(),
             false => format!("relative error ({})", quantity_label(key)),
         }
@@ -1107,12 +1109,11 @@ fn contact_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
                     .iter()
                     .find(|r| r.method == m && r.quantity == q)
                     .map_or("n/a".into(), RateRow::short_text);
-                let method_index = Method::ALL.iter().position(|&x| x == m).unwrap_or(0);
                 series.push(Series::of_quantity(
                     format!("{m} {q}: {rate}"),
                     points,
                     c,
-                    method_index,
+                    plot::method_style(m),
                     m == Method::Nts,
                 ));
             }
