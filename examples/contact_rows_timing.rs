@@ -16,11 +16,16 @@ fn main() {
     let (first, last) = match args.get(1) {
         Some(r) => {
             let (a, b) = r.split_once('-').unwrap_or((r, r));
-            (a.parse().expect("LEVELS: 5-7"), b.parse().expect("LEVELS: 5-7"))
+            (
+                a.parse().expect("LEVELS: 5-7"),
+                b.parse().expect("LEVELS: 5-7"),
+            )
         }
         None => (5usize, 7usize),
     };
-    let repeats: usize = args.get(2).map_or(5, |r| r.parse().expect("REPEATS: a count"));
+    let repeats: usize = args
+        .get(2)
+        .map_or(5, |r| r.parse().expect("REPEATS: a count"));
     let scene = Scene::load("contact-mms").expect("the built-in scene");
     for level in first..=last {
         for method in Method::ALL {

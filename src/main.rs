@@ -367,7 +367,9 @@ fn study(
                 .map_or("-".to_string(), |t| format!("{:.0} s", t.1));
             println!("{n:width$} {time:>9}  {d}");
         }
-        println!("(run time: the committed report's, on 2 cores, after the build; - where its report records none)");
+        println!(
+            "(run time: the committed report's, on 2 cores, after the build; - where its report records none)"
+        );
         return Ok(());
     }
     let kind = Study::resolve(name)?;

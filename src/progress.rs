@@ -11,7 +11,9 @@ use std::time::Duration;
 static PHASE: Mutex<String> = Mutex::new(String::new());
 
 fn set_phase(what: &str) {
-    let mut p = PHASE.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let mut p = PHASE
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     p.clear();
     p.push_str(what);
 }
@@ -19,7 +21,9 @@ fn set_phase(what: &str) {
 /// What the run was doing when it was last told ([`Progress::phase`], [`Progress::new`]);
 /// None between phases.
 pub fn current_phase() -> Option<String> {
-    let p = PHASE.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let p = PHASE
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     (!p.is_empty()).then(|| p.clone())
 }
 
@@ -68,7 +72,10 @@ impl Progress {
             .progress_chars("=> "),
         );
         pb.set_prefix(name.to_string());
-        set_phase(&format!("{name}: solving {}", crate::io::count(n as usize, unit)));
+        set_phase(&format!(
+            "{name}: solving {}",
+            crate::io::count(n as usize, unit)
+        ));
         Progress(pb, true)
     }
 

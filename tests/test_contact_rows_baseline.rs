@@ -27,13 +27,14 @@ fn baseline_path() -> PathBuf {
 
 /// Every committed scene's name, sorted.
 fn scenes() -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes"))
-        .unwrap()
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .map(|p| p.file_stem().unwrap().to_string_lossy().to_string())
-        .collect();
+    let mut names: Vec<String> =
+        std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes"))
+            .unwrap()
+            .flatten()
+            .map(|e| e.path())
+            .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+            .map(|p| p.file_stem().unwrap().to_string_lossy().to_string())
+            .collect();
     names.sort();
     names
 }
@@ -44,7 +45,11 @@ fn lines_of(scene: &str, level: usize, method: Method, rows: &[Row]) -> Vec<Stri
     rows.iter()
         .enumerate()
         .map(|(k, r)| {
-            let entries: Vec<String> = r.entries.iter().map(|(d, c)| format!("{d}:{c:e}")).collect();
+            let entries: Vec<String> = r
+                .entries
+                .iter()
+                .map(|(d, c)| format!("{d}:{c:e}"))
+                .collect();
             format!(
                 "{scene},{level},{method},{k},{},{},{},{},{:e},{}",
                 r.piece,
@@ -107,7 +112,10 @@ fn difference(a: &str, b: &str) -> Option<f64> {
     if ea.len() != eb.len() || ea.iter().zip(&eb).any(|(x, y)| x.0 != y.0) {
         return None;
     }
-    let scale = ea.iter().fold(0.0f64, |m, e| m.max(e.1.abs())).max(f64::MIN_POSITIVE);
+    let scale = ea
+        .iter()
+        .fold(0.0f64, |m, e| m.max(e.1.abs()))
+        .max(f64::MIN_POSITIVE);
     let coefficients = ea
         .iter()
         .zip(&eb)
@@ -136,7 +144,8 @@ fn every_scenes_rows_equal_the_baseline() {
     );
     let mut worst = 0.0f64;
     for (a, b) in baseline.iter().zip(&now) {
-        let d = difference(a, b).unwrap_or_else(|| panic!("a row changed:\nbaseline {a}\nnow      {b}"));
+        let d = difference(a, b)
+            .unwrap_or_else(|| panic!("a row changed:\nbaseline {a}\nnow      {b}"));
         assert!(d <= TOLERANCE, "{d:e}:\nbaseline {a}\nnow      {b}");
         worst = worst.max(d);
     }

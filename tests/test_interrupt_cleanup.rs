@@ -276,11 +276,13 @@ fn an_interrupted_refinement_leaves_no_temporary_mesh() {
     let dir = tempfile::tempdir().unwrap();
     let cache = dir.path().join("cache");
     let mut c = Command::new(BIN);
-    c.args(["solve", "--scene", "rates", "--level", "6", "--steps", "1", "--out", "o"])
-        .current_dir(dir.path())
-        .env("CONTACT_RATES_CACHE", &cache)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped());
+    c.args([
+        "solve", "--scene", "rates", "--level", "6", "--steps", "1", "--out", "o",
+    ])
+    .current_dir(dir.path())
+    .env("CONTACT_RATES_CACHE", &cache)
+    .stdout(Stdio::null())
+    .stderr(Stdio::piped());
     // SAFETY: signal() is async-signal-safe, as a pre_exec hook must be.
     unsafe {
         c.pre_exec(|| {
@@ -290,11 +292,15 @@ fn an_interrupted_refinement_leaves_no_temporary_mesh() {
     }
     let mut child = c.spawn().unwrap();
     let cached = |level: usize| {
-        std::fs::read_dir(&cache).into_iter().flatten().flatten().any(|e| {
-            e.file_name()
-                .to_string_lossy()
-                .ends_with(&format!("-L{level}.msh"))
-        })
+        std::fs::read_dir(&cache)
+            .into_iter()
+            .flatten()
+            .flatten()
+            .any(|e| {
+                e.file_name()
+                    .to_string_lossy()
+                    .ends_with(&format!("-L{level}.msh"))
+            })
     };
     // Level 4 cached: gmsh is refining level 5 (a few seconds on 2 cores).
     wait_until(&mut child, "level 4 in the mesh cache", || cached(4));
@@ -312,6 +318,10 @@ fn an_interrupted_refinement_leaves_no_temporary_mesh() {
     assert_eq!(temporary(), Vec::<String>::new(), "{err}");
     // gmsh was ended, not orphaned: nothing appears later either.
     std::thread::sleep(Duration::from_millis(1500));
-    assert_eq!(temporary(), Vec::<String>::new(), "a temporary mesh written after the exit");
+    assert_eq!(
+        temporary(),
+        Vec::<String>::new(),
+        "a temporary mesh written after the exit"
+    );
     assert!(cached(4), "the completed levels stay cached");
 }

@@ -302,7 +302,10 @@ fn a_hidden_series_says_what_it_lies_on() {
         shape: None,
     };
     let hs = [0.1, 0.05, 0.025];
-    let mortar = at(hs.iter().map(|&h| (h, h)).collect(), "mortar (theorem norm)");
+    let mortar = at(
+        hs.iter().map(|&h| (h, h)).collect(),
+        "mortar (theorem norm)",
+    );
     let close = at(hs.iter().map(|&h| (h, h * (1.0 + 3e-5))).collect(), "nts");
     let same = at(hs.iter().map(|&h| (h, h)).collect(), "lac");
     let shifted = at(hs.iter().map(|&h| (1.01 * h, h)).collect(), "code");

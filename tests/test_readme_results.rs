@@ -393,7 +393,10 @@ fn docs_studies_glossary_is_the_one_the_reports_print() {
     use contact_rates::verify::quantity::{Quantity, glossary};
     let studies = std::fs::read_to_string(root().join("docs/studies.md")).unwrap();
     let (start, end) = ("<!-- glossary:start -->\n", "<!-- glossary:end -->");
-    let from = studies.find(start).expect("docs/studies.md has glossary markers") + start.len();
+    let from = studies
+        .find(start)
+        .expect("docs/studies.md has glossary markers")
+        + start.len();
     let to = from + studies[from..].find(end).expect("a glossary end marker");
     let expected = glossary(&Quantity::ALL);
     assert!(
@@ -401,6 +404,9 @@ fn docs_studies_glossary_is_the_one_the_reports_print() {
         "docs/studies.md's glossary differs; replace the text between its glossary markers with the output of `cargo run --release -- results --glossary`:\n{expected}"
     );
     for q in Quantity::ALL {
-        assert!(expected.contains(&format!("`{}`", q.name())), "{q} has no entry");
+        assert!(
+            expected.contains(&format!("`{}`", q.name())),
+            "{q} has no entry"
+        );
     }
 }

@@ -111,13 +111,19 @@ fn solve_writes_contact_csv_and_a_paraview_time_series() {
             assert_eq!(f(at[0], 2), 0.0, "{method} piece {piece} starts at 0");
             for w in at.windows(2) {
                 let (a, b) = (w[0], w[1]);
-                assert!(f(b, 2) > f(a, 2), "{method} piece {piece}: arc length increases");
+                assert!(
+                    f(b, 2) > f(a, 2),
+                    "{method} piece {piece}: arc length increases"
+                );
                 assert!(
                     (f(b, 3), f(b, 4)) > (f(a, 3), f(a, 4)),
                     "{method} piece {piece}: reading order"
                 );
                 let d = (f(b, 3) - f(at[0], 3)).hypot(f(b, 4) - f(at[0], 4));
-                assert!((d - f(b, 2)).abs() <= 1e-12, "{method} piece {piece}: arc length");
+                assert!(
+                    (d - f(b, 2)).abs() <= 1e-12,
+                    "{method} piece {piece}: arc length"
+                );
             }
         }
         // The .pvd and its VTU files.

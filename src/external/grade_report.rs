@@ -9,8 +9,8 @@ use crate::report::folder::{write, write_folder};
 use crate::report::markdown::{Doc, Table};
 use crate::report::plot::{self, Series};
 use crate::verify::judge::RateRow;
-use crate::verify::quantity::Quantity;
 use crate::verify::judge::SEPARATES;
+use crate::verify::quantity::Quantity;
 use crate::verify::rates::{ROUNDOFF, Verdict};
 use crate::verify::table::{ErrorRecord, MethodLabel, RateRecord, methods_in_order};
 use std::path::Path;
@@ -274,7 +274,10 @@ impl Graded {
         }
         plot::loglog(
             &d.join("contact_vs_h.png"),
-            &format!("where {} differs from the cones (colour: quantity)", self.label),
+            &format!(
+                "where {} differs from the cones (colour: quantity)",
+                self.label
+            ),
             "h (max element diameter)",
             "relative error",
             &series,

@@ -361,9 +361,7 @@ pub fn group_name(g: &JudgedGroup) -> String {
 /// and the threshold's outcome with the numbers that decided it. The group's name leads
 /// where the table names methods or quantities.
 pub fn verdict_line(g: &JudgedGroup) -> String {
-    let line = g
-        .assessment
-        .verdict_line(g.threshold.zip(g.outcome));
+    let line = g.assessment.verdict_line(g.threshold.zip(g.outcome));
     match g.method.is_empty() && g.quantity.is_empty() {
         true => line,
         false => format!("{}: {line}", group_name(g)),

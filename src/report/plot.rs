@@ -11,9 +11,9 @@ use crate::error::{Error, Result};
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, ValueFormatter};
 use plotters::coord::types::RangedCoordf64;
+use plotters::element::{Drawable, PointCollection};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
-use plotters::element::{Drawable, PointCollection};
 use plotters_backend::{BackendCoord, DrawingErrorKind};
 use std::path::Path;
 use std::sync::Once;
@@ -958,7 +958,10 @@ impl Shape {
             Shape::Circle => (0..20)
                 .map(|k| {
                     let a = std::f64::consts::TAU * k as f64 / 20.0;
-                    ((r as f64 * a.cos()).round() as i32, (r as f64 * a.sin()).round() as i32)
+                    (
+                        (r as f64 * a.cos()).round() as i32,
+                        (r as f64 * a.sin()).round() as i32,
+                    )
                 })
                 .collect(),
             Shape::Square => vec![(-q, -q), (q, -q), (q, q), (-q, q)],
@@ -970,7 +973,14 @@ impl Shape {
     }
 
     /// The marker at `at` ([`Mark`]).
-    fn at<C>(self, at: C, r: i32, color: RGBColor, ring: Option<u32>, line: Option<ShapeStyle>) -> Mark<C> {
+    fn at<C>(
+        self,
+        at: C,
+        r: i32,
+        color: RGBColor,
+        ring: Option<u32>,
+        line: Option<ShapeStyle>,
+    ) -> Mark<C> {
         Mark {
             at,
             shape: self,
@@ -1164,7 +1174,11 @@ where
         });
         let label = match (covered, partly_under) {
             (Some(j), _) => format!("{}{}", s.label, coincidence(s, &series[j])),
-            (None, Some(k)) => format!("{} (partly under {})", s.label, first_word(&series[k].label)),
+            (None, Some(k)) => format!(
+                "{} (partly under {})",
+                s.label,
+                first_word(&series[k].label)
+            ),
             (None, None) => s.label.clone(),
         };
         let (r, ring) = match covered {
@@ -1204,7 +1218,11 @@ pub fn coincidence(s: &Series, under: &Series) -> String {
     let name = first_word(&under.label);
     let mut largest: Option<f64> = Some(0.0);
     for p in &s.points {
-        match under.points.iter().find(|q| (q.0 - p.0).abs() <= 1e-12 * p.0.abs().max(1.0)) {
+        match under
+            .points
+            .iter()
+            .find(|q| (q.0 - p.0).abs() <= 1e-12 * p.0.abs().max(1.0))
+        {
             Some(q) => {
                 let d = (p.1 - q.1).abs() / p.1.abs().max(q.1.abs()).max(f64::MIN_POSITIVE);
                 largest = largest.map(|l| l.max(d));

@@ -79,7 +79,10 @@ struct ContactCsv {
 /// arc length).
 fn reading_order(piece: &[ContactNode]) -> Vec<(f64, &ContactNode)> {
     let key = |c: &ContactNode| (c.position[0], c.position[1]);
-    let Some(start) = piece.iter().min_by(|a, b| key(a).partial_cmp(&key(b)).unwrap()) else {
+    let Some(start) = piece
+        .iter()
+        .min_by(|a, b| key(a).partial_cmp(&key(b)).unwrap())
+    else {
         return Vec::new();
     };
     let distance = |c: &ContactNode| {
@@ -243,16 +246,20 @@ impl<'a> Series<'a> {
         self.written.push((time, file));
         for piece in nodes.chunk_by(|a, b| a.piece == b.piece) {
             self.contact
-                .extend(reading_order(piece).into_iter().map(|(arc_length, c)| ContactCsv {
-                    time,
-                    piece: c.piece,
-                    arc_length,
-                    x: c.position[0],
-                    y: c.position[1],
-                    pressure: c.pressure,
-                    normal_jump: c.normal_jump,
-                    active: c.active,
-                }));
+                .extend(
+                    reading_order(piece)
+                        .into_iter()
+                        .map(|(arc_length, c)| ContactCsv {
+                            time,
+                            piece: c.piece,
+                            arc_length,
+                            x: c.position[0],
+                            y: c.position[1],
+                            pressure: c.pressure,
+                            normal_jump: c.normal_jump,
+                            active: c.active,
+                        }),
+                );
         }
     }
 

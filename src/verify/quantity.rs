@@ -172,26 +172,62 @@ impl Quantity {
     /// is a relative error, the max over the time steps.
     pub fn meaning(self) -> &'static str {
         match self {
-            Quantity::Theorem => "Theorem 3.1's norm: ||u - u_ref||_H1 + ||sigma - sigma_ref||_L2 over both bodies, relative to the truth's.",
-            Quantity::H1U => "the displacement's error in the H1 norm over both bodies, relative to the truth's H1 norm.",
-            Quantity::L2U => "the displacement's error in the L2 norm over both bodies, relative to the truth's L2 norm.",
-            Quantity::L2Stress => "the stress's error in the L2 norm over both bodies, relative to the truth's.",
-            Quantity::L2Pressure => "the contact pressure's error in L2(Gamma_C), relative to the truth's pressure norm.",
-            Quantity::BestL2Pressure => "the error of the best approximation of the exact pressure in the method's own pressure space (piecewise linear on the body-1 trace for mortar and nts, constant per macro-element for lac): what no solution in that space can beat (exact studies only).",
-            Quantity::MaxPenetration => "the largest interpenetration [u.nu]^+ on Gamma_C, relative to max |u_ref|.",
-            Quantity::BandStress => "the stress's error on the one layer of triangles that touch Gamma_C, relative to the stress norm over both bodies: where a contact condition's consistency error sits (a fixed error in that layer shows as h^(1/2)).",
-            Quantity::ContactEdge => "the largest distance from an edge of the truth's contact zone to the nearest discrete one, relative to |Gamma_C| (1 where the discrete solution has no edge and the truth has one).",
-            Quantity::PressureResultant => "the error of the resultant contact force (int p over Gamma_C), relative to the truth's.",
-            Quantity::PressureWeighted => "||h^(1/2) (p - p_ref)||_L2(Gamma_C) relative to |Gamma_C|^(1/2) ||p_ref||: a discrete stand-in for the pressure's H^(-1/2) error, the norm the theory bounds.",
-            Quantity::PressureOscillation => "|TV(p) - TV(p_ref)|, the error of the pressure's total variation along Gamma_C, relative to max(TV(p_ref), max |p_ref|) (the second keeps it defined for a constant truth): oscillations an L2 error may hide.",
-            Quantity::L2Penetration => "the L2(Gamma_C) norm of the interpenetration [u.nu]^+, relative to |Gamma_C|^(1/2) max |u_ref|.",
-            Quantity::Consistency => "Proposition 3.1's consistency term |int_Gamma_C sigma_nu [u_h.nu]|^(1/2) with the exact sigma_nu, relative to the exact energy norm: the part of the error a discrete contact condition adds (0 for a cone inside the continuous one).",
-            Quantity::ConeDistance => "D, the distance between a method's solution and mortar's on the same meshes, in the theorem norm, relative to the truth's: D - e_mortar <= e <= D + e_mortar.",
+            Quantity::Theorem => {
+                "Theorem 3.1's norm: ||u - u_ref||_H1 + ||sigma - sigma_ref||_L2 over both bodies, relative to the truth's."
+            }
+            Quantity::H1U => {
+                "the displacement's error in the H1 norm over both bodies, relative to the truth's H1 norm."
+            }
+            Quantity::L2U => {
+                "the displacement's error in the L2 norm over both bodies, relative to the truth's L2 norm."
+            }
+            Quantity::L2Stress => {
+                "the stress's error in the L2 norm over both bodies, relative to the truth's."
+            }
+            Quantity::L2Pressure => {
+                "the contact pressure's error in L2(Gamma_C), relative to the truth's pressure norm."
+            }
+            Quantity::BestL2Pressure => {
+                "the error of the best approximation of the exact pressure in the method's own pressure space (piecewise linear on the body-1 trace for mortar and nts, constant per macro-element for lac): what no solution in that space can beat (exact studies only)."
+            }
+            Quantity::MaxPenetration => {
+                "the largest interpenetration [u.nu]^+ on Gamma_C, relative to max |u_ref|."
+            }
+            Quantity::BandStress => {
+                "the stress's error on the one layer of triangles that touch Gamma_C, relative to the stress norm over both bodies: where a contact condition's consistency error sits (a fixed error in that layer shows as h^(1/2))."
+            }
+            Quantity::ContactEdge => {
+                "the largest distance from an edge of the truth's contact zone to the nearest discrete one, relative to |Gamma_C| (1 where the discrete solution has no edge and the truth has one)."
+            }
+            Quantity::PressureResultant => {
+                "the error of the resultant contact force (int p over Gamma_C), relative to the truth's."
+            }
+            Quantity::PressureWeighted => {
+                "||h^(1/2) (p - p_ref)||_L2(Gamma_C) relative to |Gamma_C|^(1/2) ||p_ref||: a discrete stand-in for the pressure's H^(-1/2) error, the norm the theory bounds."
+            }
+            Quantity::PressureOscillation => {
+                "|TV(p) - TV(p_ref)|, the error of the pressure's total variation along Gamma_C, relative to max(TV(p_ref), max |p_ref|) (the second keeps it defined for a constant truth): oscillations an L2 error may hide."
+            }
+            Quantity::L2Penetration => {
+                "the L2(Gamma_C) norm of the interpenetration [u.nu]^+, relative to |Gamma_C|^(1/2) max |u_ref|."
+            }
+            Quantity::Consistency => {
+                "Proposition 3.1's consistency term |int_Gamma_C sigma_nu [u_h.nu]|^(1/2) with the exact sigma_nu, relative to the exact energy norm: the part of the error a discrete contact condition adds (0 for a cone inside the continuous one)."
+            }
+            Quantity::ConeDistance => {
+                "D, the distance between a method's solution and mortar's on the same meshes, in the theorem norm, relative to the truth's: D - e_mortar <= e <= D + e_mortar."
+            }
             Quantity::ConeDistanceH1U => "D in the displacement's H1 norm, relative as h1_u.",
             Quantity::ConeDistanceL2Stress => "D in the stress's L2 norm, relative as l2_stress.",
-            Quantity::ConeDistanceBandStress => "D in the stress on the triangles touching Gamma_C, relative as band_stress.",
-            Quantity::ConeDistanceL2Pressure => "D in the pressure on Gamma_C, relative as l2_pressure.",
-            Quantity::ConeDistanceNormalJump => "D in the normal jump [u.nu] on Gamma_C, relative as l2_penetration.",
+            Quantity::ConeDistanceBandStress => {
+                "D in the stress on the triangles touching Gamma_C, relative as band_stress."
+            }
+            Quantity::ConeDistanceL2Pressure => {
+                "D in the pressure on Gamma_C, relative as l2_pressure."
+            }
+            Quantity::ConeDistanceNormalJump => {
+                "D in the normal jump [u.nu] on Gamma_C, relative as l2_penetration."
+            }
         }
     }
 

@@ -902,7 +902,10 @@ impl Assessment {
     /// and its outcome, the outcome with the numbers that decided it ([`outcome_reason`]).
     pub fn verdict_line(&self, threshold: Option<(f64, Outcome)>) -> String {
         let successive = match self.successive.iter().any(Option::is_some) {
-            true => format!(" (successive rates {})", self.successive_text().replace(' ', ", ")),
+            true => format!(
+                " (successive rates {})",
+                self.successive_text().replace(' ', ", ")
+            ),
             false => String::new(),
         };
         let mut line = match (self.verdict, self.fit) {
