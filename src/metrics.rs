@@ -92,7 +92,7 @@ pub fn contact_nodes(p: &Problem, s: &State) -> Vec<ContactNode> {
         first_of_piece.push(k);
         k += piece.slave_nodes.len() + piece.master_nodes.len();
     }
-    let rows_u = contact::apply_rows(&p.rows, &s.u);
+    let rows_u = contact::constraint_values(&p.rows, &s.u);
     let u_max = crate::solve::inf_norm(&s.u).max(f64::MIN_POSITIVE);
     let mut out: Vec<ContactNode> = Vec::new();
     for ((row, &lambda), &cu) in p.rows.iter().zip(&s.lambda).zip(&rows_u) {

@@ -5,7 +5,7 @@
 //! patch .geo meshed with matching contact lines (equal sizes, no grading).
 
 mod common;
-use contact_rates::contact::{Method, Piece, constraint_rows};
+use contact_rates::contact::{self, Method, Piece, constraint_rows};
 
 /// A deterministic pseudo-random sequence (xorshift) so the test is reproducible.
 fn rng(seed: &mut u64) -> f64 {
@@ -39,6 +39,7 @@ fn piece(slave_s: Vec<f64>, master_s: Vec<f64>, len: f64) -> Piece {
         master_nodes: (0..master_s.len()).collect(),
         master_s,
         breaks: Vec::new(),
+        ..Default::default()
     }
 }
 
@@ -52,7 +53,7 @@ fn mortar_projection_reproduces_linear_functions_and_keeps_end_values() {
             random_trace(nm, len, &mut seed),
             len,
         );
-        let tr = p.transfer(Method::Mortar);
+        let tr = contact::mortar::transfer(&p);
         for (a, b) in [(1.0, 0.0), (0.0, 1.0), (-2.5, 0.75)] {
             let phi: Vec<f64> = p.master_s.iter().map(|s| a + b * s).collect();
             for (i, s) in p.slave_s.iter().enumerate() {
@@ -98,7 +99,7 @@ fn interpolation_reproduces_linear_functions() {
         random_trace(6, 1.0, &mut seed),
         1.0,
     );
-    let tr = p.transfer(Method::Nts);
+    let tr = contact::nts::transfer(&p);
     for (i, s) in p.slave_s.iter().enumerate() {
         let v: f64 = tr[i]
             .iter()

@@ -53,7 +53,9 @@ fn lines_of(scene: &str, level: usize, method: Method, rows: &[Row]) -> Vec<Stri
             format!(
                 "{scene},{level},{method},{k},{},{},{},{},{:e},{}",
                 r.piece,
-                r.i,
+                // The baseline's row index i: the row's node, or the first body-1 node
+                // inside a macro-element.
+                r.node().unwrap_or(r.span[0] + 1),
                 r.span[0],
                 r.span[1],
                 r.weight,
@@ -73,7 +75,15 @@ fn current() -> Vec<String> {
         for level in LEVELS {
             for method in Method::ALL {
                 match Case::build(&scene, level, method, &[]) {
-                    Ok(case) => out.extend(lines_of(&name, level, method, &case.problem.rows)),
+                    Ok(case) => {
+                        // The traces of every committed scene touch: no row has a gap.
+                        let rows = &case.problem.rows;
+                        assert!(
+                            rows.iter().all(|r| r.gap == 0.0),
+                            "{name} level {level} {method}: a row has a gap"
+                        );
+                        out.extend(lines_of(&name, level, method, rows))
+                    }
                     Err(e) => out.push(format!("{name},{level},{method},error,{e}")),
                 }
             }

@@ -95,7 +95,7 @@ fn on_nested_traces_the_cones_coincide() {
             .fold(0.0f64, f64::max);
         let mut worst = 0.0f64;
         for (a, b) in rm.iter().zip(rn) {
-            assert_eq!((a.piece, a.i), (b.piece, b.i));
+            assert_eq!((a.piece, a.span), (b.piece, b.span));
             let dense = |r: &contact_rates::contact::Row| {
                 let mut v: Vec<(usize, f64)> = r.entries.clone();
                 v.sort_by_key(|e| e.0);
@@ -115,7 +115,7 @@ fn on_nested_traces_the_cones_coincide() {
                 da.iter().map(|e| e.0).collect::<Vec<_>>(),
                 db.iter().map(|e| e.0).collect::<Vec<_>>(),
                 "row {} of piece {}",
-                a.i,
+                a.span[0],
                 a.piece
             );
             for (x, y) in da.iter().zip(&db) {

@@ -24,7 +24,8 @@ use contact_rates::verify::truth::Truth;
 fn nodal_pressure(p: &contact_rates::solve::Problem, lambda: &[f64]) -> Vec<f64> {
     let mut out = vec![0.0; p.model.n_nodes];
     for (row, l) in p.rows.iter().zip(lambda) {
-        out[p.interface.pieces[row.piece].slave_nodes[row.i]] = row.pressure(*l);
+        out[p.interface.pieces[row.piece].slave_nodes[row.node().expect("a nodal row")]] =
+            row.pressure(*l);
     }
     out
 }

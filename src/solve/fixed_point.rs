@@ -120,7 +120,7 @@ impl<'a> FixedPoint<'a> {
         })
     }
 
-    /// Solve the contact subproblem `A u = b - C^T lambda`, `C u <= 0`, complementarity.
+    /// Solve the contact subproblem `A u = b - C^T lambda`, `C u <= g`, complementarity.
     /// Returns (u over global dofs, lambda, inner iterations).
     fn contact_subproblem(&mut self, b: &[f64], u0: &[f64]) -> Result<(Vec<f64>, Vec<f64>, usize)> {
         match self.inner {
@@ -137,8 +137,11 @@ impl<'a> FixedPoint<'a> {
         let mut u_old = u0.to_vec();
         let tol = self.inner_tol;
         for it in 1..=100_000 {
-            // (4.4): (A + omega C^T W C) u = b - C^T W q.
-            let wq: Vec<f64> = self.q.iter().zip(&w).map(|(q, w)| q * w).collect();
+            // (4.4): (A + omega C^T W C) u = b - C^T W (q - omega g), the constraint
+            // C u <= g (g: the rows' gaps) shifted to C u - g <= 0.
+            let wq: Vec<f64> = (self.q.iter().zip(&w).zip(&p.rows))
+                .map(|((q, w), r)| (q - omega * r.gap) * w)
+                .collect();
             let mut rhs_g = vec![0.0; 2 * model.n_nodes];
             contact::add_transpose(&p.rows, &wq, &mut rhs_g);
             let mut rhs = model.restrict(&rhs_g);
@@ -147,7 +150,7 @@ impl<'a> FixedPoint<'a> {
             }
             self.system.solve(&mut rhs);
             let u = model.expand(&rhs);
-            let g = contact::apply_rows(&p.rows, &u);
+            let g = contact::constraint_values(&p.rows, &u);
             // (4.5): q~ = 2 g + q/omega; q_half = omega (q~ - 2 P_U q~); relaxation rho.
             let mut dq = 0.0f64;
             for i in 0..self.q.len() {
@@ -171,7 +174,7 @@ impl<'a> FixedPoint<'a> {
             }
             if du <= tol * un && dq <= tol * qn {
                 // Physical multiplier p = q + omega g, nodal force lambda = W p.
-                let g = contact::apply_rows(&p.rows, &u_old);
+                let g = contact::constraint_values(&p.rows, &u_old);
                 let lambda = (0..g.len())
                     .map(|i| w[i] * (self.q[i] + omega * g[i]).max(0.0))
                     .collect();
@@ -241,8 +244,9 @@ impl<'a> FixedPoint<'a> {
             .max_iter(200)
             .build()
             .expect("valid Clarabel settings");
-        let zeros = vec![0.0; m];
-        let mut solver = DefaultSolver::new(&pm, &q, &am, &zeros, &cones, settings)
+        // C u <= g with u = alpha x: C x + s = g / alpha, s >= 0.
+        let gaps: Vec<f64> = p.rows.iter().map(|r| r.gap / alpha).collect();
+        let mut solver = DefaultSolver::new(&pm, &q, &am, &gaps, &cones, settings)
             .map_err(|e| Error::NotConverged(format!("Clarabel setup failed: {e}")))?;
         solver.solve();
         self.clarabel_s += t0.elapsed().as_secs_f64();

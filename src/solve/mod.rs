@@ -253,7 +253,7 @@ pub trait StepSolver {
 
 /// How far `state` is from solving (2.1) at the load `f_ext`, relative to the force scale
 /// max(|F|, |f_int|) over the free dofs: the equilibrium residual |f_int - F + C^T lambda|
-/// and the complementarity max_i |min(lambda_i, -c g_i)| (gaps g = C u turned into forces
+/// and the complementarity max_i |min(lambda_i, -c g_i)| (g = C u - gap turned into forces
 /// by `c`, the mean diagonal of the stiffness). Every solver stops when both are below its
 /// tolerance.
 pub fn distance_to_solution(p: &Problem, state: &State, f_ext: &[f64], c: f64) -> (f64, f64) {
@@ -266,7 +266,7 @@ pub fn distance_to_solution(p: &Problem, state: &State, f_ext: &[f64], c: f64) -
     }
     contact::add_transpose(&p.rows, &state.lambda, &mut r);
     let residual = inf_norm(&p.model.restrict(&r)) / scale;
-    let gaps = contact::apply_rows(&p.rows, &state.u);
+    let gaps = contact::constraint_values(&p.rows, &state.u);
     (residual, complementarity(&state.lambda, &gaps, c) / scale)
 }
 

@@ -482,7 +482,7 @@ impl Newton<'_> {
                     residual[eq] += v * l;
                 }
             }
-            contact::apply_rows(&self.p.rows, u)
+            contact::constraint_values(&self.p.rows, u)
         });
         let scale = inf_norm(&data.f_free).max(internal).max(f64::MIN_POSITIVE);
         Evaluation {

@@ -193,12 +193,8 @@ pub fn pressure_profile(p: &Problem, s: &State) -> PressureProfile {
     for (row, l) in p.rows.iter().zip(&s.lambda) {
         let piece = &p.interface.pieces[row.piece];
         let value = row.pressure(*l);
-        if row.is_macro() {
-            for end in row.span {
-                out[row.piece].push((piece.point(piece.slave_s[end]), value));
-            }
-        } else {
-            out[row.piece].push((piece.point(piece.slave_s[row.i]), value));
+        for at in row.pressure_at(piece) {
+            out[row.piece].push((piece.point(at), value));
         }
     }
     out

@@ -131,14 +131,9 @@ fn describe(label: &str, case: &Case, sol: &Solution, wall: f64) -> Run {
             .zip(&last.lambda)
             .filter(|(r, _)| r.piece == pi)
         {
-            pressure.push((
-                offset + piece.slave_s[row.i],
-                if row.weight > 0.0 {
-                    l / row.weight
-                } else {
-                    0.0
-                },
-            ));
+            for at in row.pressure_at(piece) {
+                pressure.push((offset + at, row.pressure(*l)));
+            }
         }
         offset += piece.length;
     }
