@@ -3,9 +3,10 @@
 use crate::contact;
 use crate::solve::{Problem, State};
 
-/// Largest interpenetration [u.nu]^+ over all trace nodes of both bodies (length units).
+/// Largest interpenetration ([u.nu] - g)^+ over all trace nodes of both bodies, g the
+/// initial gap between the traces (length units).
 pub fn max_penetration(p: &Problem, s: &State) -> f64 {
-    contact::normal_jumps(&p.interface, &s.u)
+    contact::penetrations(&p.interface, &s.u)
         .iter()
         .map(|j| j.2)
         .fold(0.0, f64::max)

@@ -49,8 +49,8 @@ pub struct Piece {
     /// macro-elements end there, so that they follow a rule about the mesh alone. Mortar's
     /// and nts's rows do not see them.
     pub breaks: Vec<usize>,
-    /// On a straight piece, each body-2 node's signed distance from the piece along the
-    /// normal (length; positive: the bodies are apart). Empty where the two traces coincide
+    /// Each body-2 node's signed distance from body 1's trace along the normal through it
+    /// (length; positive: the bodies are apart). Empty where the two traces coincide
     /// (every distance below 1e-9 of the piece: rounding, not a gap).
     pub master_gap: Vec<f64>,
     /// A curved piece's nodes and normals (None: straight).
@@ -286,6 +286,12 @@ impl Piece {
                 }
             }
         }
+    }
+
+    /// The gap at body-2 node `q`: its distance from body 1's trace along the normal that
+    /// passes through it (length).
+    pub fn master_node_gap(&self, q: usize) -> f64 {
+        self.master_gap.get(q).copied().unwrap_or(0.0)
     }
 
     /// The gap at slave node `j` along its normal (length).
@@ -749,21 +755,17 @@ impl Piece {
         self.master_s = placed.iter().map(|x| x.1).collect();
         self.master_s[0] = 0.0;
         *self.master_s.last_mut().unwrap() = self.length;
-        match &mut self.curve {
-            None => {
-                let apart = placed.iter().any(|x| x.2.abs() > tol);
-                self.master_gap = match apart {
-                    true => placed.iter().map(|x| x.2).collect(),
-                    false => Vec::new(),
-                };
-            }
-            Some(c) => {
-                c.master_points = self
-                    .master_nodes
-                    .iter()
-                    .map(|&n| model.position(n))
-                    .collect();
-            }
+        let apart = placed.iter().any(|x| x.2.abs() > tol);
+        self.master_gap = match apart {
+            true => placed.iter().map(|x| x.2).collect(),
+            false => Vec::new(),
+        };
+        if let Some(c) = &mut self.curve {
+            c.master_points = self
+                .master_nodes
+                .iter()
+                .map(|&n| model.position(n))
+                .collect();
         }
         Ok(())
     }

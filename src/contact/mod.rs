@@ -175,3 +175,20 @@ pub fn normal_jumps(interface: &Interface, u: &[f64]) -> Vec<(usize, f64, f64)> 
     }
     out
 }
+
+/// The penetration at every trace node of both bodies: the normal jump
+/// ([`normal_jumps`]) less the initial gap between the two discrete traces there along
+/// body 1's normal; positive where the deformed bodies overlap: (piece, arc length,
+/// penetration). Length units. Equal to the jump where the traces touch.
+pub fn penetrations(interface: &Interface, u: &[f64]) -> Vec<(usize, f64, f64)> {
+    let gaps = interface.pieces.iter().flat_map(|p| {
+        let slave = (0..p.slave_s.len()).map(|j| p.slave_gap(j));
+        let master = (0..p.master_s.len()).map(|q| p.master_node_gap(q));
+        slave.chain(master).collect::<Vec<f64>>()
+    });
+    normal_jumps(interface, u)
+        .into_iter()
+        .zip(gaps)
+        .map(|((piece, s, jump), gap)| (piece, s, jump - gap))
+        .collect()
+}
