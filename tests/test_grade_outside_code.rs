@@ -102,6 +102,12 @@ fn round_trip_of_this_projects_solves_gives_the_study_errors() {
             .iter()
             .find(|c| c.method.name() == "mortar" && c.level == r.level && c.quantity == r.quantity)
             .expect("the study has the row");
+        // The committed study ran on the baseline's rows, which the rebuilt operator
+        // equals to 1e-13 (issue 75), not bit for bit: errors agree to 1e-8 relative, and
+        // an error that is itself round-off (the resultant fixed by equilibrium, 2e-12)
+        // to 1e-11 absolute.
+        let allowed = 1e-8 * s.error.abs() + 1e-11;
+        assert!((r.error - s.error).abs() <= allowed, "{r:?} vs {s:?}");
         worst = worst.max((r.error - s.error).abs() / s.error.abs());
         assert!(
             (r.h - s.h).abs() <= 1e-15 * s.h && r.dofs == s.dofs,
@@ -112,7 +118,6 @@ fn round_trip_of_this_projects_solves_gives_the_study_errors() {
         "round trip: {} errors, largest relative difference to the study {worst:.2e}",
         mine.len()
     );
-    assert!(worst <= 1e-10, "{worst}");
     // Rates and verdicts against grade's own mortar on the same levels.
     let rate = |m: &str, q: Quantity| -> &RateRow {
         g.rates
