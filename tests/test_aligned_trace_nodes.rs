@@ -88,8 +88,8 @@ fn coincident_nodes_give_the_identity_in_both_nodal_methods() {
     let want = nodal_rows(&identity, &weights);
     let segments = p.mortar_segments();
     assert_eq!(segments.len(), 3, "one mortar segment per matching segment");
-    assert_rows_equal("nts (a)", &contact::nts::rows(&p, &segments), &want);
-    assert_rows_equal("mortar (a)", &contact::mortar::rows(&p, &segments), &want);
+    assert_rows_equal("nts (a)", &contact::nts::rows(&p), &want);
+    assert_rows_equal("mortar (a)", &contact::mortar::rows(&p), &want);
 }
 
 #[test]
@@ -118,11 +118,11 @@ fn a_slave_node_on_a_master_node_gives_the_hand_derived_rows() {
         vec![(0, 0, [0.0, 0.25]), (1, 0, [0.25, 0.5]), (2, 1, [0.5, 1.0])],
         "the mortar segments: the node at 1/2 is one breakpoint, not two"
     );
-    assert_rows_equal("nts (b)", &contact::nts::rows(&p, &segments), &want);
-    assert_rows_equal("mortar (b)", &contact::mortar::rows(&p, &segments), &want);
+    assert_rows_equal("nts (b)", &contact::nts::rows(&p), &want);
+    assert_rows_equal("mortar (b)", &contact::mortar::rows(&p), &want);
     // LAC's one macro-element [0, 1] (three segments: a triple): the averages of the hats
     // over |M| = 1: body 1 (1/8, 1/4, 3/8, 1/4), body 2 (1/4, 1/2, 1/4).
-    let lac = contact::lac::rows(&p, &segments);
+    let lac = contact::lac::rows(&p);
     let want = PieceRow {
         span: [0, 3],
         slave: [0.125, 0.25, 0.375, 0.25]

@@ -100,7 +100,6 @@ pub fn macro_averages(piece: &Piece) -> Vec<MacroAverage> {
                 add(&mut slave, g.0.slave, g.1.slave, g.1.weight / size);
                 add(&mut master, g.0.master, g.1.master, g.1.weight / size);
             }
-            slave.sort_by_key(|e| e.0);
             MacroAverage {
                 span,
                 size,
@@ -112,7 +111,8 @@ pub fn macro_averages(piece: &Piece) -> Vec<MacroAverage> {
 }
 
 /// The rows on one piece.
-pub fn rows(piece: &Piece, segments: &[MortarSegment]) -> Vec<PieceRow> {
+pub fn rows(piece: &Piece) -> Vec<PieceRow> {
+    let segments = &piece.mortar_segments();
     spans(piece)
         .into_iter()
         .map(|span| {
@@ -129,7 +129,6 @@ pub fn rows(piece: &Piece, segments: &[MortarSegment]) -> Vec<PieceRow> {
                 }
                 gap += w * g.gap;
             }
-            slave.sort_by_key(|e| e.0);
             PieceRow {
                 span,
                 slave,

@@ -20,14 +20,17 @@ pub enum Method {
     Lac,
 }
 
-/// The space a method's contact pressure lies in.
+/// The discrete space of a pressure: a method's, and a pressure profile's (what its best
+/// approximation of a pressure is taken in).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PressureSpace {
-    /// Continuous, linear between body-1 trace nodes: one multiplier per node, read as the
-    /// nodal force over the node's lumped trace weight.
-    NodalLinear,
-    /// Constant on each row's support (a macro-element M): the multiplier over |M|.
-    PiecewiseConstant,
+    /// Continuous, linear between consecutive points (the nodal rows' pressure at the
+    /// body-1 trace nodes, the multiplier over the node's lumped weight; a code's nodal
+    /// pressure).
+    Linear,
+    /// Constant between the two points of each consecutive pair (LAC's pressure on its
+    /// macro-elements, the multiplier over |M|, written at each macro-element's two ends).
+    ConstantOnPairs,
 }
 
 /// What the code knows of one method.
@@ -40,8 +43,9 @@ pub struct MethodInfo {
     pub pressure: PressureSpace,
     /// Whether it is the reference the distance D between cones is measured against.
     pub reference: bool,
-    /// Its rows on one piece, from the piece's mortar segments.
-    pub rows: fn(&Piece, &[super::MortarSegment]) -> Vec<PieceRow>,
+    /// Its rows on one piece (the methods that integrate build the piece's mortar
+    /// segments, [`Piece::mortar_segments`]; the pointwise ones do not).
+    pub rows: fn(&Piece) -> Vec<PieceRow>,
 }
 
 /// Every method, in the order the reports list them (the enum's order).
@@ -49,21 +53,21 @@ pub const REGISTRY: [MethodInfo; 3] = [
     MethodInfo {
         method: Method::Mortar,
         name: "mortar",
-        pressure: PressureSpace::NodalLinear,
+        pressure: PressureSpace::Linear,
         reference: true,
         rows: super::mortar::rows,
     },
     MethodInfo {
         method: Method::Nts,
         name: "nts",
-        pressure: PressureSpace::NodalLinear,
+        pressure: PressureSpace::Linear,
         reference: false,
         rows: super::nts::rows,
     },
     MethodInfo {
         method: Method::Lac,
         name: "lac",
-        pressure: PressureSpace::PiecewiseConstant,
+        pressure: PressureSpace::ConstantOnPairs,
         reference: false,
         rows: super::lac::rows,
     },
@@ -88,16 +92,6 @@ impl Method {
         REGISTRY.iter().find(|m| m.reference).unwrap().method
     }
 
-    /// Whether this is the reference method.
-    pub fn is_reference(self) -> bool {
-        self.info().reference
-    }
-
-    /// Every method but the reference, in order.
-    pub fn others() -> impl Iterator<Item = Method> {
-        Method::ALL.into_iter().filter(|m| !m.is_reference())
-    }
-
     /// The space its pressure lies in.
     pub fn pressure_space(self) -> PressureSpace {
         self.info().pressure
@@ -106,7 +100,7 @@ impl Method {
     /// Whether the pressure is constant on each row's support rather than linear between
     /// body-1 nodes.
     pub fn piecewise_constant_pressure(self) -> bool {
-        self.pressure_space() == PressureSpace::PiecewiseConstant
+        self.pressure_space() == PressureSpace::ConstantOnPairs
     }
 
     /// Parse a name of the registry.

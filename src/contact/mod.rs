@@ -93,13 +93,34 @@ pub struct PieceRow {
     pub gap: f64,
 }
 
+impl PieceRow {
+    /// The nodal row at body-1 node `j` (mortar, nts): `u^1_j.nu_j - sum_q c_q u^2_q.nu_j
+    /// <= gap` over the body-2 nodes' coefficients `master` (q, c_q), nu_j the node's
+    /// normal. Coefficients below 1e-15 of the largest are dropped: the mortar rows decay
+    /// geometrically away from the node, and such entries are below round-off.
+    pub fn nodal(piece: &Piece, j: usize, master: &[(usize, f64)], gap: f64) -> PieceRow {
+        let nu = piece.slave_normal(j);
+        let big = master.iter().fold(0.0f64, |a, e| a.max(e.1.abs()));
+        PieceRow {
+            span: [j, j],
+            slave: vec![(j, nu)],
+            master: master
+                .iter()
+                .filter(|e| e.1.abs() > 1e-15 * big)
+                .map(|&(q, v)| (q, [-v * nu[0], -v * nu[1]]))
+                .collect(),
+            weight: piece.lumped_weight(j),
+            gap,
+        }
+    }
+}
+
 /// Constraint rows of the chosen cone over global dofs; constrained dofs are dropped.
 pub fn constraint_rows(model: &Model, interface: &Interface, method: Method) -> Vec<Row> {
     let rows_of = method.info().rows;
     let mut rows = Vec::new();
     for (pi, p) in interface.pieces.iter().enumerate() {
-        let segments = p.mortar_segments();
-        for row in rows_of(p, &segments) {
+        for row in rows_of(p) {
             let mut entries = Vec::new();
             let slave = row.slave.iter().map(|&(j, c)| (p.slave_nodes[j], c));
             let master = row.master.iter().map(|&(q, c)| (p.master_nodes[q], c));

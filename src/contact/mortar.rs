@@ -9,30 +9,16 @@
 
 use super::{MortarSegment, Piece, PieceRow};
 
-/// The rows on one piece. Entries of P below 1e-15 of the row's largest are dropped: the
-/// rows decay geometrically away from the node, and such entries are below round-off.
-pub fn rows(piece: &Piece, segments: &[MortarSegment]) -> Vec<PieceRow> {
-    let (transfer, gaps) = projection(piece, segments);
+/// The rows on one piece, one per body-1 node ([`PieceRow::nodal`]).
+pub fn rows(piece: &Piece) -> Vec<PieceRow> {
+    let (transfer, gaps) = projection(piece, &piece.mortar_segments());
     transfer
         .iter()
         .zip(gaps)
         .enumerate()
         .map(|(i, (row, gap))| {
-            let nu = piece.slave_normal(i);
-            let big = row.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            let master = row
-                .iter()
-                .enumerate()
-                .filter(|(_, v)| v.abs() > 1e-15 * big)
-                .map(|(q, &v)| (q, [-v * nu[0], -v * nu[1]]))
-                .collect();
-            PieceRow {
-                span: [i, i],
-                slave: vec![(i, nu)],
-                master,
-                weight: piece.lumped_weight(i),
-                gap,
-            }
+            let master: Vec<(usize, f64)> = row.iter().copied().enumerate().collect();
+            PieceRow::nodal(piece, i, &master, gap)
         })
         .collect()
 }

@@ -3,27 +3,16 @@
 //! `u^1(y_j).nu_j - (I_h u^2)(y_j).nu_j <= g(y_j)`, g the gap along that normal. Its
 //! pressure is nodal (the multiplier over the node's lumped weight).
 
-use super::{MortarSegment, Piece, PieceRow};
+use super::{Piece, PieceRow};
 
-/// The rows on one piece (the mortar segments are not needed: the rows are pointwise).
-pub fn rows(piece: &Piece, _segments: &[MortarSegment]) -> Vec<PieceRow> {
+/// The rows on one piece (pointwise: no mortar segment is needed).
+pub fn rows(piece: &Piece) -> Vec<PieceRow> {
     (0..piece.slave_s.len())
         .map(|j| {
-            let nu = piece.slave_normal(j);
             let (meet, gap) = piece.meet_master(piece.slave_s[j]);
-            let shape = meet.shape();
-            let big = shape[0].abs().max(shape[1].abs());
-            let master = (0..2)
-                .filter(|&b| shape[b].abs() > 1e-15 * big)
-                .map(|b| (meet.segment + b, [-shape[b] * nu[0], -shape[b] * nu[1]]))
-                .collect();
-            PieceRow {
-                span: [j, j],
-                slave: vec![(j, nu)],
-                master,
-                weight: piece.lumped_weight(j),
-                gap,
-            }
+            let [a, b] = meet.shape();
+            let master = [(meet.segment, a), (meet.segment + 1, b)];
+            PieceRow::nodal(piece, j, &master, gap)
         })
         .collect()
 }

@@ -33,17 +33,7 @@ pub struct P1Field<'a> {
     pub pressure_space: PressureSpace,
 }
 
-/// The discrete space of a pressure profile: what its best approximation of a pressure is
-/// taken in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PressureSpace {
-    /// Continuous, linear between consecutive points (the nodal rows' pressure at the
-    /// body-1 trace nodes; a code's nodal pressure).
-    Linear,
-    /// Constant between the two points of each consecutive pair (LAC's pressure on its
-    /// macro-elements, written at each macro-element's two ends).
-    ConstantOnPairs,
-}
+pub use crate::contact::PressureSpace;
 
 /// Why a displacement field cannot be measured.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -77,10 +67,7 @@ impl<'a> P1Field<'a> {
             u: Cow::Borrowed(&s.u),
             stress: Cow::Borrowed(&s.sigma),
             pressure: Some(pressure_profile(p, s)),
-            pressure_space: match p.method.piecewise_constant_pressure() {
-                true => PressureSpace::ConstantOnPairs,
-                false => PressureSpace::Linear,
-            },
+            pressure_space: p.method.pressure_space(),
         }
     }
 
