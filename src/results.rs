@@ -119,7 +119,7 @@ pub fn headline(reports: &Path) -> Result<String> {
     }
     let mut doc = Doc::new();
     doc.bullet(format!(
-        "**Where the cones differ:** {}.",
+        "**Where the methods differ:** {}.",
         cones_differ(&studies)
     ));
     let theorem: Vec<String> = CONES.iter().map(|&m| theorem_rates(&studies, m)).collect();
@@ -127,29 +127,32 @@ pub fn headline(reports: &Path) -> Result<String> {
         "**Theorem 3.1's norm**, observed rates in h with their verdicts: {}.",
         theorem.join("; ")
     ));
-    let distances: Vec<String> = studies
-        .iter()
-        .filter_map(|(name, _, report)| {
-            let d = report.rate(Method::Nts, Quantity::ConeDistance)?;
-            let a = report.asymptote(Quantity::Theorem)?;
-            Some(match (d.verdict, a.asymptotic_rate) {
-                (Verdict::Fitted, Some(_)) => format!(
-                    "in `{name}` D falls at {}, and nts's error {}",
-                    rate_text(d),
-                    a.describe()
-                ),
-                _ => format!(
-                    "in `{name}` D supports no rate ({}): no asymptotic rate is predicted",
-                    rate_text(d)
-                ),
+    let reference = Method::reference();
+    for m in Method::compared(&CONES) {
+        let distances: Vec<String> = studies
+            .iter()
+            .filter_map(|(name, _, report)| {
+                let d = report.rate(m, Quantity::ConeDistance)?;
+                let a = report.asymptote(m, Quantity::Theorem)?;
+                Some(match (d.verdict, a.asymptotic_rate) {
+                    (Verdict::Fitted, Some(_)) => format!(
+                        "in `{name}` D falls at {}, and {m}'s error {}",
+                        rate_text(d),
+                        a.describe()
+                    ),
+                    _ => format!(
+                        "in `{name}` D supports no rate ({}): no asymptotic rate is predicted",
+                        rate_text(d)
+                    ),
+                })
             })
-        })
-        .collect();
-    if !distances.is_empty() {
-        doc.bullet(format!(
-            "**nts read against its distance D to mortar** (D - e_mortar <= e_nts <= D + e_mortar, on the same meshes): {}.",
-            distances.join("; ")
-        ));
+            .collect();
+        if !distances.is_empty() {
+            doc.bullet(format!(
+                "**{m} read against its distance D to {reference}** (D - e_{reference} <= e_{m} <= D + e_{reference}, on the same meshes): {}.",
+                distances.join("; ")
+            ));
+        }
     }
     doc.bullet(crate::studies::regularity::results::headline(reports)?);
     doc.bullet(format!(
@@ -164,58 +167,80 @@ pub fn headline(reports: &Path) -> Result<String> {
         ));
     }
     doc.blank();
-    let mut table = Table::new([
+    let mut header = vec![
         "study: scene, measured against".to_string(),
-        "where the cones differ: contact quantities at the finest level, nts's error / mortar's (rates)".to_string(),
+        format!(
+            "where the methods differ: contact quantities at the finest level, each method's error / {reference}'s (rates)"
+        ),
         "does not converge".to_string(),
-        "rate, mortar (threshold: the study file's)".to_string(),
-        "rate, nts (threshold: the study file's)".to_string(),
-        "rate, lac (threshold: the study file's)".to_string(),
-    ]);
+    ];
+    header.extend(
+        CONES
+            .iter()
+            .map(|m| format!("rate, {m} (threshold: the study file's)")),
+    );
+    let mut table = Table::new(header);
     for (name, what, report) in &studies {
         table.row(headline_row(name, what, report));
     }
     Ok(doc.as_str().to_string() + &table.render())
 }
 
-/// The headline's first line: how many contact-quantity errors separate the cones over the
-/// studies, which cone's is the larger, by how much, and where mortar is exact.
+/// The headline's first line: how many contact-quantity errors separate each method from
+/// the reference over the studies, whose is the larger, by how much, and where the
+/// reference is exact.
 fn cones_differ(studies: &[(&str, &str, Report)]) -> String {
-    let (mut nts_larger, mut total, mut widest) = (0, 0, 1.0f64);
-    let mut mortar_exact = Vec::new();
-    for (name, _, report) in studies {
-        for c in report.compare_cones().separate {
-            total += 1;
-            if c.ratio > 1.0 {
-                nts_larger += 1;
-            }
-            if c.ratio.is_infinite() {
-                if !mortar_exact.contains(name) {
-                    mortar_exact.push(*name);
+    let reference = Method::reference();
+    let mut parts = Vec::new();
+    for m in Method::compared(&CONES) {
+        let (mut larger, mut total, mut widest) = (0, 0, 1.0f64);
+        let mut reference_exact = Vec::new();
+        for (name, _, report) in studies {
+            for c in report
+                .compare_cones()
+                .separate
+                .iter()
+                .filter(|c| c.method == m)
+            {
+                total += 1;
+                if c.ratio > 1.0 {
+                    larger += 1;
                 }
-            } else if c.ratio > 1.0 {
-                // The sentence says by how much nts's error is the larger.
-                widest = widest.max(c.ratio);
+                if c.ratio.is_infinite() {
+                    if !reference_exact.contains(name) {
+                        reference_exact.push(*name);
+                    }
+                } else if c.ratio > 1.0 {
+                    // The sentence says by how much the method's error is the larger.
+                    widest = widest.max(c.ratio);
+                }
             }
         }
+        let exact = if reference_exact.is_empty() {
+            String::new()
+        } else {
+            let names: Vec<String> = reference_exact.iter().map(|n| format!("`{n}`")).collect();
+            format!(
+                "; {reference} is exact to round-off where {m} is not in {}",
+                names.join(", ")
+            )
+        };
+        let by = if larger > 0 && widest > 1.0 {
+            format!(", by up to {widest:.0}x")
+        } else {
+            String::new()
+        };
+        parts.push(if total == 0 {
+            format!("{m}: no contact quantity's error separates it from {reference}")
+        } else {
+            format!("{m}: {total} contact-quantity errors separate it from {reference}, {m}'s the larger in {larger}{by}{exact}")
+        });
     }
-    let exact = if mortar_exact.is_empty() {
-        String::new()
-    } else {
-        let names: Vec<String> = mortar_exact.iter().map(|n| format!("`{n}`")).collect();
-        format!("; mortar is exact to round-off in {}", names.join(", "))
-    };
-    if total == 0 {
-        format!(
-            "no contact quantity's error separates them (ratio beyond {SEPARATES}x at the finest level) in any of the {} studies",
-            studies.len()
-        )
-    } else {
-        format!(
-            "over the {} studies, {total} contact-quantity errors separate them (ratio beyond {SEPARATES}x at the finest level, among the quantities where every method's verdict supports a comparison, the rule of each study's README; the others are listed in docs/results.md), nts's the larger in {nts_larger}, by up to {widest:.0}x{exact}",
-            studies.len()
-        )
-    }
+    format!(
+        "over the {} studies (ratio beyond {SEPARATES}x at the finest level, among the quantities where every method's verdict supports a comparison, the rule of each study's README; the others are listed in docs/results.md): {}",
+        studies.len(),
+        parts.join("; ")
+    )
 }
 
 /// Theorem 3.1's norm in one cone over the studies: the range of the fitted rates, and
@@ -300,7 +325,7 @@ fn by_study<'a>(
 }
 
 /// One study's row of the headline table.
-fn headline_row(name: &str, what: &str, report: &Report) -> [String; 6] {
+fn headline_row(name: &str, what: &str, report: &Report) -> Vec<String> {
     let mut comparison = report.compare_cones();
     // The widest gap first; an exact cone (an infinite or zero ratio) leads.
     comparison
@@ -320,14 +345,13 @@ fn headline_row(name: &str, what: &str, report: &Report) -> [String; 6] {
         .stalled()
         .map(|r| format!("{} `{}`", r.method, r.quantity))
         .collect();
-    [
+    let mut row = vec![
         format!("[`{name}`]({README_REPORTS}/{name}/README.md): {what}"),
         separate,
         listed(&stalled, ", ", "nothing"),
-        judged_rate(report, Method::Mortar),
-        judged_rate(report, Method::Nts),
-        judged_rate(report, Method::Lac),
-    ]
+    ];
+    row.extend(CONES.iter().map(|&m| judged_rate(report, m)));
+    row
 }
 
 /// The rate of the quantity the study judges (the one with a threshold) in cone `m`, as

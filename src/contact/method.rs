@@ -43,6 +43,9 @@ pub struct MethodInfo {
     pub pressure: PressureSpace,
     /// Whether it is the reference the distance D between cones is measured against.
     pub reference: bool,
+    /// Its symbol in the paper (K_h^pi, K_h^I) when it is one of the paper's two cones:
+    /// the paper's solver and Theorem 3.1's rates are stated for those.
+    pub paper_symbol: Option<&'static str>,
     /// Its rows on one piece (the methods that integrate build the piece's mortar
     /// segments, [`Piece::mortar_segments`]; the pointwise ones do not).
     pub rows: fn(&Piece) -> Vec<PieceRow>,
@@ -53,6 +56,7 @@ pub const REGISTRY: [MethodInfo; 3] = [
     MethodInfo {
         method: Method::Mortar,
         name: "mortar",
+        paper_symbol: Some("K_h^pi"),
         pressure: PressureSpace::Linear,
         reference: true,
         rows: super::mortar::rows,
@@ -60,6 +64,7 @@ pub const REGISTRY: [MethodInfo; 3] = [
     MethodInfo {
         method: Method::Nts,
         name: "nts",
+        paper_symbol: Some("K_h^I"),
         pressure: PressureSpace::Linear,
         reference: false,
         rows: super::nts::rows,
@@ -67,6 +72,7 @@ pub const REGISTRY: [MethodInfo; 3] = [
     MethodInfo {
         method: Method::Lac,
         name: "lac",
+        paper_symbol: None,
         pressure: PressureSpace::ConstantOnPairs,
         reference: false,
         rows: super::lac::rows,
@@ -90,6 +96,22 @@ impl Method {
     /// The method the distance D between cones is measured against (mortar).
     pub fn reference() -> Method {
         REGISTRY.iter().find(|m| m.reference).unwrap().method
+    }
+
+    /// Whether this is the reference the distance D between cones is measured against.
+    pub fn is_reference(self) -> bool {
+        self.info().reference
+    }
+
+    /// The methods of `methods` other than the reference, in their order: the ones a
+    /// report compares with the reference.
+    pub fn compared(methods: &[Method]) -> impl Iterator<Item = Method> + '_ {
+        methods.iter().copied().filter(|m| !m.is_reference())
+    }
+
+    /// Whether it is one of the paper's two cones (K_h^pi, K_h^I).
+    pub fn in_paper(self) -> bool {
+        self.info().paper_symbol.is_some()
     }
 
     /// The space its pressure lies in.

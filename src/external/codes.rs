@@ -302,7 +302,7 @@ fn side(p: &Problem, code: &MethodLabel) -> Side {
             Some((m, e.error))
         })
         .collect();
-    let Some(&(_, mortar)) = cones.iter().find(|c| c.0 == Method::Mortar) else {
+    let Some(&(_, mortar)) = cones.iter().find(|c| c.0.is_reference()) else {
         return Side::Unknown;
     };
     let x = finest.error;
@@ -569,7 +569,7 @@ fn section(doc: &mut Doc, p: &Problem) {
     let key = p.key();
     doc.heading(2, format!("{} (levels {})", p.study, p.levels()));
     let mortar_exact = p
-        .finest(&MethodLabel::Cone(crate::contact::Method::Mortar), key)
+        .finest(&MethodLabel::Cone(crate::contact::Method::reference()), key)
         .is_some_and(|r| r.error <= EXACT);
     let mut table = Table::new([
         "method",

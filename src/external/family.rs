@@ -77,7 +77,13 @@ impl Family {
     /// are used), with the mesh as gmsh wrote it.
     pub fn case(&self, level: usize) -> Result<(Case, crate::mesh::RawMesh)> {
         let (generated, raw) = Case::mesh(&self.scene, level, &self.params)?;
-        let case = Case::on_mesh(&self.scene, level, Method::Mortar, generated, raw.clone())?;
+        let case = Case::on_mesh(
+            &self.scene,
+            level,
+            Method::reference(),
+            generated,
+            raw.clone(),
+        )?;
         Ok((case, raw))
     }
 

@@ -597,7 +597,7 @@ fn solve_cones(
 fn mortar_at(cones: &Cones, level: usize) -> Option<(&Case, &Solution)> {
     cones
         .iter()
-        .find(|c| c.0 == Method::Mortar && c.1 == level)
+        .find(|c| c.0.is_reference() && c.1 == level)
         .map(|c| (&c.2, &c.3))
 }
 
@@ -682,7 +682,7 @@ fn cone_rows(
     let mut errors = Vec::new();
     for (method, level, case, solution) in cones {
         let (mut errors_here, scale) = truth.measure_solved(case, solution);
-        if *method != Method::Mortar
+        if !method.is_reference()
             && let Some((mc, ms)) = mortar_at(cones, *level)
         {
             let (a, b) = (

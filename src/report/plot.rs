@@ -915,6 +915,12 @@ pub fn method_style(method: Method) -> usize {
     Method::ALL.iter().position(|&m| m == method).unwrap_or(0)
 }
 
+/// Whether a method's lines are drawn thin and dashed on the plots of several quantities
+/// (nts, so that its lines stay told apart from mortar's where they overlap).
+pub fn method_dashed(method: Method) -> bool {
+    method == Method::Nts
+}
+
 /// A marker's shape.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Shape {

@@ -360,7 +360,7 @@ pub fn decomposition(errors: &[ErrorRecord]) -> Vec<DecompositionRow> {
             .iter()
             .find(|r| r.parameter == p && &r.method == m && r.quantity == q && r.level == level)
     };
-    let mortar = MethodLabel::Cone(crate::contact::Method::Mortar);
+    let mortar = MethodLabel::Cone(crate::contact::Method::reference());
     let mut out = Vec::new();
     for group in groups(errors) {
         let first = group[0];
@@ -544,7 +544,7 @@ pub struct AsymptoteRow {
 /// The rows of asymptotes.csv for every method other than mortar with a distance to
 /// mortar in `errors`, judged as `rates`.
 pub fn asymptotes(rates: &[RateRow], errors: &[ErrorRecord]) -> Vec<AsymptoteRow> {
-    let mortar = MethodLabel::Cone(crate::contact::Method::Mortar);
+    let mortar = MethodLabel::Cone(crate::contact::Method::reference());
     let decomposition = decomposition(errors);
     let find =
         |m: &MethodLabel, q: Quantity| rates.iter().find(|r| &r.method == m && r.quantity == q);

@@ -430,8 +430,8 @@ impl StudyFile {
                 ),
             );
         }
-        let both = self.methods.contains(&Method::Mortar)
-            && self.methods.iter().any(|&m| m != Method::Mortar);
+        let both = self.methods.iter().any(|m| m.is_reference())
+            && self.methods.iter().any(|m| !m.is_reference());
         if let Some(q) = self.quantities.iter().find(|q| q.is_distance() && !both) {
             return bad(
                 path,

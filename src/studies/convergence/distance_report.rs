@@ -1,6 +1,7 @@
-//! The distance between the two cones in a convergence report: e_mortar, e_nts and D
-//! against h, the triangle-inequality bounds D - e_mortar <= e_nts <= D + e_mortar, the
-//! consistency term of each cone, and nts read against its distance to mortar.
+//! The distance between the cones in a convergence report: each method X compared with
+//! the reference (mortar, [`Method::reference`]): e_mortar, e_X and X's distance D to
+//! mortar against h, the triangle-inequality bounds D - e_mortar <= e_X <= D + e_mortar,
+//! the consistency term of each cone, and X read against its distance to mortar.
 
 use super::{RateRow, StudyResult};
 use crate::contact::Method;
@@ -17,10 +18,19 @@ fn supported_fit(row: Option<&RateRow>) -> Option<Fit> {
     row?.supported_fit()
 }
 
+/// The methods whose distance to the reference the study measures in the theorem norm.
+fn with_distance(res: &StudyResult) -> Vec<Method> {
+    Method::compared(&res.file.methods)
+        .filter(|&m| res.rate(m, Quantity::ConeDistance).is_some())
+        .collect()
+}
+
 /// The section, where the study measures the cone distance in the theorem norm.
 pub fn section(doc: &mut Doc, res: &StudyResult) {
     let key = Quantity::ConeDistance;
-    if res.rate(Method::Nts, key).is_none() {
+    let others = with_distance(res);
+    let reference = Method::reference();
+    if others.is_empty() {
         // No distance in the theorem norm (patch's truth has no displacement): the methods
         // are still read against the distances the study measures.
         if !judge::asymptotes(&res.rates, &res.errors).is_empty() {
@@ -32,25 +42,27 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
     let theorem = Quantity::Theorem;
     doc.heading(2, "The distance between the cones")
         .paragraph(
-            "Both cones are solved on the same meshes, so the distance D between their solutions is computed exactly on one mesh: D = max over the steps of ||u^I - u^pi||_H1 + ||sigma^I - sigma^pi||_L2, relative to the truth's norm as the errors are. By the triangle inequality D - e_mortar <= e_nts <= D + e_mortar. D falling like h^(1/2) while e_mortar falls like h shows that nts's error holds an h^(1/2) part: the rate Theorem 3.1 allows K_h^I is then attained, not only respected.",
+            "Every method is solved on the same meshes as mortar, so the distance D between a method X's solution and mortar's is computed exactly on one mesh: D = max over the steps of ||u^X - u^pi||_H1 + ||sigma^X - sigma^pi||_L2, relative to the truth's norm as the errors are. By the triangle inequality D - e_mortar <= e_X <= D + e_mortar. nts's D falling like h^(1/2) while e_mortar falls like h shows that nts's error holds an h^(1/2) part: the rate Theorem 3.1 allows K_h^I is then attained, not only respected.",
         )
         .image("the cones' errors and their distance against h", "cone_distance.png");
     let consistency = res.file.quantities.contains(&Quantity::Consistency);
-    let mut header: Vec<String> = ["level", "h", "e_mortar", "e_nts", "D", "D - e_mortar", "D + e_mortar"]
-        .into_iter()
-        .map(String::from)
-        .collect();
+    let mut header: Vec<String> = vec!["level".into(), "h".into(), format!("e_{reference}")];
+    for m in &others {
+        header.extend([format!("e_{m}"), format!("D_{m}"), format!("D_{m} - e_{reference}"), format!("D_{m} + e_{reference}")]);
+    }
     if consistency {
-        header.push("consistency, mortar".into());
-        header.push("consistency, nts".into());
+        header.extend(res.file.methods.iter().map(|m| format!("consistency, {m}")));
     }
     let mut table = Table::new(header);
     for level in &res.file.mesh.levels {
-        let (Some(em), Some(en), Some(d)) = (
-            res.error(Method::Mortar, *level, theorem),
-            res.error(Method::Nts, *level, theorem),
-            res.error(Method::Nts, *level, key),
-        ) else {
+        let Some(em) = res.error(reference, *level, theorem) else {
+            continue;
+        };
+        let pairs: Option<Vec<(f64, f64)>> = others
+            .iter()
+            .map(|&m| Some((res.error(m, *level, theorem)?, res.error(m, *level, key)?)))
+            .collect();
+        let Some(pairs) = pairs else {
             continue;
         };
         let h = res
@@ -58,17 +70,12 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
             .iter()
             .find(|e| e.level == *level)
             .map_or(f64::NAN, |e| e.h);
-        let mut row = vec![
-            level.to_string(),
-            format!("{h:.5}"),
-            format!("{em:.4e}"),
-            format!("{en:.4e}"),
-            format!("{d:.4e}"),
-            format!("{:.4e}", d - em),
-            format!("{:.4e}", d + em),
-        ];
+        let mut row = vec![level.to_string(), format!("{h:.5}"), format!("{em:.4e}")];
+        for (en, d) in pairs {
+            row.extend([format!("{en:.4e}"), format!("{d:.4e}"), format!("{:.4e}", d - em), format!("{:.4e}", d + em)]);
+        }
         if consistency {
-            for m in [Method::Mortar, Method::Nts] {
+            for &m in &res.file.methods {
                 row.push(
                     res.error(m, *level, Quantity::Consistency)
                         .map_or("-".into(), |v| format!("{v:.4e}")),
@@ -78,14 +85,16 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
         table.row(row);
     }
     doc.table(&table);
-    let mut rates = Table::new(["quantity", "rate of the distance in h (nts's rows of rates.csv)"]);
-    for q in Quantity::DISTANCES {
-        if let Some(r) = res.rate(Method::Nts, q) {
-            rates.row([format!("`{q}`"), r.assessment.describe()]);
+    let mut rates = Table::new(["quantity", "rate of the distance in h (the method's rows of rates.csv)"]);
+    for &m in &others {
+        for q in Quantity::DISTANCES {
+            if let Some(r) = res.rate(m, q) {
+                rates.row([format!("`{q}`, {m}"), r.assessment.describe()]);
+            }
         }
     }
     if consistency {
-        for m in [Method::Mortar, Method::Nts] {
+        for &m in &res.file.methods {
             if let Some(r) = res.rate(m, Quantity::Consistency) {
                 rates.row([format!("`consistency`, {m}"), r.assessment.describe()]);
             }
@@ -96,22 +105,22 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
     compared(doc, res);
 }
 
-/// nts's distance to mortar in the theorem norm of `errors`, by level.
-fn distances(errors: &[crate::verify::table::ErrorRecord]) -> Vec<LevelError> {
+/// `method`'s distance to mortar in the theorem norm of `errors`, by level.
+fn distances(errors: &[crate::verify::table::ErrorRecord], method: Method) -> Vec<LevelError> {
     let rows: Vec<&crate::verify::table::ErrorRecord> = errors
         .iter()
-        .filter(|e| e.method == Method::Nts && e.quantity == Quantity::ConeDistance)
+        .filter(|e| e.method == method && e.quantity == Quantity::ConeDistance)
         .collect();
     let mut out = judge::levels_of_errors(&rows);
     out.sort_by_key(|e| e.level);
     out
 }
 
-/// nts's distance to mortar here and in the committed report reports/`other`, on the
-/// levels both measure, in level order: (here, there).
-fn beside(res: &StudyResult, other: &str) -> Result<(Vec<LevelError>, Vec<LevelError>)> {
+/// `method`'s distance to mortar here and in the committed report reports/`other`, on
+/// the levels both measure, in level order: (here, there).
+fn beside(res: &StudyResult, other: &str, method: Method) -> Result<(Vec<LevelError>, Vec<LevelError>)> {
     let path = crate::report::folder::reports_dir().join(other).join("errors.csv");
-    let (ours, theirs) = (distances(&res.errors), distances(&crate::verify::table::read(&path)?));
+    let (ours, theirs) = (distances(&res.errors, method), distances(&crate::verify::table::read(&path)?, method));
     let common = |a: &[LevelError], b: &[LevelError]| -> Vec<LevelError> {
         a.iter().filter(|x| b.iter().any(|y| y.level == x.level)).cloned().collect()
     };
@@ -144,16 +153,19 @@ pub fn lead(doc: &mut Doc, res: &StudyResult) {
         return;
     };
     let levels = &res.file.mesh.levels;
-    let ratio = |l: usize| {
-        Some(res.error(Method::Nts, l, Quantity::ConeDistance)? / res.error(Method::Mortar, l, Quantity::Theorem)?)
+    let reference = Method::reference();
+    let ratio = |m: Method, l: usize| {
+        Some(res.error(m, l, Quantity::ConeDistance)? / res.error(reference, l, Quantity::Theorem)?)
     };
-    let finest: Vec<String> = levels
-        .iter()
-        .rev()
-        .take(2)
-        .rev()
-        .map(|&l| ratio(l).map_or(format!("- (level {l})"), |r| format!("{r:.2} (level {l})")))
-        .collect();
+    let finest = |m: Method| -> Vec<String> {
+        levels
+            .iter()
+            .rev()
+            .take(2)
+            .rev()
+            .map(|&l| ratio(m, l).map_or(format!("- (level {l})"), |r| format!("{r:.2} (level {l})")))
+            .collect()
+    };
     let describe = |m: Method, q: Quantity| res.rate(m, q).map_or("-".into(), |r| r.assessment.describe());
     let fraction = |m: Method| {
         res.levels
@@ -162,12 +174,18 @@ pub fn lead(doc: &mut Doc, res: &StudyResult) {
             .max_by_key(|l| l.level)
             .map_or("-".into(), |l| format!("{:.4}", l.contact_fraction))
     };
-    let mut lines = vec![
-        format!(
-            "nts's distance to mortar D (theorem norm): {}; D / e_mortar on the two finest levels {}: where D is the larger, nts's error is D's.",
-            describe(Method::Nts, Quantity::ConeDistance),
-            finest.join(", ")
-        ),
+    let others = with_distance(res);
+    let mut lines: Vec<String> = others
+        .iter()
+        .map(|&m| {
+            format!(
+                "{m}'s distance to {reference} D (theorem norm): {}; D / e_{reference} on the two finest levels {}: where D is the larger, {m}'s error is D's.",
+                describe(m, Quantity::ConeDistance),
+                finest(m).join(", ")
+            )
+        })
+        .collect();
+    lines.extend([
         format!(
             "Theorem norm: {}.",
             res.file
@@ -186,11 +204,14 @@ pub fn lead(doc: &mut Doc, res: &StudyResult) {
                 .collect::<Vec<_>>()
                 .join(", ")
         ),
-    ];
-    if let Ok((mine, yours)) = beside(res, other) {
+    ]);
+    for &m in &others {
+        let Ok((mine, yours)) = beside(res, other, m) else {
+            continue;
+        };
         if let (Some(first), Some(a), Some(b)) = (mine.first(), mine.last(), yours.last()) {
             lines.push(format!(
-                "Against {other} at its levels {}-{} (each D relative to its own problem's norm): D's rate here {}, there {}; D / h^(1/2) at level {} {:.4} here, {:.4} there ({:.2}x).",
+                "Against {other} at its levels {}-{} (each D relative to its own problem's norm): {m}'s D's rate here {}, there {}; D / h^(1/2) at level {} {:.4} here, {:.4} there ({:.2}x).",
                 first.level,
                 a.level,
                 judged_with_constant(&mine),
@@ -205,25 +226,31 @@ pub fn lead(doc: &mut Doc, res: &StudyResult) {
     doc.heading(2, "What the study learned").list(lines);
 }
 
-/// The study file's `compare`: nts's distance to mortar beside the other study's (its
-/// committed report) at the levels both measure, judged on those levels alone.
+/// The study file's `compare`: each method's distance to mortar beside the other study's
+/// (its committed report) at the levels both measure, judged on those levels alone.
 fn compared(doc: &mut Doc, res: &StudyResult) {
     let Some(other) = &res.file.compare else {
         return;
     };
     doc.heading(3, &format!("The distance beside {other}'s"));
-    let (mine, yours) = match beside(res, other) {
-        Ok(pair) => pair,
-        Err(e) => {
-            doc.paragraph(format!("Not compared: {e} (`cargo run --release -- study {other}` writes it)."));
-            return;
+    for m in with_distance(res) {
+        match beside(res, other, m) {
+            Ok((mine, yours)) => compared_table(doc, other, m, &mine, &yours),
+            Err(e) => {
+                doc.paragraph(format!("Not compared: {e} (`cargo run --release -- study {other}` writes it)."));
+                return;
+            }
         }
-    };
+    }
+}
+
+/// One method's distance to mortar here (`mine`) and in `other` (`yours`), level by level.
+fn compared_table(doc: &mut Doc, other: &str, m: Method, mine: &[LevelError], yours: &[LevelError]) {
     let mut table = Table::new(
         ["level", "h here", "D here", "h there", &format!("D in {other}"), "here / there", "D / h^(1/2) here", "D / h^(1/2) there"]
             .map(String::from),
     );
-    for (a, b) in mine.iter().zip(&yours) {
+    for (a, b) in mine.iter().zip(yours) {
         table.row([
             a.level.to_string(),
             format!("{:.5}", a.h),
@@ -236,9 +263,10 @@ fn compared(doc: &mut Doc, res: &StudyResult) {
         ]);
     }
     doc.paragraph(format!(
-        "nts's distance to mortar in the theorem norm here and in reports/{other} (its committed errors.csv), relative to each problem's own exact solution, at the levels both measure, each judged by the same rules on those levels only: here {}; in {other} {}.",
-        judged_with_constant(&mine),
-        judged_with_constant(&yours)
+        "{m}'s distance to {} in the theorem norm here and in reports/{other} (its committed errors.csv), relative to each problem's own exact solution, at the levels both measure, each judged by the same rules on those levels only: here {}; in {other} {}.",
+        Method::reference(),
+        judged_with_constant(mine),
+        judged_with_constant(yours)
     ))
     .table(&table);
 }
@@ -272,7 +300,7 @@ fn decomposition(doc: &mut Doc, res: &StudyResult) {
             method.to_string(),
             format!("`{q}`"),
             describe(method, q),
-            describe(Method::Mortar, q),
+            describe(Method::reference(), q),
             describe(method, dq),
             a.largest_pythagorean.map_or("-".into(), |v| format!("{v:.1e}")),
             match a.mortar_verdict {
@@ -291,12 +319,14 @@ fn decomposition(doc: &mut Doc, res: &StudyResult) {
         .table(&table);
 }
 
-/// cone_distance.png: e_mortar, e_nts and D in the theorem norm against h, with D's and
-/// mortar's fitted lines.
+/// cone_distance.png: e_mortar, and each other method's e_X and distance D to mortar, in
+/// the theorem norm against h, with D's and mortar's fitted lines.
 pub fn plot(res: &StudyResult, d: &Path) -> Result<()> {
-    let Some(d_row) = res.rate(Method::Nts, Quantity::ConeDistance) else {
+    let others = with_distance(res);
+    if others.is_empty() {
         return Ok(());
-    };
+    }
+    let reference = Method::reference();
     let points = |m: Method, q: Quantity| -> Vec<(f64, f64)> {
         res.errors
             .iter()
@@ -305,14 +335,14 @@ pub fn plot(res: &StudyResult, d: &Path) -> Result<()> {
             .collect()
     };
     let mut series = Vec::new();
-    let curves = [
-        ("e_mortar", Method::Mortar, Quantity::Theorem, res.rate(Method::Mortar, Quantity::Theorem), 0),
-        ("e_nts", Method::Nts, Quantity::Theorem, None, 1),
-        ("D (nts - mortar)", Method::Nts, Quantity::ConeDistance, Some(d_row), 2),
-    ];
+    let mut curves = vec![(format!("e_{reference}"), reference, Quantity::Theorem, res.rate(reference, Quantity::Theorem), 0)];
+    for (k, &m) in others.iter().enumerate() {
+        curves.push((format!("e_{m}"), m, Quantity::Theorem, None, 1 + 2 * k));
+        curves.push((format!("D ({m} - {reference})"), m, Quantity::ConeDistance, res.rate(m, Quantity::ConeDistance), 2 + 2 * k));
+    }
     for (label, m, q, row, color) in curves {
         series.push(Series {
-            label: label.to_string(),
+            label: label.clone(),
             points: points(m, q),
             markers: true,
             line: row.is_none(),

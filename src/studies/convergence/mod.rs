@@ -396,7 +396,7 @@ impl Plan {
         (!sf.reference.exact).then(|| {
             [r - 2, r - 1, r].map(|l| {
                 let label = format!("reference level {l}");
-                jobs.add(label, Method::Mortar, l, &parameters, sf.steps, 0)
+                jobs.add(label, Method::reference(), l, &parameters, sf.steps, 0)
             })
         })
     }
@@ -548,7 +548,7 @@ fn measure_levels(
         let (method, level) = (*method, *level);
         out.errors
             .extend(error_rows(sf, method, case, sol, errors)?);
-        if method != Method::Mortar {
+        if !method.is_reference() {
             out.errors
                 .extend(distance_rows(sf, &runs, method, level, &measured)?);
         }
@@ -575,7 +575,7 @@ fn distance_rows(
 ) -> Result<Vec<ErrorRecord>> {
     let wanted: Vec<Quantity> = sf.quantities.iter().copied().filter(|q| q.is_distance()).collect();
     let find = |m: Method| runs.iter().position(|r| r.0 == m && r.1 == level);
-    let (Some(a), Some(b)) = (find(Method::Mortar), find(method)) else {
+    let (Some(a), Some(b)) = (find(Method::reference()), find(method)) else {
         return Ok(Vec::new());
     };
     if wanted.is_empty() {

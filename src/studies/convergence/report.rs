@@ -521,10 +521,14 @@ fn cones_compared(doc: &mut Doc, res: &StudyResult) {
         ));
     }
     fixed_at_a_node(doc, res);
-    if [Method::Mortar, Method::Nts].iter().all(|m| res.file.methods.contains(m)) {
+    let reference = Method::reference();
+    if res.file.methods.contains(&reference) {
         doc.list(quantities.iter().filter_map(|&q| {
-            let sentence = cones_sentence(res, q)?;
-            Some(format!("{q}: {sentence} at level {finest}."))
+            let sentences: Vec<String> = Method::compared(&res.file.methods)
+                .filter_map(|m| cones_sentence(res, q, reference, m))
+                .collect();
+            (!sentences.is_empty())
+                .then(|| format!("{q}: {} at level {finest}.", sentences.join("; ")))
         }));
     }
 }
@@ -559,7 +563,7 @@ fn fixed_at_a_node(doc: &mut Doc, res: &StudyResult) {
                     "{m} `{}`: {e:.4e} on levels {levels}, {} the rows' resolution at level {finest} ({b:.4e} of |Gamma_C|: {}): a position every level keeps, which falls only once the rows resolve finer than it",
                     r.quantity,
                     if e <= b { "within" } else { "**beyond**" },
-                    if m == Method::Lac { "the largest macro-element" } else { "the largest body-1 segment" }
+                    if m.piecewise_constant_pressure() { "the largest macro-element" } else { "the largest body-1 segment" }
                 ),
                 None => format!("{m} `{}`: {e:.4e} on levels {levels}", r.quantity),
             })
@@ -626,37 +630,38 @@ fn quantities_compared(res: &StudyResult) -> (Vec<Quantity>, Vec<String>) {
     (shown, left_out)
 }
 
-/// How mortar and nts compare in one quantity at the finest level, from their errors and
-/// verdicts (None where a cone has no error there).
-fn cones_sentence(res: &StudyResult, q: Quantity) -> Option<String> {
-    let a = finest_error(res, Method::Mortar, q)?;
-    let b = finest_error(res, Method::Nts, q)?;
+/// How `other` compares with `reference` in one quantity at the finest level, from their
+/// errors and verdicts (None where a cone has no error there).
+fn cones_sentence(res: &StudyResult, q: Quantity, reference: Method, other: Method) -> Option<String> {
+    let a = finest_error(res, reference, q)?;
+    let b = finest_error(res, other, q)?;
     let verdict = |m: Method| rate_row(res, m, q).map(|r| r.assessment.verdict);
     let floor = rates::ROUNDOFF;
-    Some(match (verdict(Method::Mortar), verdict(Method::Nts)) {
+    let (r, o) = (reference, other);
+    Some(match (verdict(reference), verdict(other)) {
         (Some(Verdict::RoundOff), Some(Verdict::RoundOff)) => {
-            "both cones are exact (round-off)".to_string()
+            format!("{r} and {o} are exact (round-off)")
         }
         (Some(Verdict::RoundOff), _) => {
-            format!("mortar is exact (round-off); nts's error is {b:.3e}")
+            format!("{r} is exact (round-off); {o}'s error is {b:.3e}")
         }
         (_, Some(Verdict::RoundOff)) => {
-            format!("nts is exact (round-off); mortar's error is {a:.3e}")
+            format!("{o} is exact (round-off); {r}'s error is {a:.3e}")
         }
         (Some(Verdict::NotConverging), Some(Verdict::NotConverging)) => {
-            "neither cone converges".to_string()
+            format!("neither {r} nor {o} converges")
         }
         (_, Some(Verdict::NotConverging)) => format!(
-            "**nts does not converge** (stalls at {b:.3e}); mortar reaches {a:.3e}, {:.1}x smaller",
+            "**{o} does not converge** (stalls at {b:.3e}); {r} reaches {a:.3e}, {:.1}x smaller",
             b / a.max(floor)
         ),
         (Some(Verdict::NotConverging), _) => {
-            format!("**mortar does not converge** (stalls at {a:.3e}); nts reaches {b:.3e}")
+            format!("**{r} does not converge** (stalls at {a:.3e}); {o} reaches {b:.3e}")
         }
-        _ if b > 1.5 * a => format!("nts's error is {:.2}x mortar's", b / a.max(floor)),
-        _ if a > 1.5 * b => format!("mortar's error is {:.2}x nts's", a / b.max(floor)),
+        _ if b > 1.5 * a => format!("{o}'s error is {:.2}x {r}'s", b / a.max(floor)),
+        _ if a > 1.5 * b => format!("{r}'s error is {:.2}x {o}'s", a / b.max(floor)),
         _ => format!(
-            "the cones agree within a factor 1.5 (nts / mortar = {:.3})",
+            "{o} and {r} agree within a factor 1.5 ({o} / {r} = {:.3})",
             b / a.max(floor)
         ),
     })
@@ -1114,7 +1119,7 @@ fn contact_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
                     points,
                     c,
                     plot::method_style(m),
-                    m == Method::Nts,
+                    plot::method_dashed(m),
                 ));
             }
         }

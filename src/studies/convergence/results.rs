@@ -152,18 +152,17 @@ impl Report {
             .map(|e| e.error)
     }
 
-    /// The contact quantities compared between the cones at the finest level.
+    /// The contact quantities compared at the finest level between the reference (mortar)
+    /// and each other method of the registry, one method after the other.
     pub(crate) fn compare_cones(&self) -> Comparison<'_> {
         let mut c = Comparison::default();
-        for mortar in self
+        let reference = Method::reference();
+        for q in self
             .rates
             .iter()
-            .filter(|r| r.method == Method::Mortar && r.quantity.is_contact())
+            .filter(|r| r.method == reference && r.quantity.is_contact())
+            .map(|r| r.quantity)
         {
-            let q = mortar.quantity;
-            let Some(nts) = self.rate(Method::Nts, q) else {
-                continue;
-            };
             // The rule of the study's own README (report.rs's quantities_compared): a
             // quantity is compared only where every method's verdict compares the cones.
             if !self
@@ -173,26 +172,41 @@ impl Report {
                 .all(|r| r.verdict.compares_cones())
             {
                 c.not_compared.push(q.to_string());
-                continue;
             }
-            let (Some(a), Some(b)) = (self.error(mortar), self.error(nts)) else {
-                continue;
-            };
-            let ratio = error_ratio(mortar.verdict, nts.verdict, a, b);
-            if !(1.0 / SEPARATES..=SEPARATES).contains(&ratio) {
-                c.separate.push(Separation {
-                    quantity: q,
-                    ratio,
-                    mortar_error: a,
-                    nts_error: b,
-                    mortar,
-                    nts,
-                });
-            } else if mortar.verdict == Verdict::RoundOff && nts.verdict == Verdict::RoundOff {
-                // error_ratio's 1.0 here is no measured ratio: say why they agree.
-                c.agree.push(format!("{q} (both cones exact)"));
-            } else {
-                c.agree.push(q.to_string());
+        }
+        for method in Method::compared(&CONES) {
+            for base in self
+                .rates
+                .iter()
+                .filter(|r| r.method == reference && r.quantity.is_contact())
+            {
+                let q = base.quantity;
+                let Some(other) = self.rate(method, q) else {
+                    continue;
+                };
+                if c.not_compared.contains(&q.to_string()) {
+                    continue;
+                }
+                let (Some(a), Some(b)) = (self.error(base), self.error(other)) else {
+                    continue;
+                };
+                let ratio = error_ratio(base.verdict, other.verdict, a, b);
+                if !(1.0 / SEPARATES..=SEPARATES).contains(&ratio) {
+                    c.separate.push(Separation {
+                        quantity: q,
+                        method,
+                        ratio,
+                        reference_error: a,
+                        other_error: b,
+                        reference: base,
+                        other,
+                    });
+                } else if base.verdict == Verdict::RoundOff && other.verdict == Verdict::RoundOff {
+                    // error_ratio's 1.0 here is no measured ratio: say why they agree.
+                    c.agree.push((method, format!("{q} (both exact)")));
+                } else {
+                    c.agree.push((method, q.to_string()));
+                }
             }
         }
         c
@@ -207,30 +221,38 @@ impl Report {
             .filter(|r| r.verdict == Verdict::NotConverging && !r.quantity.is_distance())
     }
 
-    /// What nts's distance to mortar supports of nts's rate in `q`, where measured.
-    pub(crate) fn asymptote(&self, q: Quantity) -> Option<&AsymptoteRow> {
+    /// What `method`'s distance to mortar supports of its rate in `q`, where measured.
+    pub(crate) fn asymptote(&self, method: Method, q: Quantity) -> Option<&AsymptoteRow> {
         self.asymptotes
             .iter()
-            .find(|a| a.method == Method::Nts && a.quantity == q)
+            .find(|a| a.method == method && a.quantity == q)
     }
 
-    /// The distance between the cones and the consistency terms, as a sentence; None where
-    /// the study does not measure it.
+    /// The distance of each method to mortar and the consistency terms, as a sentence;
+    /// None where the study does not measure it.
     pub(crate) fn distance_text(&self) -> Option<String> {
-        let d = self.rate(Method::Nts, Quantity::ConeDistance)?;
-        let mut out = format!(
-            "the distance D between the cones' solutions (Theorem 3.1's norm) falls at {}",
-            rate_text(d)
-        );
-        if let Some(a) = self.asymptote(Quantity::Theorem) {
-            out.push_str(&format!(
-                " (D / e_mortar {:.2} at level {}, largest abs(pythagorean) {:.1e}): nts's theorem norm {}",
-                a.finest_ratio.unwrap_or(f64::NAN),
-                a.finest_level,
-                a.largest_pythagorean.unwrap_or(f64::NAN),
-                a.describe()
-            ));
+        let reference = Method::reference();
+        let parts: Vec<String> = Method::compared(&CONES)
+            .filter_map(|m| {
+                let d = self.rate(m, Quantity::ConeDistance)?;
+                let mut out = format!("{m}'s distance D to {reference} falls at {}", rate_text(d));
+                if let Some(a) = self.asymptote(m, Quantity::Theorem) {
+                    // No ratio is written where the study measured none (never a NaN).
+                    let ratio = a.finest_ratio.map_or("-".into(), |v| format!("{v:.2}"));
+                    let pythagorean = a.largest_pythagorean.map_or("-".into(), |v| format!("{v:.1e}"));
+                    out.push_str(&format!(
+                        " (D / e_{reference} {ratio} at level {}, largest abs(pythagorean) {pythagorean}): {m}'s theorem norm {}",
+                        a.finest_level,
+                        a.describe()
+                    ));
+                }
+                Some(out)
+            })
+            .collect();
+        if parts.is_empty() {
+            return None;
         }
+        let mut out = format!("in Theorem 3.1's norm, {}", parts.join("; "));
         let consistency: Vec<String> = CONES
             .iter()
             .filter_map(|&m| {
@@ -248,71 +270,81 @@ impl Report {
     }
 }
 
-/// nts's error over mortar's; a cone at round-off is exact: infinite where mortar is, 0
-/// where nts is, 1 where both are (rather than a ratio of round-off).
-pub(crate) fn error_ratio(mortar: Verdict, nts: Verdict, mortar_error: f64, nts_error: f64) -> f64 {
+/// The other method's error over the reference's; a method at round-off is exact:
+/// infinite where the reference is, 0 where the other is, 1 where both are (rather than a
+/// ratio of round-off).
+pub(crate) fn error_ratio(reference: Verdict, other: Verdict, reference_error: f64, other_error: f64) -> f64 {
     let exact = |v: Verdict| v == Verdict::RoundOff;
-    match (exact(mortar), exact(nts)) {
+    match (exact(reference), exact(other)) {
         (true, true) => 1.0,
         (true, false) => f64::INFINITY,
         (false, true) => 0.0,
-        (false, false) => nts_error / mortar_error,
+        (false, false) => other_error / reference_error,
     }
 }
 
-/// A contact quantity whose errors differ between the cones by more than [`SEPARATES`].
+/// A contact quantity whose errors differ between a method and the reference by more than
+/// [`SEPARATES`].
 pub(crate) struct Separation<'a> {
     pub(crate) quantity: Quantity,
-    /// nts's error over mortar's at the finest level ([`error_ratio`]).
+    /// The method compared with the reference.
+    pub(crate) method: Method,
+    /// The other method's error over the reference's at the finest level ([`error_ratio`]).
     pub(crate) ratio: f64,
-    pub(crate) mortar_error: f64,
-    pub(crate) nts_error: f64,
-    pub(crate) mortar: &'a RateRecord,
-    pub(crate) nts: &'a RateRecord,
+    pub(crate) reference_error: f64,
+    pub(crate) other_error: f64,
+    pub(crate) reference: &'a RateRecord,
+    pub(crate) other: &'a RateRecord,
 }
 
 impl Separation<'_> {
     /// "nts/mortar = 63", "nts/mortar = 2.99", "mortar exact" or "nts exact".
     pub(crate) fn ratio_text(&self) -> String {
+        let (r, o) = (Method::reference(), self.method);
         if self.ratio.is_infinite() {
-            "mortar exact".to_string()
+            format!("{r} exact")
         } else if self.ratio == 0.0 {
-            "nts exact".to_string()
+            format!("{o} exact")
         } else if self.ratio >= 10.0 {
-            format!("nts/mortar = {:.0}", self.ratio)
+            format!("{o}/{r} = {:.0}", self.ratio)
         } else {
-            format!("nts/mortar = {:.2}", self.ratio)
+            format!("{o}/{r} = {:.2}", self.ratio)
         }
     }
 
-    /// The gap between the cones either way (infinite where one is exact).
+    /// The gap between the two methods either way (infinite where one is exact).
     pub(crate) fn gap(&self) -> f64 {
         self.ratio.max(1.0 / self.ratio)
     }
 
-    /// The headline's cell: "`l2_pressure` 63x (mortar 1.85, nts not converging)".
+    /// The headline's cell: "`l2_pressure` nts/mortar 63x (mortar 1.85, nts not converging)"
+    /// (the method named first, since one study lists several methods against the reference).
     pub(crate) fn headline_text(&self) -> String {
         let q = self.quantity;
-        let (mortar, nts) = (rate_short(self.mortar), rate_short(self.nts));
+        let (r, o) = (Method::reference(), self.method);
+        let (a, b) = (rate_short(self.reference), rate_short(self.other));
         if self.ratio.is_infinite() {
-            format!("`{q}` mortar exact (nts {nts})")
+            format!("`{q}` {r} exact ({o} {b})")
         } else if self.ratio == 0.0 {
-            format!("`{q}` nts exact (mortar {mortar})")
+            format!("`{q}` {o} exact ({r} {a})")
         } else if self.ratio >= 10.0 {
-            format!("`{q}` {:.0}x (mortar {mortar}, nts {nts})", self.ratio)
+            format!("`{q}` {o}/{r} {:.0}x ({r} {a}, {o} {b})", self.ratio)
+        } else if self.ratio >= 1.0 {
+            format!("`{q}` {o}/{r} {:.1}x ({r} {a}, {o} {b})", self.ratio)
         } else {
-            format!("`{q}` {:.1}x (mortar {mortar}, nts {nts})", self.ratio)
+            format!("`{q}` {o}/{r} {:.2}x ({r} {a}, {o} {b})", self.ratio)
         }
     }
 }
 
-/// The contact quantities of a report, by what the cones' errors say.
+/// The contact quantities of a report, by what the methods' errors say against the
+/// reference's.
 #[derive(Default)]
 pub(crate) struct Comparison<'a> {
-    /// Error ratio beyond [`SEPARATES`], in rates.csv's order.
+    /// Error ratio beyond [`SEPARATES`], method by method, in rates.csv's order.
     pub(crate) separate: Vec<Separation<'a>>,
-    /// Within [`SEPARATES`].
-    pub(crate) agree: Vec<String>,
+    /// Within [`SEPARATES`]: the method and the quantity.
+    pub(crate) agree: Vec<(Method, String)>,
     /// No rate the numbers support in some cone, or fixed by equilibrium.
     pub(crate) not_compared: Vec<String>,
 }
@@ -337,13 +369,15 @@ pub(crate) fn study_section(doc: &mut Doc, dir: &Path, name: &str, what: &str) -
         doc.bullet(format!("Theorem 3.1's norm: {}.", theorem.join("; ")));
     }
     plasticity_and_time(doc, dir)?;
-    doc.bullet(format!(
-        "nts at h^(1/2) (the fit and the last judged rate within {NEAR_HALF} of 0.5): {}.",
-        listed(&near_half(&report), "; ", "no quantity")
-    ));
+    for m in Method::compared(&CONES) {
+        doc.bullet(format!(
+            "{m} at h^(1/2) (the fit and the last judged rate within {NEAR_HALF} of 0.5): {}.",
+            listed(&near_half(&report, m), "; ", "no quantity")
+        ));
+    }
     separation_bullets(doc, &report);
     if let Some(text) = report.distance_text() {
-        doc.bullet(format!("Between the cones: {text}."));
+        doc.bullet(format!("Between the methods: {text}."));
     }
     doc.bullet(format!(
         "Does not converge: {}.",
@@ -371,14 +405,14 @@ pub(crate) fn study_section(doc: &mut Doc, dir: &Path, name: &str, what: &str) -
     Ok(())
 }
 
-/// The quantities other than the theorem norm where nts's fitted rate and its last judged
-/// rate are both within [`NEAR_HALF`] of 1/2 (a rate claim: never the fit alone).
-pub(crate) fn near_half(report: &Report) -> Vec<String> {
+/// The quantities other than the theorem norm where `method`'s fitted rate and its last
+/// judged rate are both within [`NEAR_HALF`] of 1/2 (a rate claim: never the fit alone).
+pub(crate) fn near_half(report: &Report, method: Method) -> Vec<String> {
     let near = |v: f64| (v - 0.5).abs() <= NEAR_HALF;
     report
         .rates
         .iter()
-        .filter(|r| r.method == Method::Nts && r.quantity != Quantity::Theorem)
+        .filter(|r| r.method == method && r.quantity != Quantity::Theorem)
         .filter(|r| r.verdict.supports_rate())
         .filter(|r| r.rate.is_some_and(near) && r.last_rate.is_some_and(near))
         .map(|r| {
@@ -392,35 +426,43 @@ pub(crate) fn near_half(report: &Report) -> Vec<String> {
         .collect()
 }
 
-/// The contact quantities that separate the cones at the finest level, those within
-/// [`SEPARATES`], and those not compared.
+/// The contact quantities that separate each method from the reference at the finest
+/// level, those within [`SEPARATES`], and those not compared.
 pub(crate) fn separation_bullets(doc: &mut Doc, report: &Report) {
     let comparison = report.compare_cones();
-    let separate: Vec<String> = comparison
-        .separate
-        .iter()
-        .map(|c| {
-            format!(
-                "{} {} (mortar {:.2e}, {}; nts {:.2e}, {})",
-                c.quantity,
-                c.ratio_text(),
-                c.mortar_error,
-                rate_text(c.mortar),
-                c.nts_error,
-                rate_text(c.nts)
-            )
-        })
-        .collect();
-    let agree = if comparison.agree.is_empty() {
-        String::new()
-    } else {
-        format!(" Within {SEPARATES}x: {}.", comparison.agree.join(", "))
-    };
-    doc.bullet(format!(
-        "Contact quantities that separate the cones at level {} (error ratio beyond {SEPARATES}): {}.{agree}",
-        report.finest,
-        listed(&separate, "; ", "none"),
-    ));
+    let reference = Method::reference();
+    for m in Method::compared(&CONES) {
+        if report.rate(m, Quantity::Theorem).is_none() && !comparison.agree.iter().any(|a| a.0 == m) && !comparison.separate.iter().any(|c| c.method == m) {
+            continue;
+        }
+        let separate: Vec<String> = comparison
+            .separate
+            .iter()
+            .filter(|c| c.method == m)
+            .map(|c| {
+                format!(
+                    "{} {} ({reference} {:.2e}, {}; {m} {:.2e}, {})",
+                    c.quantity,
+                    c.ratio_text(),
+                    c.reference_error,
+                    rate_text(c.reference),
+                    c.other_error,
+                    rate_text(c.other)
+                )
+            })
+            .collect();
+        let agree: Vec<&str> = comparison.agree.iter().filter(|a| a.0 == m).map(|a| a.1.as_str()).collect();
+        let agree = if agree.is_empty() {
+            String::new()
+        } else {
+            format!(" Within {SEPARATES}x: {}.", agree.join(", "))
+        };
+        doc.bullet(format!(
+            "Contact quantities that separate {m} from {reference} at level {} (error ratio beyond {SEPARATES}): {}.{agree}",
+            report.finest,
+            listed(&separate, "; ", "none"),
+        ));
+    }
     if !comparison.not_compared.is_empty() {
         doc.bullet(format!(
             "Not compared (no rate the numbers support in some cone, or fixed by equilibrium): {}.",

@@ -366,7 +366,7 @@ pub fn against_aligned(doc: &mut Doc, reg: &Regularity, reports: &Path, quantiti
     );
     for (beta, res) in &reg.members {
         for &q in quantities {
-            for m in [Method::Mortar, Method::Nts] {
+            for &m in &res.file.methods {
                 let Some((a, errors)) = judge_aligned(&aligned, *beta, m, q) else {
                     continue;
                 };
@@ -420,7 +420,7 @@ pub fn against_uniform(doc: &mut Doc, reg: &Regularity, reports: &Path, quantiti
     };
     for (beta, res) in &reg.members {
         for &q in quantities {
-            for m in [Method::Mortar, Method::Nts] {
+            for &m in &res.file.methods {
                 let Some(graded) = judge_levels(res, m, q, |_| true) else {
                     continue;
                 };
@@ -479,13 +479,13 @@ pub fn unaligned_findings(
         .iter()
         .map(|(beta, res)| {
             let here = |m: Method| cell(judge_levels(res, m, Quantity::Theorem, |_| true).as_ref());
-            format!(
-                "beta = {beta}: mortar {} (aligned {}), nts {} (aligned {})",
-                here(Method::Mortar),
-                aligned_theorem(&aligned, *beta, Method::Mortar),
-                here(Method::Nts),
-                aligned_theorem(&aligned, *beta, Method::Nts)
-            )
+            let each: Vec<String> = res
+                .file
+                .methods
+                .iter()
+                .map(|&m| format!("{m} {} (aligned {})", here(m), aligned_theorem(&aligned, *beta, m)))
+                .collect();
+            format!("beta = {beta}: {}", each.join(", "))
         })
         .collect();
     out.push(format!(
@@ -497,9 +497,9 @@ pub fn unaligned_findings(
         .members
         .iter()
         .filter_map(|(beta, res)| {
-            let (_, errors) = judge_aligned(&aligned, *beta, Method::Mortar, Quantity::Theorem)?;
+            let (_, errors) = judge_aligned(&aligned, *beta, Method::reference(), Quantity::Theorem)?;
             let a = errors.iter().find(|e| e.0 == finest)?.1;
-            Some(format!("{:.3} (beta = {beta})", res.error(Method::Mortar, finest, Quantity::Theorem)? / a))
+            Some(format!("{:.3} (beta = {beta})", res.error(Method::reference(), finest, Quantity::Theorem)? / a))
         })
         .collect();
     if !ratios.is_empty() {
@@ -508,26 +508,31 @@ pub fn unaligned_findings(
             ratios.join(", ")
         ));
     }
-    let ratio: Vec<String> = reg
-        .members
-        .iter()
-        .filter_map(|(beta, res)| {
-            let l = res.errors.iter().map(|e| e.level).max()?;
-            let d = res.error(Method::Nts, l, Quantity::ConeDistance)?;
-            Some(format!("{:.2} (beta = {beta})", d / res.error(Method::Mortar, l, Quantity::Theorem)?))
-        })
-        .collect();
-    out.push(format!(
-        "nts's distance to mortar over mortar's error at the finest level: {}; D's own verdicts are in the table below.",
-        ratio.join(", ")
-    ));
+    for m in Method::compared(&reg.methods()) {
+        let ratio: Vec<String> = reg
+            .members
+            .iter()
+            .filter_map(|(beta, res)| {
+                let l = res.errors.iter().map(|e| e.level).max()?;
+                let d = res.error(m, l, Quantity::ConeDistance)?;
+                Some(format!("{:.2} (beta = {beta})", d / res.error(Method::reference(), l, Quantity::Theorem)?))
+            })
+            .collect();
+        if !ratio.is_empty() {
+            out.push(format!(
+                "{m}'s distance to {} over its error at the finest level: {}; D's own verdicts are in the table below.",
+                Method::reference(),
+                ratio.join(", ")
+            ));
+        }
+    }
     let rows = parity_rows(reg, quantities);
     let alternating: Vec<String> = reg
         .members
         .iter()
-        .flat_map(|(beta, _)| {
+        .flat_map(|(beta, res)| {
             let rows = &rows;
-            [Method::Mortar, Method::Nts].into_iter().flat_map(move |m| {
+            res.file.methods.iter().copied().flat_map(move |m| {
                 quantities.iter().filter_map(move |&q| {
                     let find = |l: Levels| {
                         rows.iter()
@@ -576,7 +581,7 @@ pub fn graded_findings(reg: &Regularity, reports: &Path) -> Result<Vec<String>> 
             .map_or(String::new(), |f| format!(", {:.3} in dofs", -f.rate))
     };
     let mut out = Vec::new();
-    for m in [Method::Mortar, Method::Nts] {
+    for m in reg.methods() {
         let per_beta: Vec<String> = reg
             .members
             .iter()
@@ -594,24 +599,25 @@ pub fn graded_findings(reg: &Regularity, reports: &Path) -> Result<Vec<String>> 
             .collect();
         out.push(format!("{m}, theorem norm on graded meshes: {}.", per_beta.join("; ")));
     }
-    let distance: Vec<String> = reg
-        .members
-        .iter()
-        .map(|(beta, res)| {
-            let l = res.errors.iter().map(|e| e.level).max().unwrap_or(0);
-            let ratio = res
-                .error(Method::Nts, l, Quantity::ConeDistance)
-                .zip(res.error(Method::Mortar, l, Quantity::Theorem))
-                .map_or("-".into(), |(d, e)| format!("{:.2}", d / e));
-            format!(
-                "beta = {beta}: D {}, D / e_mortar {ratio} at level {l}",
-                cell(judge_levels(res, Method::Nts, Quantity::ConeDistance, |_| true).as_ref())
-            )
-        })
-        .collect();
-    out.push(format!(
-        "Grading removes the singular part's limit on mortar's rate, not nts's consistency error: nts's distance to mortar {}.",
-        distance.join("; ")
-    ));
+    for m in Method::compared(&reg.methods()) {
+        let distance: Vec<String> = reg
+            .members
+            .iter()
+            .map(|(beta, res)| {
+                let l = res.errors.iter().map(|e| e.level).max().unwrap_or(0);
+                let ratio = res
+                    .error(m, l, Quantity::ConeDistance)
+                    .zip(res.error(Method::reference(), l, Quantity::Theorem))
+                    .map_or("-".into(), |(d, e)| format!("{:.2}", d / e));
+                format!(
+                    "beta = {beta}: D {}, D / e_{} {ratio} at level {l}",
+                    cell(judge_levels(res, m, Quantity::ConeDistance, |_| true).as_ref()),
+                    Method::reference()
+                )
+            })
+            .collect();
+        out.push(format!("{m}'s distance to {} on graded meshes: {}.", Method::reference(), distance.join("; ")));
+    }
+    out.push("Grading removes the singular part's limit on mortar's rate, not nts's consistency error (nts's distance above).".into());
     Ok(out)
 }

@@ -60,11 +60,12 @@ struct DecompositionCsv {
     pythagorean: f64,
 }
 
-/// D / e_mortar in the theorem norm at a study's finest level.
-fn finest_ratio(res: &StudyResult) -> Option<f64> {
+/// `method`'s distance to mortar over mortar's error, D / e_mortar, in the theorem norm at
+/// a study's finest level.
+fn finest_ratio(res: &StudyResult, method: Method) -> Option<f64> {
     let finest = res.errors.iter().map(|e| e.level).max()?;
-    let d = res.error(Method::Nts, finest, Quantity::ConeDistance)?;
-    Some(d / res.error(Method::Mortar, finest, Quantity::Theorem)?)
+    let d = res.error(method, finest, Quantity::ConeDistance)?;
+    Some(d / res.error(Method::reference(), finest, Quantity::Theorem)?)
 }
 
 /// One row of the regularity study's rates.csv.
@@ -156,6 +157,14 @@ impl Regularity {
         matches!(self.family.placement, Placement::Graded { .. })
     }
 
+    /// The methods the family's studies solve, in the registry's order.
+    pub(super) fn methods(&self) -> Vec<Method> {
+        Method::ALL
+            .into_iter()
+            .filter(|m| self.members.iter().any(|(_, res)| res.file.methods.contains(m)))
+            .collect()
+    }
+
     fn row(&self, beta: f64, m: Method, q: Quantity) -> Option<&RateRow> {
         self.members
             .iter()
@@ -192,13 +201,16 @@ impl Regularity {
                     None => format!("{m} not measured"),
                 };
                 let dagger = if theorem_applies(*beta) { "" } else { " †" };
-                let ratio = finest_ratio(res).map_or(String::new(), |r| format!("; D / e_mortar at the finest level {r:.2}"));
+                let ratios: Vec<String> = Method::compared(&res.file.methods)
+                    .filter_map(|m| finest_ratio(res, m).map(|r| format!("{m} {r:.2}")))
+                    .collect();
+                let ratio = match ratios.is_empty() {
+                    true => String::new(),
+                    false => format!("; D / e_{} at the finest level {}", Method::reference(), ratios.join(", ")),
+                };
                 let which = if self.graded() { "best on graded meshes" } else { "best min(1, beta)" };
-                format!(
-                    "beta = {beta}{dagger}: {which} = {best:.2}; {}, {}{ratio}",
-                    say(Method::Mortar),
-                    say(Method::Nts),
-                )
+                let says: Vec<String> = self.methods().into_iter().map(say).collect();
+                format!("beta = {beta}{dagger}: {which} = {best:.2}; {}{ratio}", says.join(", "))
             })
             .collect()
     }
@@ -215,7 +227,7 @@ impl Regularity {
                 let follows_best = self
                     .row(*beta, Method::Nts, Quantity::Theorem)
                     .is_some_and(|r| follows(&r.assessment, best));
-                Some((*beta, finest_ratio(res)?, follows_best))
+                Some((*beta, finest_ratio(res, Method::Nts)?, follows_best))
             })
             .collect();
         rows.sort_by(|a, b| a.1.total_cmp(&b.1));
@@ -272,9 +284,11 @@ impl Regularity {
         }
     }
 
-    /// The table of rates in h, mortar / nts, beside the family's best rates.
+    /// The table of rates in h, one per method, beside the family's best rates.
     fn rates_table(&self, doc: &mut Doc) {
-        doc.heading(2, if self.graded() { "Rates in h, mortar / nts, beside the best graded-mesh rate" } else { "Rates in h, mortar / nts, beside the best uniform-mesh rate" });
+        let methods = self.methods();
+        let names: Vec<&str> = methods.iter().map(|m| m.name()).collect();
+        doc.heading(2, &format!("Rates in h, {}, beside the best {} rate", names.join(" / "), if self.graded() { "graded-mesh" } else { "uniform-mesh" }));
         let mut t = Table::new(
             ["beta"]
                 .into_iter()
@@ -284,15 +298,13 @@ impl Regularity {
         for (beta, _) in &self.members {
             let dagger = if theorem_applies(*beta) { "" } else { " †" };
             t.row(std::iter::once(format!("{beta}{dagger}")).chain(QUANTITIES.iter().map(|&q| {
-                let best = match (q, self.row(*beta, Method::Mortar, Quantity::BestL2Pressure)) {
+                // The nodal methods' best pressure: the reference's space (linear on the trace).
+                let best = match (q, self.row(*beta, Method::reference(), Quantity::BestL2Pressure)) {
                     (Quantity::L2Pressure, Some(b)) => format!(" (best measured {})", cell(Some(b))),
                     _ => self.family.best_rate(q, *beta).map_or(String::new(), |b| format!(" (best {b:.2})")),
                 };
-                format!(
-                    "{} / {}{best}",
-                    cell(self.row(*beta, Method::Mortar, q)),
-                    cell(self.row(*beta, Method::Nts, q))
-                )
+                let cells: Vec<String> = methods.iter().map(|&m| cell(self.row(*beta, m, q))).collect();
+                format!("{}{best}", cells.join(" / "))
             })));
         }
         doc.table(&t);
@@ -423,13 +435,15 @@ impl Regularity {
             .flat_map(|(beta, res)| {
                 QUANTITIES.iter().filter_map(move |&q| {
                     let best = self.family.best_rate(q, *beta).filter(|b| *b < crate::verify::rates::STALLED)?;
-                    let successive = |m: Method| {
-                        res.rate(m, q).map_or("-".into(), |r| r.assessment.successive_text())
-                    };
+                    let successive: Vec<String> = res
+                        .file
+                        .methods
+                        .iter()
+                        .map(|&m| format!("{m} {}", res.rate(m, q).map_or("-".into(), |r| r.assessment.successive_text())))
+                        .collect();
                     Some(format!(
-                        "`{q}` at beta = {beta} (best {best:.2}): successive rates mortar {}, nts {}",
-                        successive(Method::Mortar),
-                        successive(Method::Nts)
+                        "`{q}` at beta = {beta} (best {best:.2}): successive rates {}",
+                        successive.join(", ")
                     ))
                 })
             })
@@ -459,7 +473,8 @@ impl Regularity {
     fn plots(&self, d: &Path) -> Result<()> {
         for q in QUANTITIES {
             let mut series = Vec::new();
-            for (i, m) in [Method::Mortar, Method::Nts].into_iter().enumerate() {
+            for m in self.methods() {
+                let i = plot::method_style(m);
                 let points: Vec<(f64, f64)> = self
                     .members
                     .iter()
@@ -485,7 +500,8 @@ impl Regularity {
                     .join(super::ALIGNED.name)
                     .join("rates.csv");
                 if let Ok(rows) = crate::verify::table::read::<RateCsv>(&path) {
-                    for (i, m) in [Method::Mortar, Method::Nts].into_iter().enumerate() {
+                    for m in self.methods() {
+                        let i = plot::method_style(m);
                         let points: Vec<(f64, f64)> = rows
                             .iter()
                             .filter(|r| r.method == m && r.quantity == q)
@@ -516,7 +532,8 @@ impl Regularity {
                     points,
                     markers: false,
                     line: true,
-                    color: 2,
+                    // The colour after the methods'.
+                    color: Method::ALL.len(),
                     thin: true,
                     shape: None,
                 });

@@ -95,9 +95,8 @@ fn regularity_headline(rows: &[RegularityRate]) -> String {
         format!("{m}'s rate {}", parts.join("; "))
     };
     format!(
-        "**Rates against the regularity of the contact transition** ([`regularity`](reports/regularity/README.md), u ~ r^beta where contact ends, Theorem 3.1's norm against the best uniform-mesh rate min(1, beta)): {}; {}.",
-        cone(Method::Mortar),
-        cone(Method::Nts)
+        "**Rates against the regularity of the contact transition** ([`regularity`](reports/regularity/README.md), u ~ r^beta where contact ends, Theorem 3.1's norm against the best uniform-mesh rate min(1, beta)): {}.",
+        Method::ALL.map(cone).join("; ")
     )
 }
 

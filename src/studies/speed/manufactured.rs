@@ -77,7 +77,7 @@ fn timed(scene: &Scene, name: &str, level: usize, sizes: &[(String, f64)]) -> Re
     while k < n {
         release_free_heap();
         crate::fe::forget_loads();
-        let case = Case::build(scene, level, Method::Mortar, sizes)?;
+        let case = Case::build(scene, level, Method::reference(), sizes)?;
         let model = &case.problem.model;
         n = repeats(model.n_free);
         let (sol, _) = solve_case(&case, SolverKind::Newton, STEPS)?;

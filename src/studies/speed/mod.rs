@@ -283,8 +283,8 @@ pub fn run() -> Result<SpeedResult> {
                 let case = Case::build(&scene, level, method, &sizes(family, false))?;
                 for kind in [SolverKind::Newton, SolverKind::Paper] {
                     // The paper's solver is timed against newton on the two cones of the
-                    // paper; lac is timed with newton, against the floor.
-                    let paper_run = viscoplastic && PAPER_LEVELS.contains(&level) && method != Method::Lac;
+                    // paper; the other methods with newton, against the floor.
+                    let paper_run = viscoplastic && PAPER_LEVELS.contains(&level) && method.in_paper();
                     if kind == SolverKind::Paper && !paper_run {
                         continue;
                     }
@@ -331,7 +331,7 @@ pub fn run() -> Result<SpeedResult> {
     let rcase = Case::build(
         &Scene::load(family.scene)?,
         REFERENCE_LEVEL,
-        Method::Mortar,
+        Method::reference(),
         &sizes(family, true),
     )?;
     let (rsol, _) = solve_case(&rcase, SolverKind::Newton, STEPS)?;

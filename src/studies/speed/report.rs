@@ -287,7 +287,7 @@ fn time_vs_dofs(res: &SpeedResult, d: &Path) -> Result<()> {
                 shape: None,
             });
         }
-        let floor: Vec<(f64, f64)> = family_runs(res, family, Method::Mortar, SolverKind::Newton)
+        let floor: Vec<(f64, f64)> = family_runs(res, family, Method::reference(), SolverKind::Newton)
             .map(|r| (r.run.dofs as f64, floor_of(r)))
             .collect();
         series.push(Series {
@@ -516,7 +516,7 @@ fn bounds_table(res: &SpeedResult) -> Table {
         "applications: newton / floor's single way",
     ]);
     for family in &FAMILIES {
-        for r in family_runs(res, family, Method::Mortar, SolverKind::Newton)
+        for r in family_runs(res, family, Method::reference(), SolverKind::Newton)
             .filter(|r| r.run.dofs >= 10_000)
         {
             let (f, t) = (&r.floor, &r.run.timings);
@@ -597,7 +597,7 @@ fn one_thread_table(res: &SpeedResult) -> Table {
 fn newton_against_paper(res: &SpeedResult) -> Vec<String> {
     let finest = crate::studies::speed::PAPER_LEVELS.iter().max().unwrap();
     let mut out = Vec::new();
-    for m in [Method::Mortar, Method::Nts] {
+    for m in Method::ALL.into_iter().filter(|m| m.in_paper()) {
         let at_finest = |so| family_runs(res, &FAMILIES[0], m, so).find(|r| r.run.level == *finest);
         if let (Some(a), Some(b)) = (at_finest(SolverKind::Newton), at_finest(SolverKind::Paper)) {
             out.push(format!(

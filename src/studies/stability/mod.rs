@@ -487,7 +487,7 @@ fn omega_sweep(rates: &Scene) -> Result<Vec<Variant>> {
 /// The automatic omega of the paper solver on the rates scene at level 1 (mean stiffness
 /// diagonal over mean trace weight), so the sweep is stated relative to it.
 fn omega_auto(scene: &Scene) -> Result<f64> {
-    let case = Case::build(scene, 1, Method::Mortar, &[])?;
+    let case = Case::build(scene, 1, Method::reference(), &[])?;
     let p = &case.problem;
     let (pattern, slots) = p.model.stiffness_pattern(&[], p.model.n_free);
     let mut vals = vec![0.0; pattern.nnz()];

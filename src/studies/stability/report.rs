@@ -22,7 +22,7 @@ pub fn write_stability(res: &StabilityResult, dir: &Path) -> Result<()> {
     })
 }
 
-/// Iterations and difference to newton against each swept parameter (mortar).
+/// Iterations and difference to newton against each swept parameter (the reference method).
 fn sweep_plots(res: &StabilityResult, d: &Path) -> Result<()> {
     for case in HardCase::SWEEPS {
         let sweep = case.sweep().expect("a swept case");
@@ -30,7 +30,7 @@ fn sweep_plots(res: &StabilityResult, d: &Path) -> Result<()> {
         let rows: Vec<_> = res
             .rows
             .iter()
-            .filter(|r| r.case == case && r.method == Method::Mortar)
+            .filter(|r| r.case == case && r.method.is_reference())
             .collect();
         let mut its = Vec::new();
         let mut errs = Vec::new();

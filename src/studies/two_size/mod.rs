@@ -274,7 +274,7 @@ impl Plan {
                 [r - 2, r - 1, r].map(|l| {
                     add(
                         format!("reference {s} level {l}"),
-                        Method::Mortar,
+                        Method::reference(),
                         [l, l],
                         &reference_parameters,
                         s,
