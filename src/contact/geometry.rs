@@ -116,7 +116,7 @@ pub struct MortarSegment {
     /// The interval in body 1's arc length.
     pub s: [f64; 2],
     /// Its Gauss points.
-    pub points: Vec<GaussPoint>,
+    pub points: [GaussPoint; GAUSS.len()],
 }
 
 /// A Gauss point of a mortar segment, with both sides' shape values there.
@@ -139,7 +139,7 @@ pub struct GaussPoint {
 
 /// Gauss-Legendre points on [0, 1] and weights: exact for degree 5, so for the products of
 /// two linear shape functions on a straight piece, which is all the rows integrate there.
-const GAUSS: [(f64, f64); 3] = [
+pub(crate) const GAUSS: [(f64, f64); 3] = [
     (0.112_701_665_379_258_31, 5.0 / 18.0),
     (0.5, 8.0 / 18.0),
     (0.887_298_334_620_741_7, 5.0 / 18.0),
@@ -317,46 +317,63 @@ impl Piece {
     /// with three Gauss points.
     pub fn mortar_segments(&self) -> Vec<MortarSegment> {
         let (ss, ms) = (&self.slave_s, &self.master_s);
-        let mut br: Vec<f64> = ss.iter().chain(ms.iter()).copied().collect();
-        br.sort_by(f64::total_cmp);
-        br.dedup_by(|x, y| (*x - *y).abs() <= 1e-14 * self.length);
-        br.windows(2)
-            .filter(|w| w[1] > w[0])
-            .map(|w| {
-                let (x0, x1) = (w[0], w[1]);
-                let middle = 0.5 * (x0 + x1);
-                let slave = locate(ss, middle).segment;
-                let master = locate(ms, middle).segment;
-                let points = GAUSS
-                    .iter()
-                    .map(|&(xi, w)| {
-                        let s = x0 + xi * (x1 - x0);
-                        let t = (s - ss[slave]) / (ss[slave + 1] - ss[slave]);
-                        let (meet, gap) = self.meet_master(s);
-                        // The middle of the interval decides the master segment: at its
-                        // ends rounding may place a point on the next one.
-                        let on = match meet.segment == master {
-                            true => meet.t,
-                            false => (s - ms[master]) / (ms[master + 1] - ms[master]),
-                        };
-                        GaussPoint {
-                            weight: w * (x1 - x0),
-                            s,
-                            slave: [1.0 - t, t],
-                            master: [1.0 - on, on],
-                            normal: self.normal_at(s),
-                            gap,
-                        }
-                    })
-                    .collect();
-                MortarSegment {
-                    slave,
-                    master,
-                    s: [x0, x1],
-                    points,
+        // Both traces' abscissae are sorted: merge them (no sort) and walk both traces'
+        // segments along (no search per segment); the row assembly is timed against the
+        // solve.
+        let mut br: Vec<f64> = Vec::with_capacity(ss.len() + ms.len());
+        let (mut i, mut j) = (0, 0);
+        while i < ss.len() || j < ms.len() {
+            let take_slave = j == ms.len() || (i < ss.len() && ss[i] <= ms[j]);
+            let x = if take_slave { ss[i] } else { ms[j] };
+            if take_slave {
+                i += 1;
+            } else {
+                j += 1;
+            }
+            match br.last() {
+                Some(&last) if (x - last).abs() <= 1e-14 * self.length => {}
+                _ => br.push(x),
+            }
+        }
+        let mut out = Vec::with_capacity(br.len());
+        let (mut slave, mut master) = (0, 0);
+        for w in br.windows(2).filter(|w| w[1] > w[0]) {
+            let (x0, x1) = (w[0], w[1]);
+            let middle = 0.5 * (x0 + x1);
+            // The segments holding the middle, as `locate` finds them, moving forward only.
+            while slave + 2 < ss.len() && ss[slave + 1] <= middle {
+                slave += 1;
+            }
+            while master + 2 < ms.len() && ms[master + 1] <= middle {
+                master += 1;
+            }
+            let points = GAUSS.map(|(xi, w)| {
+                let s = x0 + xi * (x1 - x0);
+                let t = (s - ss[slave]) / (ss[slave + 1] - ss[slave]);
+                let (meet, gap) = self.meet_master(s);
+                // The middle of the interval decides the master segment: at its ends
+                // rounding may place a point on the next one.
+                let on = match meet.segment == master {
+                    true => meet.t,
+                    false => (s - ms[master]) / (ms[master + 1] - ms[master]),
+                };
+                GaussPoint {
+                    weight: w * (x1 - x0),
+                    s,
+                    slave: [1.0 - t, t],
+                    master: [1.0 - on, on],
+                    normal: self.normal_at(s),
+                    gap,
                 }
-            })
-            .collect()
+            });
+            out.push(MortarSegment {
+                slave,
+                master,
+                s: [x0, x1],
+                points,
+            });
+        }
+        out
     }
 }
 

@@ -98,16 +98,20 @@ impl PieceRow {
     /// <= gap` over the body-2 nodes' coefficients `master` (q, c_q), nu_j the node's
     /// normal. Coefficients below 1e-15 of the largest are dropped: the mortar rows decay
     /// geometrically away from the node, and such entries are below round-off.
-    pub fn nodal(piece: &Piece, j: usize, master: &[(usize, f64)], gap: f64) -> PieceRow {
+    pub fn nodal(
+        piece: &Piece,
+        j: usize,
+        master: impl Iterator<Item = (usize, f64)> + Clone,
+        gap: f64,
+    ) -> PieceRow {
         let nu = piece.slave_normal(j);
-        let big = master.iter().fold(0.0f64, |a, e| a.max(e.1.abs()));
+        let big = master.clone().fold(0.0f64, |a, e| a.max(e.1.abs()));
         PieceRow {
             span: [j, j],
             slave: vec![(j, nu)],
             master: master
-                .iter()
                 .filter(|e| e.1.abs() > 1e-15 * big)
-                .map(|&(q, v)| (q, [-v * nu[0], -v * nu[1]]))
+                .map(|(q, v)| (q, [-v * nu[0], -v * nu[1]]))
                 .collect(),
             weight: piece.lumped_weight(j),
             gap,
@@ -121,7 +125,7 @@ pub fn constraint_rows(model: &Model, interface: &Interface, method: Method) -> 
     let mut rows = Vec::new();
     for (pi, p) in interface.pieces.iter().enumerate() {
         for row in rows_of(p) {
-            let mut entries = Vec::new();
+            let mut entries = Vec::with_capacity(2 * (row.slave.len() + row.master.len()));
             let slave = row.slave.iter().map(|&(j, c)| (p.slave_nodes[j], c));
             let master = row.master.iter().map(|&(q, c)| (p.master_nodes[q], c));
             for (node, coefficient) in slave.chain(master) {

@@ -16,10 +16,7 @@ pub fn rows(piece: &Piece) -> Vec<PieceRow> {
         .iter()
         .zip(gaps)
         .enumerate()
-        .map(|(i, (row, gap))| {
-            let master: Vec<(usize, f64)> = row.iter().copied().enumerate().collect();
-            PieceRow::nodal(piece, i, &master, gap)
-        })
+        .map(|(i, (row, gap))| PieceRow::nodal(piece, i, row.iter().copied().enumerate(), gap))
         .collect()
 }
 

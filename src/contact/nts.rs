@@ -12,7 +12,7 @@ pub fn rows(piece: &Piece) -> Vec<PieceRow> {
             let (meet, gap) = piece.meet_master(piece.slave_s[j]);
             let [a, b] = meet.shape();
             let master = [(meet.segment, a), (meet.segment + 1, b)];
-            PieceRow::nodal(piece, j, &master, gap)
+            PieceRow::nodal(piece, j, master.into_iter(), gap)
         })
         .collect()
 }
