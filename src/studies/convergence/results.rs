@@ -272,14 +272,28 @@ impl Report {
 
 /// The other method's error over the reference's; a method at round-off is exact:
 /// infinite where the reference is, 0 where the other is, 1 where both are (rather than a
-/// ratio of round-off).
+/// ratio of round-off). Two errors exactly equal (both 0 included) give 1, never NaN.
 pub(crate) fn error_ratio(reference: Verdict, other: Verdict, reference_error: f64, other_error: f64) -> f64 {
     let exact = |v: Verdict| v == Verdict::RoundOff;
     match (exact(reference), exact(other)) {
         (true, true) => 1.0,
         (true, false) => f64::INFINITY,
         (false, true) => 0.0,
+        (false, false) if other_error == reference_error => 1.0,
         (false, false) => other_error / reference_error,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn two_zero_errors_are_equal_not_nan() {
+        let v = Verdict::Fitted;
+        assert_eq!(error_ratio(v, v, 0.0, 0.0), 1.0);
+        assert_eq!(error_ratio(v, v, 0.0, 1e-3), f64::INFINITY);
+        assert_eq!(error_ratio(v, v, 2e-3, 1e-3), 0.5);
     }
 }
 
