@@ -157,36 +157,25 @@ impl Report {
     pub(crate) fn compare_cones(&self) -> Comparison<'_> {
         let mut c = Comparison::default();
         let reference = Method::reference();
-        for q in self
+        // The rule of the study's own README (report.rs's quantities_compared): a contact
+        // quantity is compared only where every method's verdict compares the cones.
+        let (compared, left_out): (Vec<&RateRecord>, Vec<&RateRecord>) = self
             .rates
             .iter()
             .filter(|r| r.method == reference && r.quantity.is_contact())
-            .map(|r| r.quantity)
-        {
-            // The rule of the study's own README (report.rs's quantities_compared): a
-            // quantity is compared only where every method's verdict compares the cones.
-            if !self
-                .rates
-                .iter()
-                .filter(|r| r.quantity == q && r.method.cone().is_some())
-                .all(|r| r.verdict.compares_cones())
-            {
-                c.not_compared.push(q.to_string());
-            }
-        }
+            .partition(|base| {
+                self.rates
+                    .iter()
+                    .filter(|r| r.quantity == base.quantity && r.method.cone().is_some())
+                    .all(|r| r.verdict.compares_cones())
+            });
+        c.not_compared = left_out.iter().map(|r| r.quantity.to_string()).collect();
         for method in Method::compared(&CONES) {
-            for base in self
-                .rates
-                .iter()
-                .filter(|r| r.method == reference && r.quantity.is_contact())
-            {
+            for &base in &compared {
                 let q = base.quantity;
                 let Some(other) = self.rate(method, q) else {
                     continue;
                 };
-                if c.not_compared.contains(&q.to_string()) {
-                    continue;
-                }
                 let (Some(a), Some(b)) = (self.error(base), self.error(other)) else {
                     continue;
                 };
@@ -446,7 +435,11 @@ pub(crate) fn separation_bullets(doc: &mut Doc, report: &Report) {
     let comparison = report.compare_cones();
     let reference = Method::reference();
     for m in Method::compared(&CONES) {
-        if report.rate(m, Quantity::Theorem).is_none() && !comparison.agree.iter().any(|a| a.0 == m) && !comparison.separate.iter().any(|c| c.method == m) {
+        // A method the study does not solve gets no bullet.
+        let measured = report.rate(m, Quantity::Theorem).is_some()
+            || comparison.agree.iter().any(|a| a.0 == m)
+            || comparison.separate.iter().any(|c| c.method == m);
+        if !measured {
             continue;
         }
         let separate: Vec<String> = comparison

@@ -2,6 +2,7 @@
 //! judged on its own, where the transition point sits among the trace nodes, and the rates
 //! beside the aligned uniform family's (read from its committed report, reports/regularity).
 
+use super::report::finest_ratio;
 use super::{ALIGNED, PlacementRow, Regularity};
 use crate::contact::Method;
 use crate::error::Result;
@@ -463,6 +464,27 @@ fn aligned_theorem(rows: &[AlignedError], beta: f64, m: Method) -> String {
     judge_aligned(rows, beta, m, Quantity::Theorem).map_or("-".into(), |(a, _)| cell(Some(&a)))
 }
 
+/// Per compared method, D / e_mortar at each member's finest level, as a sentence (none
+/// where no member measures D).
+fn distance_ratios(reg: &Regularity) -> Vec<String> {
+    Method::compared(&reg.methods())
+        .filter_map(|m| {
+            let ratio: Vec<String> = reg
+                .members
+                .iter()
+                .filter_map(|(beta, res)| Some(format!("{:.2} (beta = {beta})", finest_ratio(res, m)?)))
+                .collect();
+            (!ratio.is_empty()).then(|| {
+                format!(
+                    "{m}'s distance to {} over its error at the finest level: {}; D's own verdicts are in the table below.",
+                    Method::reference(),
+                    ratio.join(", ")
+                )
+            })
+        })
+        .collect()
+}
+
 /// What the unaligned study learned, in a few sentences of numbers: the cones' theorem-norm
 /// verdicts beside the aligned family's, mortar's error against the aligned one at its
 /// finest level, D / e_mortar, where the parities disagree with the whole, and where c sat.
@@ -508,24 +530,7 @@ pub fn unaligned_findings(
             ratios.join(", ")
         ));
     }
-    for m in Method::compared(&reg.methods()) {
-        let ratio: Vec<String> = reg
-            .members
-            .iter()
-            .filter_map(|(beta, res)| {
-                let l = res.errors.iter().map(|e| e.level).max()?;
-                let d = res.error(m, l, Quantity::ConeDistance)?;
-                Some(format!("{:.2} (beta = {beta})", d / res.error(Method::reference(), l, Quantity::Theorem)?))
-            })
-            .collect();
-        if !ratio.is_empty() {
-            out.push(format!(
-                "{m}'s distance to {} over its error at the finest level: {}; D's own verdicts are in the table below.",
-                Method::reference(),
-                ratio.join(", ")
-            ));
-        }
-    }
+    out.extend(distance_ratios(reg));
     let rows = parity_rows(reg, quantities);
     let alternating: Vec<String> = reg
         .members
@@ -605,10 +610,7 @@ pub fn graded_findings(reg: &Regularity, reports: &Path) -> Result<Vec<String>> 
             .iter()
             .map(|(beta, res)| {
                 let l = res.errors.iter().map(|e| e.level).max().unwrap_or(0);
-                let ratio = res
-                    .error(m, l, Quantity::ConeDistance)
-                    .zip(res.error(Method::reference(), l, Quantity::Theorem))
-                    .map_or("-".into(), |(d, e)| format!("{:.2}", d / e));
+                let ratio = finest_ratio(res, m).map_or("-".into(), |r| format!("{r:.2}"));
                 format!(
                     "beta = {beta}: D {}, D / e_{} {ratio} at level {l}",
                     cell(judge_levels(res, m, Quantity::ConeDistance, |_| true).as_ref()),

@@ -62,7 +62,7 @@ struct DecompositionCsv {
 
 /// `method`'s distance to mortar over mortar's error, D / e_mortar, in the theorem norm at
 /// a study's finest level.
-fn finest_ratio(res: &StudyResult, method: Method) -> Option<f64> {
+pub(super) fn finest_ratio(res: &StudyResult, method: Method) -> Option<f64> {
     let finest = res.errors.iter().map(|e| e.level).max()?;
     let d = res.error(method, finest, Quantity::ConeDistance)?;
     Some(d / res.error(Method::reference(), finest, Quantity::Theorem)?)
