@@ -1214,7 +1214,7 @@ where
 
 /// A legend label's first word: the method or code it names.
 fn first_word(label: &str) -> &str {
-    label.split([' ', ':', '(']).next().unwrap_or("")
+    label.split([' ', ',', ':', '(']).next().unwrap_or("")
 }
 
 /// What a series that lies on `under` adds to its legend: " (= mortar to 1e-4)", the first
