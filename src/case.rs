@@ -117,7 +117,7 @@ impl Case {
         if level > 0 {
             check_memory(scene, &all, level)?;
         }
-        let (generated, raw) = mesh_healed(scene, &all, level)?;
+        let (generated, raw) = mesh_healed(scene, &all, level, &gmsh::cache_dir())?;
         Self::from_mesh(scene, level, method, generated, raw, t0)
     }
 
@@ -140,8 +140,8 @@ impl Case {
         if top > 0 {
             check_memory(scene, &all, top)?;
         }
-        let (g0, r0) = mesh_healed(scene, &all, levels[0])?;
-        let (g1, r1) = mesh_healed(scene, &all, levels[1])?;
+        let (g0, r0) = mesh_healed(scene, &all, levels[0], &gmsh::cache_dir())?;
+        let (g1, r1) = mesh_healed(scene, &all, levels[1], &gmsh::cache_dir())?;
         let raw = msh::RawMesh::combine_bodies(
             &r0,
             &r1,
@@ -159,7 +159,12 @@ impl Case {
         level: usize,
         params: &[(String, f64)],
     ) -> Result<(gmsh::GeneratedMesh, msh::RawMesh)> {
-        mesh_healed(scene, &checked_parameters(scene, params)?, level)
+        mesh_healed(
+            scene,
+            &checked_parameters(scene, params)?,
+            level,
+            &gmsh::cache_dir(),
+        )
     }
 
     /// The case of `scene` on a mesh [`Case::mesh`] gave, at `level`, for `method`: every
@@ -267,26 +272,33 @@ pub fn memory_refusal(
     if level == 0 {
         return Ok(None);
     }
-    // A refusal leaves the mesh cache as it found it: the coarsest mesh meshed here to
-    // count its nodes goes again.
-    let cached = |dir: &std::path::Path| -> std::collections::BTreeSet<std::path::PathBuf> {
-        std::fs::read_dir(dir)
-            .into_iter()
-            .flatten()
-            .flatten()
-            .map(|e| e.path())
-            .collect()
-    };
+    // A refusal leaves the mesh cache as it found it. Level 0, where it is not cached, is
+    // meshed in a folder of its own and moved into the cache only where the level fits:
+    // files that appear in the shared cache meanwhile are other runs' (a concurrent solve
+    // refining the same family), never ours to remove.
     let cache = gmsh::cache_dir();
-    let before = cached(&cache);
-    let (_, raw) = mesh_healed(scene, params, 0)?;
+    let (geo_params, geo_level) = gmsh_call(scene, params, 0);
+    let cached = gmsh::cache_path(&cache, &scene.geo, &geo_params, geo_level)?;
+    let probe = if cached.exists() {
+        None
+    } else {
+        std::fs::create_dir_all(&cache).map_err(|e| Error::io(&cache, e))?;
+        let dir = tempfile::Builder::new()
+            .prefix(".level-0-")
+            .tempdir_in(&cache)
+            .map_err(|e| Error::io(&cache, e))?;
+        Some(dir)
+    };
+    let meshed_in = probe.as_ref().map_or(cache.as_path(), |d| d.path());
+    let (generated, raw) = mesh_healed(scene, params, 0, meshed_in)?;
     let dofs = |l: usize| 2.0 * raw.nodes.len() as f64 * 4f64.powi(l as i32);
     let bytes = |l: usize| dofs(l) * BYTES_PER_DOF;
     if bytes(level) <= available {
+        if probe.is_some() {
+            // Another run may have put it there meanwhile: the same bytes, either is kept.
+            let _ = std::fs::rename(&generated.path, &cached);
+        }
         return Ok(None);
-    }
-    for new in cached(&cache).difference(&before) {
-        let _ = std::fs::remove_file(new);
     }
     let gib = |b: f64| b / (1024.0 * 1024.0 * 1024.0);
     let fits = (0..level)
@@ -321,8 +333,9 @@ fn mesh_healed(
     scene: &Scene,
     params: &[(String, f64)],
     level: usize,
+    cache: &std::path::Path,
 ) -> Result<(gmsh::GeneratedMesh, msh::RawMesh)> {
-    mesh_or_regenerated(scene, params, level).map_err(|e| match e {
+    mesh_or_regenerated(scene, params, level, cache).map_err(|e| match e {
         Error::Input {
             file,
             field,
@@ -357,26 +370,32 @@ fn parameter_list(params: &[(String, f64)]) -> String {
         .join(", ")
 }
 
+/// The gmsh parameters and the number of splits that give `scene`'s mesh at `level`: a
+/// remeshed family meshes the .geo again at each level, `level` one of its parameters.
+fn gmsh_call(scene: &Scene, params: &[(String, f64)], level: usize) -> (Vec<(String, f64)>, usize) {
+    match scene.refinement {
+        Refinement::Split => (params.to_vec(), level),
+        Refinement::Remesh => (
+            params
+                .iter()
+                .cloned()
+                .chain([("level".to_string(), level as f64)])
+                .collect(),
+            0,
+        ),
+    }
+}
+
 /// [`mesh_healed`] before its errors are put on the scene file.
 fn mesh_or_regenerated(
     scene: &Scene,
     params: &[(String, f64)],
     level: usize,
+    cache: &std::path::Path,
 ) -> Result<(gmsh::GeneratedMesh, msh::RawMesh)> {
-    // A remeshed family: the .geo meshed again at each level, `level` one of its parameters.
-    let remeshed: Vec<(String, f64)>;
-    let (params, level) = match scene.refinement {
-        Refinement::Split => (params, level),
-        Refinement::Remesh => {
-            remeshed = params
-                .iter()
-                .cloned()
-                .chain([("level".to_string(), level as f64)])
-                .collect();
-            (&remeshed[..], 0)
-        }
-    };
-    let generated = gmsh::generate(&scene.geo, params, level)?;
+    let (params, level) = gmsh_call(scene, params, level);
+    let params = &params[..];
+    let generated = gmsh::generate_in(cache, &scene.geo, params, level)?;
     match msh::read_msh(&generated.path) {
         Ok(raw) => Ok((generated, raw)),
         Err(_) => {
@@ -385,7 +404,7 @@ fn mesh_or_regenerated(
                 generated.path.display()
             );
             std::fs::remove_file(&generated.path).map_err(|e| Error::io(&generated.path, e))?;
-            let generated = gmsh::generate(&scene.geo, params, level)?;
+            let generated = gmsh::generate_in(cache, &scene.geo, params, level)?;
             let raw = msh::read_msh(&generated.path)?;
             Ok((generated, raw))
         }

@@ -181,19 +181,49 @@ pub struct GeneratedMesh {
 /// Generate (or fetch from the cache) the mesh of `geo` with `params` refined `level` times
 /// by uniform splitting. Level 0 is gmsh's own 2D mesh; level L splits level L-1 (nested).
 pub fn generate(geo: &Path, params: &[(String, f64)], level: usize) -> Result<GeneratedMesh> {
+    generate_in(&cache_dir(), geo, params, level)
+}
+
+/// The cache key of `geo` with `params`: the stem of its files' names and the hash of the
+/// .geo's bytes, the parameters and the gmsh version; with the .geo's own hash and the
+/// version.
+fn cache_key(geo: &Path, params: &[(String, f64)]) -> Result<(String, String, String)> {
     let bytes = std::fs::read(geo).map_err(|e| Error::io(geo, e))?;
     let version = gmsh_version()?;
     let geo_hash = sha256_hex(&bytes);
-    let mut key = bytes.clone();
+    let mut key = bytes;
     for (k, v) in params {
         key.extend_from_slice(format!("\n{k}={v:e}").as_bytes());
     }
     key.extend_from_slice(version.as_bytes());
-    let hash = &sha256_hex(&key)[..20];
-    let dir = cache_dir();
-    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
     let stem = geo.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh");
-    let path_of = |l: usize| dir.join(format!("{stem}-{hash}-L{l}.msh"));
+    let name = format!("{stem}-{}", &sha256_hex(&key)[..20]);
+    Ok((name, geo_hash, version))
+}
+
+/// Where [`generate_in`] keeps (or would keep) the mesh of `geo` with `params` at `level`
+/// in the cache folder `dir`, whether or not it is there.
+pub fn cache_path(
+    dir: &Path,
+    geo: &Path,
+    params: &[(String, f64)],
+    level: usize,
+) -> Result<PathBuf> {
+    let (name, _, _) = cache_key(geo, params)?;
+    Ok(dir.join(format!("{name}-L{level}.msh")))
+}
+
+/// [`generate`] with the cache in the folder `dir`.
+pub fn generate_in(
+    dir: &Path,
+    geo: &Path,
+    params: &[(String, f64)],
+    level: usize,
+) -> Result<GeneratedMesh> {
+    let (name, geo_hash, version) = cache_key(geo, params)?;
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let stem = geo.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh");
+    let path_of = |l: usize| dir.join(format!("{name}-L{l}.msh"));
     // Find the finest cached level at or below `level`.
     let mut have = None;
     for l in (0..=level).rev() {
@@ -206,10 +236,7 @@ pub fn generate(geo: &Path, params: &[(String, f64)], level: usize) -> Result<Ge
     static COUNTER: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let tmp = |l: usize| {
         let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        dir.join(format!(
-            "{stem}-{hash}-L{l}.{}-{n}.tmp.msh",
-            std::process::id()
-        ))
+        dir.join(format!("{name}-L{l}.{}-{n}.tmp.msh", std::process::id()))
     };
     let start = match have {
         Some(l) => l + 1,
