@@ -1,4 +1,5 @@
-//! Constitutive laws of SPEC section 1: plane-stress elasticity `E` and the Perzyna
+//! Constitutive laws of SPEC section 1: elasticity `E` (plane stress, or plane strain where a
+//! scene asks), and the Perzyna
 //! viscoplastic function `G(sigma) = -(1/(2 lambda)) E (sigma - P_B sigma)`, with `P_B` the
 //! projection onto the von Mises set `B` in the `(tau, E tau)` inner product.
 //!
@@ -15,14 +16,39 @@ pub type Stress = Vector3<f64>;
 /// Strain tensor components `[e11, e22, e12]` (dimensionless).
 pub type Strain = Vector3<f64>;
 
-/// Plane-stress isotropic elasticity: `E tau = a tr(tau) I + b tau`,
-/// `a = E nu / (1 - nu^2)`, `b = E / (1 + nu)`.
+/// Isotropic elasticity of the in-plane components: `E tau = a tr(tau) I + b tau`,
+/// `b = E / (1 + nu)` = 2 mu, and `a = E nu / (1 - nu^2)` in plane stress (sigma_33 = 0),
+/// `a = E nu / ((1 + nu) (1 - 2 nu))` = Lame's lambda in plane strain (eps_33 = 0,
+/// sigma_33 = nu (sigma_11 + sigma_22)).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Elasticity {
     /// Young's modulus E (stress units).
     pub young: f64,
     /// Poisson's ratio nu (dimensionless, in (-1, 0.5)).
     pub poisson: f64,
+    /// Which out-of-plane component vanishes.
+    pub plane: Plane,
+}
+
+/// The 2D reduction of the 3D law: which out-of-plane component is zero.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Plane {
+    /// sigma_33 = 0 (a thin plate; the paper's setting).
+    #[default]
+    Stress,
+    /// eps_33 = 0 (a long body: Hertz's cylinder, Lame's tube).
+    Strain,
+}
+
+impl Plane {
+    /// "plane stress" or "plane strain", for reports and exported problems.
+    pub fn label(self) -> &'static str {
+        match self {
+            Plane::Stress => "plane stress",
+            Plane::Strain => "plane strain",
+        }
+    }
 }
 
 /// Perzyna viscoplasticity parameters.
@@ -190,9 +216,30 @@ fn root_step(mu: f64, (v, dv): (f64, f64)) -> (f64, bool) {
 }
 
 impl Elasticity {
-    /// `a = E nu / (1 - nu^2)`.
+    /// The plane-stress elasticity of `young` and `poisson`.
+    pub fn plane_stress(young: f64, poisson: f64) -> Self {
+        Elasticity {
+            young,
+            poisson,
+            plane: Plane::Stress,
+        }
+    }
+    /// `a = E nu / (1 - nu^2)` (plane stress) or `E nu / ((1 + nu) (1 - 2 nu))` (plane
+    /// strain).
     pub fn a(&self) -> f64 {
-        self.young * self.poisson / (1.0 - self.poisson * self.poisson)
+        let nu = self.poisson;
+        match self.plane {
+            Plane::Stress => self.young * nu / (1.0 - nu * nu),
+            Plane::Strain => self.young * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
+        }
+    }
+    /// The out-of-plane stress sigma_33 of the in-plane stress `s`: 0 in plane stress,
+    /// nu (s11 + s22) in plane strain.
+    pub fn sigma_33(&self, s: &Stress) -> f64 {
+        match self.plane {
+            Plane::Stress => 0.0,
+            Plane::Strain => self.poisson * (s[0] + s[1]),
+        }
     }
     /// `b = E / (1 + nu)`.
     pub fn b(&self) -> f64 {

@@ -5,7 +5,7 @@
 use crate::analytical::{Exact, Field};
 use crate::error::{Error, Result};
 pub use crate::expr::{Expr, VectorExpr};
-use crate::material::{Elasticity, Material, Viscoplasticity};
+use crate::material::{Elasticity, Material, Plane, Viscoplasticity};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -67,6 +67,10 @@ pub struct ContactSpec {
     pub slave_curve: String,
     /// Physical-curve name of Gamma_C on the other body (the "master").
     pub master_curve: String,
+    /// The initial gap g0(x, y) >= 0 between the bodies along body 1's outward normal, as
+    /// an expression in x and y on body 1's trace (length), added to the gap between the
+    /// two meshed traces; absent: the bodies touch where their traces do.
+    pub gap: Option<String>,
 }
 
 /// Exact stress: components [s11, s22, s12] or the full tensor [[s11, s12], [s21, s22]]
@@ -181,6 +185,9 @@ pub struct SceneFile {
     pub contact: ContactSpec,
     /// Exact solution, if known.
     pub exact: Option<ExactSpec>,
+    /// The elastic law's 2D reduction, "stress" (default) or "strain", for both bodies.
+    #[serde(default)]
+    pub plane: Plane,
 }
 
 /// How a scene's mesh levels are made.
@@ -260,6 +267,8 @@ pub struct Scene {
     pub master_curve: String,
     /// The exact solution, if known (Box: it holds many expressions).
     pub exact: Option<Box<Exact>>,
+    /// The initial gap g0(x, y) along body 1's normal on Gamma_C (`[contact] gap`; length).
+    pub initial_gap: Option<Expr>,
 }
 
 /// The folder of the built-in scenes.
@@ -376,7 +385,7 @@ impl Scene {
             .unwrap_or_default();
         let geo = geo_path(&sf.geo, file)?;
         check_time(sf.final_time, sf.steps, file)?;
-        let mut bodies = bodies(&sf.bodies, file)?;
+        let mut bodies = bodies(&sf.bodies, sf.plane, file)?;
         let swapped = slave_first(&mut bodies, &sf.contact, file)?;
         let mut claims = Claims::new(file);
         for (i, c) in sf.clamp.iter().enumerate() {
@@ -395,8 +404,13 @@ impl Scene {
             "contact",
             "contact.master_curve".into(),
         )?;
+        let initial_gap = initial_gap(&sf.contact, file)?;
         let exact = match &sf.exact {
-            Some(spec) => Some(Box::new(exact_solution(spec, &mut bodies, swapped, file)?)),
+            Some(spec) => {
+                let mut exact = exact_solution(spec, &mut bodies, swapped, file)?;
+                exact.initial_gap = initial_gap.clone();
+                Some(Box::new(exact))
+            }
             None => None,
         };
         let [b0, b1]: [SceneBody; 2] = bodies.try_into().expect("two bodies");
@@ -416,8 +430,28 @@ impl Scene {
             slave_curve: sf.contact.slave_curve,
             master_curve: sf.contact.master_curve,
             exact,
+            initial_gap,
         })
     }
+}
+
+/// The `[contact] gap` key: an expression in x and y (a gap that changed with t would not
+/// be an initial one). Its sign is checked on the mesh, where body 1's trace is known.
+fn initial_gap(contact: &ContactSpec, file: &Path) -> Result<Option<Expr>> {
+    let Some(text) = &contact.gap else {
+        return Ok(None);
+    };
+    let g = Expr::parse(text, file, "contact.gap")?;
+    if g.reads_time() {
+        return Err(Error::input(
+            file,
+            "contact.gap",
+            format!(
+                "the initial gap '{text}' reads t; write it in x and y only (the gap before any load)"
+            ),
+        ));
+    }
+    Ok(Some(g))
 }
 
 /// The `geo` key: the .geo file relative to the scene file, which must exist.
@@ -452,7 +486,7 @@ fn check_time(final_time: f64, steps: usize, file: &Path) -> Result<()> {
 
 /// The `[[bodies]]` tables: exactly two, each with its material and body force, in file
 /// order.
-fn bodies(specs: &[BodySpec], file: &Path) -> Result<Vec<SceneBody>> {
+fn bodies(specs: &[BodySpec], plane: Plane, file: &Path) -> Result<Vec<SceneBody>> {
     if specs.len() != 2 {
         return Err(Error::input(
             file,
@@ -463,13 +497,13 @@ fn bodies(specs: &[BodySpec], file: &Path) -> Result<Vec<SceneBody>> {
     specs
         .iter()
         .enumerate()
-        .map(|(i, b)| body(i, b, file))
+        .map(|(i, b)| body(i, b, plane, file))
         .collect()
 }
 
 /// Body `i` of the `[[bodies]]` tables: elastic constants, the viscoplastic pair (both or
 /// neither), and the body force.
-fn body(i: usize, b: &BodySpec, file: &Path) -> Result<SceneBody> {
+fn body(i: usize, b: &BodySpec, plane: Plane, file: &Path) -> Result<SceneBody> {
     let f = |k: &str| format!("bodies[{i}].{k}");
     check_positive(file, &f("young"), b.young, "Young's modulus")?;
     if !(b.poisson > -1.0 && b.poisson < 0.5) {
@@ -484,6 +518,17 @@ fn body(i: usize, b: &BodySpec, file: &Path) -> Result<SceneBody> {
     }
     let viscoplastic = match (b.lambda, b.yield_stress) {
         (None, None) => None,
+        (Some(_), Some(_)) if plane == Plane::Strain => {
+            // The von Mises set and its projection are written for sigma_33 = 0.
+            return Err(Error::input(
+                file,
+                "plane",
+                format!(
+                    "body {} is viscoplastic, and the viscoplastic law is plane stress (the von Mises set of sigma_33 = 0); set plane = \"stress\" or make the body elastic (no lambda, no yield_stress)",
+                    b.surface
+                ),
+            ));
+        }
         (Some(l), Some(y)) => {
             check_positive(file, &f("lambda"), l, "the viscosity lambda")?;
             check_positive(file, &f("yield_stress"), y, "the yield stress")?;
@@ -518,6 +563,7 @@ fn body(i: usize, b: &BodySpec, file: &Path) -> Result<SceneBody> {
             elastic: Elasticity {
                 young: b.young,
                 poisson: b.poisson,
+                plane,
             },
             viscoplastic,
         },

@@ -19,7 +19,7 @@ fn expr(s: &str) -> Expr {
 
 fn elastic(young: f64, poisson: f64) -> Material {
     Material {
-        elastic: Elasticity { young, poisson },
+        elastic: Elasticity::plane_stress(young, poisson),
         viscoplastic: None,
     }
 }

@@ -13,10 +13,7 @@ use nalgebra::{Matrix3, Vector3};
 
 fn material(young: f64, lambda: f64) -> Material {
     Material {
-        elastic: Elasticity {
-            young,
-            poisson: 0.3,
-        },
+        elastic: Elasticity::plane_stress(young, 0.3),
         viscoplastic: Some(Viscoplasticity {
             lambda,
             yield_stress: 10f64.sqrt(),
@@ -65,10 +62,7 @@ fn stresses() -> Vec<Stress> {
 
 #[test]
 fn plane_stress_elasticity_and_compliance_are_inverse() {
-    let el = Elasticity {
-        young: 100.0,
-        poisson: 0.3,
-    };
+    let el = Elasticity::plane_stress(100.0, 0.3);
     // a = E nu / (1 - nu^2), b = E / (1 + nu)
     assert!((el.a() - 100.0 * 0.3 / 0.91).abs() < 1e-12);
     assert!((el.b() - 100.0 / 1.3).abs() < 1e-12);
@@ -153,10 +147,7 @@ fn consistent_tangent_matches_central_differences() {
 #[test]
 fn elastic_body_pays_nothing() {
     let m = Material {
-        elastic: Elasticity {
-            young: 100.0,
-            poisson: 0.3,
-        },
+        elastic: Elasticity::plane_stress(100.0, 0.3),
         viscoplastic: None,
     };
     let s = Vector3::new(1e3, -2e3, 5e2);
@@ -171,10 +162,7 @@ fn update_lanes_gives_the_bits_of_update() {
     // Three materials side by side (stiff, viscous, elastic), every group size up to LANES,
     // trial stresses inside and far outside the elastic set.
     let elastic = Material {
-        elastic: Elasticity {
-            young: 100.0,
-            poisson: 0.3,
-        },
+        elastic: Elasticity::plane_stress(100.0, 0.3),
         viscoplastic: None,
     };
     let materials = [material(100.0, 100.0), material(3e5, 100.0), elastic];

@@ -66,10 +66,7 @@ fn project_independent(el: &Elasticity, s: &Stress, y: f64) -> Stress {
 #[test]
 fn mortar_reproduces_the_homogeneous_solution_and_nts_does_not() {
     let steps = 10;
-    let el = Elasticity {
-        young: 3e5,
-        poisson: 0.3,
-    };
+    let el = Elasticity::plane_stress(3e5, 0.3);
     let (lambda, y) = (100.0, 10f64.sqrt());
     // Independent backward Euler: eps^n = eps^{n-1} + E^{-1}(sigma^n - sigma^{n-1} - k G(sigma^n)).
     let k = 1.0 / steps as f64;

@@ -47,6 +47,9 @@ pub struct Exact {
     /// The part of the fields singular at a point, already included in the fields above;
     /// the integrals split each integrand by power of r there ([`Singular`]).
     pub singular: Option<Singular>,
+    /// The scene's initial gap g0(x, y) on Gamma_C (`[contact] gap`), part of the exact
+    /// gap ([`Exact::gap_at`]).
+    pub initial_gap: Option<Expr>,
 }
 
 /// The part of an elastic manufactured solution singular at a point c: a displacement
@@ -148,7 +151,8 @@ pub fn gradient(u: &Displacement) -> [[Expr; 2]; 2] {
 }
 
 /// The stress of an elastic body with displacement gradient `g`: sigma = a tr(eps) I + b eps
-/// (plane stress, a = E nu / (1 - nu^2), b = E / (1 + nu)).
+/// (b = E / (1 + nu); a = E nu / (1 - nu^2) in plane stress, Lame's lambda in plane strain:
+/// [`crate::material::Elasticity::a`]).
 pub fn elastic_stress(material: &Material, g: &[[Expr; 2]; 2]) -> StressField {
     let (a, b) = (material.elastic.a(), material.elastic.b());
     [
@@ -212,6 +216,7 @@ impl Exact {
             source_rate,
             asymmetry: [None, None],
             singular: None,
+            initial_gap: None,
         }
     }
 
@@ -246,6 +251,7 @@ impl Exact {
             source_rate: smooth.source_rate,
             asymmetry: [None, None],
             singular: Some(singular),
+            initial_gap: smooth.initial_gap,
         }
     }
 
@@ -327,13 +333,15 @@ impl Exact {
         Some([u[0].eval(x, y, t), u[1].eval(x, y, t)])
     }
 
-    /// The gap -(u^1 - u^2).n at (x, y, t) on Gamma_C with the slave's outward normal `n`.
+    /// The gap g0 - (u^1 - u^2).n at (x, y, t) on Gamma_C with the slave's outward normal
+    /// `n`, g0 the scene's initial gap (zero where it gives none).
     pub fn gap_at(&self, n: [f64; 2], x: f64, y: f64, t: f64) -> Option<f64> {
         let (u1, u2) = (
             self.displacement_at(0, x, y, t)?,
             self.displacement_at(1, x, y, t)?,
         );
-        Some(-((u1[0] - u2[0]) * n[0] + (u1[1] - u2[1]) * n[1]))
+        let g0 = self.initial_gap.as_ref().map_or(0.0, |g| g.eval(x, y, 0.0));
+        Some(g0 - ((u1[0] - u2[0]) * n[0] + (u1[1] - u2[1]) * n[1]))
     }
 
     /// Contact pressure at (x, y, t) on Gamma_C with the slave's outward normal `n`: the

@@ -55,6 +55,9 @@ pub struct Piece {
     pub master_gap: Vec<f64>,
     /// A curved piece's nodes and normals (None: straight).
     pub curve: Option<CurvedTrace>,
+    /// The scene's initial gap g0(x, y) (`[contact] gap`), added to the gap between the
+    /// traces at every point of body 1's trace (None: no initial gap).
+    pub initial_gap: Option<crate::expr::Expr>,
 }
 
 /// The nodes of a curved piece, where the normal is not constant.
@@ -258,6 +261,23 @@ impl Piece {
     /// Where the normal at arc length `s` meets the master trace: its master segment and
     /// local coordinate there, and the gap along the normal (length; positive: apart).
     pub fn meet_master(&self, s: f64) -> (Location, f64) {
+        let (at, gap) = self.meet_master_trace(s);
+        (at, gap + self.initial_gap_at(s))
+    }
+
+    /// The scene's initial gap g0 at arc length `s` of body 1's trace (length; 0 without one).
+    pub fn initial_gap_at(&self, s: f64) -> f64 {
+        match &self.initial_gap {
+            None => 0.0,
+            Some(g) => {
+                let x = self.point(s);
+                g.eval(x[0], x[1], 0.0)
+            }
+        }
+    }
+
+    /// [`Piece::meet_master`] with the gap between the two meshed traces alone.
+    fn meet_master_trace(&self, s: f64) -> (Location, f64) {
         let at = locate(&self.master_s, s);
         match &self.curve {
             None => {
@@ -291,7 +311,7 @@ impl Piece {
     /// The gap at body-2 node `q`: its distance from body 1's trace along the normal that
     /// passes through it (length).
     pub fn master_node_gap(&self, q: usize) -> f64 {
-        self.master_gap.get(q).copied().unwrap_or(0.0)
+        self.master_gap.get(q).copied().unwrap_or(0.0) + self.initial_gap_at(self.master_s[q])
     }
 
     /// The gap at slave node `j` along its normal (length).
@@ -594,6 +614,8 @@ impl Interface {
         }
         for (piece, edges) in pieces.iter_mut().zip(&faced) {
             piece.add_master(model, edges)?;
+            piece.initial_gap = sc.initial_gap.clone();
+            piece.check_initial_gap(&sc.file)?;
         }
         Ok(Interface { pieces })
     }
@@ -710,10 +732,36 @@ fn slave_piece(model: &Model, slave: &[usize]) -> Result<Piece> {
         breaks: Vec::new(),
         master_gap: Vec::new(),
         curve,
+        initial_gap: None,
     })
 }
 
 impl Piece {
+    /// The initial gap at every trace node of both bodies is finite and not negative.
+    fn check_initial_gap(&self, file: &std::path::Path) -> Result<()> {
+        let Some(g) = &self.initial_gap else {
+            return Ok(());
+        };
+        for &s in self.slave_s.iter().chain(&self.master_s) {
+            let x = self.point(s);
+            let v = g.eval(x[0], x[1], 0.0);
+            if !v.is_finite() {
+                return Err(g.not_finite(file, "contact.gap", x[0], x[1], 0.0));
+            }
+            if v < 0.0 {
+                return Err(Error::input(
+                    file,
+                    "contact.gap",
+                    format!(
+                        "the initial gap '{}' is {v:e} < 0 at ({}, {}) on Gamma_C; an initial gap is a distance between the bodies: make it >= 0 there (bodies that overlap are meshed so)",
+                        g.text, x[0], x[1]
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Where the normal field of body 1's trace passes through the point x: (arc length
     /// s, signed distance along the normal), or None where no normal of the piece does.
     fn through(&self, x: [f64; 2]) -> Option<(f64, f64)> {

@@ -106,6 +106,11 @@ impl Expr {
         )
     }
 
+    /// Whether the expression reads t.
+    pub fn reads_time(&self) -> bool {
+        self.slots.contains(&2) || self.signs.iter().any(|z| z.reads_time())
+    }
+
     /// Whether [`Expr::eval`] runs a compiled [`Program`].
     pub fn is_compiled(&self) -> bool {
         self.program().is_some()

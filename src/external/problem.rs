@@ -54,7 +54,10 @@ pub struct Body {
     pub young: f64,
     /// Poisson's ratio nu.
     pub poisson: f64,
-    /// Plane stress: lambda* = E nu / (1 - nu^2) (stress units).
+    /// "plane stress" or "plane strain" (the same for both bodies).
+    pub plane: String,
+    /// The first Lame-type constant of the 2D law: lambda* = E nu / (1 - nu^2) in plane
+    /// stress, lambda = E nu / ((1 + nu) (1 - 2 nu)) in plane strain (stress units).
     pub lambda_star: f64,
     /// mu = E / (2 (1 + nu)) (stress units).
     pub mu: f64,
@@ -106,6 +109,11 @@ pub struct Contact {
     pub master_curve: String,
     pub roles: String,
     pub condition: String,
+    /// The initial gap g0(x, y) >= 0 along nu^1 (length), an expression evaluated on body
+    /// 1's side of Gamma_C; none: the bodies touch where their curves do.
+    pub gap: Option<String>,
+    /// How the gap enters the condition, where there is one.
+    pub gap_rule: Option<String>,
     pub pieces: Vec<ContactPiece>,
 }
 
@@ -215,7 +223,7 @@ pub fn problem_file(
         scene: scene.name.clone(),
         study: origin.study.map(str::to_string),
         description: scene.description.clone(),
-        model: "2D, small strain, plane stress, frictionless unilateral contact between two bodies, quasistatic; units are the scene's (consistent: length, force, time)".into(),
+        model: format!("2D, small strain, {}, frictionless unilateral contact between two bodies, quasistatic; units are the scene's (consistent: length, force, time)", scene.bodies[0].material.elastic.plane.label()),
         levels: origin.levels.to_vec(),
         syntax: SYNTAX.into(),
         time: Time {
@@ -231,7 +239,9 @@ pub fn problem_file(
             slave_curve: scene.slave_curve.clone(),
             master_curve: scene.master_curve.clone(),
             roles: "the slave curve is body 1's side of Gamma_C, the master curve body 2's; they coincide geometrically but are meshed independently (the nodes do not match)".into(),
-            condition: "frictionless unilateral contact: with nu = nu^1 and [u.nu] = u^1.nu^1 + u^2.nu^2 (positive where the bodies would interpenetrate), [u.nu] <= 0, p >= 0, p [u.nu] = 0 on Gamma_C, where p = -sigma_nn >= 0 is the contact pressure (a traction -p nu^1 on body 1 and -p nu^2 on body 2), and zero tangential traction on both sides".into(),
+            condition: "frictionless unilateral contact: with nu = nu^1 and [u.nu] = u^1.nu^1 + u^2.nu^2 (positive where the bodies would interpenetrate), [u.nu] <= g0, p >= 0, p ([u.nu] - g0) = 0 on Gamma_C, where g0 is the initial gap (contact.gap; 0 where none is given) and p = -sigma_nn >= 0 is the contact pressure (a traction -p nu^1 on body 1 and -p nu^2 on body 2), and zero tangential traction on both sides".into(),
+            gap: scene.initial_gap.as_ref().map(|g| g.text.clone()),
+            gap_rule: scene.initial_gap.as_ref().map(|_| "the bodies are meshed touching (the slave and master curves coincide) and g0 is the distance between them along nu^1 before any load: a point x of body 1's curve meets body 2 where [u.nu](x) = g0(x). A code that takes a gap per constraint uses its own discretization of g0: at the slave nodes for node-on-segment rows (this project's nts), the integral of g0 against each row's test function for mortar rows (mortar: the weighted gap; lac: the mean of g0 over a macro-element). A code that takes geometry only poses it by moving body 2 down by g0 along nu^1 (its contact curve y = g0(x) below body 1's for a flat Gamma_C), with the supports and loads of body 2 unchanged: that is a different mesh, and its measured gap is then its own trace's".into()),
             pieces: interface
                 .pieces
                 .iter()
@@ -259,7 +269,11 @@ fn body(scene: &Scene, b: usize) -> Body {
         poisson,
         lambda_star: m.elastic.a(),
         mu: 0.5 * m.elastic.b(),
-        elasticity: "sigma = E eps(u) = lambda_star tr(eps) I + 2 mu eps (plane stress), eps(u) = (grad u + grad u^T) / 2".into(),
+        plane: m.elastic.plane.label().into(),
+        elasticity: format!("sigma = E eps(u) = lambda_star tr(eps) I + 2 mu eps ({}{}), eps(u) = (grad u + grad u^T) / 2", m.elastic.plane.label(), match m.elastic.plane {
+            crate::material::Plane::Stress => ": sigma_33 = 0",
+            crate::material::Plane::Strain => ": eps_33 = 0, sigma_33 = nu (sigma_11 + sigma_22), lambda_star = Lame's lambda",
+        }),
         body_force: body
             .body_force
             .as_ref()
@@ -395,7 +409,7 @@ fn py_preamble(out: &mut String, problem: &ProblemFile) {
             .collect::<Vec<_>>()
             .join(", ")
     ));
-    line("# Per body (1, 2): plane-stress constants, whether the body is elastic.".into());
+    line("# Per body (1, 2): the 2D law's constants (problem.toml bodies.plane), whether the body is elastic.".into());
     line("bodies = {".into());
     for b in &problem.bodies {
         line(format!(
@@ -439,6 +453,13 @@ fn py_fields(out: &mut String, problem: &ProblemFile) {
             py(&s[1][2])
         )),
         None => line("stress = None".into()),
+    }
+    match &problem.contact.gap {
+        Some(g) => line(format!(
+            "# The initial gap g0(x, y) along nu^1 on Gamma_C (problem.toml contact.gap_rule).\ngap = parse({})",
+            py(g)
+        )),
+        None => line("gap = None".into()),
     }
     match &problem.exact.pressure {
         Some(p) => line(format!("pressure = parse({})", py(p))),
