@@ -330,8 +330,47 @@ impl SingularContact {
 
     /// The scene file of this member, written by `examples/WRITER.rs`, with `description`.
     pub fn scene_toml_as(&self, steps: usize, writer: &str, description: &str) -> String {
+        self.scene_toml_with(steps, writer, description, None)
+    }
+
+    /// The scene of this member across the initial gap g0 = x^2 / (2 R) of [`ClosingGap`]
+    /// (the `gap` study's, written by `examples/regularity_scenes.rs`).
+    pub fn gap_scene_toml(&self, gap: &ClosingGap) -> String {
+        let description = format!(
+            "The singular manufactured solution with beta = {} and its transition at c = ({}, 1) (regularity-unaligned-{:.2}), posed across the initial gap g0 = x^2 / (2 R), R = {}, which body 1's added displacement {} closes on all of Gamma_C (src/analytical/singular.rs, ClosingGap): contact on [0, c), the gap opening like dist^beta beyond, as without g0",
+            self.beta,
+            self.transition(),
+            self.beta,
+            gap.radius,
+            gap.description()
+        );
+        self.scene_toml_with(1, "regularity_scenes", &description, Some(gap))
+    }
+
+    fn scene_toml_with(
+        &self,
+        steps: usize,
+        writer: &str,
+        description: &str,
+        gap: Option<&ClosingGap>,
+    ) -> String {
         let [u1, u2] = [0, 1].map(|l| self.singular_text(l));
-        let [m1, m2] = [0, 1].map(|l| self.smooth_text(l));
+        let [mut m1, m2] = [0, 1].map(|l| self.smooth_text(l));
+        let mut gap_line = String::new();
+        let mut gap_comment = String::new();
+        if let Some(g) = gap {
+            let [cx, cy] = g.displacement_text();
+            // cy reads "-y*...": written as a difference.
+            m1 = [
+                format!("{} + {cx}", m1[0]),
+                format!("{} - {}", m1[1], cy.trim_start_matches('-')),
+            ];
+            gap_line = format!("\ngap = \"{}\"", g.gap_text());
+            gap_comment = format!(
+                "\n# Body 1 (upper) carries the closing part {} (no factor t: it closes g0 at every t,\n# traction-free on y = 1), so that g0 - [u.nu] is the gap without g0.",
+                g.description()
+            );
+        }
         let (geo, parameters) = self.mesh_lines();
         let refinement = match self.placement {
             Placement::Graded { .. } => "\nrefinement = \"remesh\"",
@@ -379,9 +418,9 @@ curve = "right_lower"
 [contact]
 slave_body = "upper"
 slave_curve = "contact_upper"
-master_curve = "contact_lower"
+master_curve = "contact_lower"{gap_line}
 
-# Contact on [0, {a}), separation on ({a}, 1]: pressure {p:.6} t r^({bm1}), gap {g:.6} t r^{beta}.
+# Contact on [0, {a}), separation on ({a}, 1]: pressure {p:.6} t r^({bm1}), gap {g:.6} t r^{beta}.{gap_comment}
 # The displacement is the smooth part below plus the singular part of [exact.singular].
 [exact]
 manufactured = true
@@ -417,5 +456,56 @@ displacement = [
             u2x = u2[0],
             u2y = u2[1],
         )
+    }
+}
+
+/// The initial gap g0(x) = x^2 / (2 R) on Gamma_C (y = 1; a cylinder of radius R over a
+/// plane, to second order) and the displacement of body 1 that closes it: u_g = w(y)
+/// ((y - 1) g0'(x), -g0(x)), w = y (2 - y). On y = 1, w = 1 and w' = 0: u_g = (0, -g0),
+/// so [u_g.nu] = g0 (nu = (0, -1)), and grad u_g = [[0, g0'], [-g0', 0]] is a rotation, so
+/// sigma(u_g) = 0 there: the approach equals g0 on all of Gamma_C and neither the pressure
+/// nor the opening beyond c changes. On the clamp y = 2, w = 0. g0 is a polynomial, so
+/// the body force -div sigma(u_g) is smooth. g0 therefore sets neither the contact zone
+/// nor the pressure: what it changes is the rows' right-hand side and the displacement.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClosingGap {
+    /// R (length).
+    pub radius: f64,
+}
+
+impl ClosingGap {
+    /// The `gap` study's: R = 10, g0 from 0 to 0.05 on [0, 1], of the order of the
+    /// singular part's displacement.
+    pub const STUDY: ClosingGap = ClosingGap { radius: 10.0 };
+
+    /// g0(x) (length).
+    pub fn gap(&self, x: f64) -> f64 {
+        x * x / (2.0 * self.radius)
+    }
+
+    /// g0 as a scene expression.
+    pub fn gap_text(&self) -> String {
+        format!("x^2/{:?}", 2.0 * self.radius)
+    }
+
+    /// u_g as scene expressions.
+    pub fn displacement_text(&self) -> [String; 2] {
+        let r = self.radius;
+        [
+            format!("y*(2-y)*(y-1)*x/{r:?}"),
+            format!("-y*(2-y)*x^2/{:?}", 2.0 * r),
+        ]
+    }
+
+    /// u_g in words, for descriptions.
+    pub fn description(&self) -> String {
+        let [x, y] = self.displacement_text();
+        format!("u_g = ({x}, {y})")
+    }
+
+    /// u_g at (x, y) (length).
+    pub fn displacement(&self, x: f64, y: f64) -> [f64; 2] {
+        let w = y * (2.0 - y);
+        [w * (y - 1.0) * x / self.radius, -w * self.gap(x)]
     }
 }

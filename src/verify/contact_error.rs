@@ -62,13 +62,13 @@ pub fn reference_profile(
     u: &[f64],
     pressure: &PressureProfile,
 ) -> TruthPressure<'static> {
-    let jumps = crate::contact::normal_jumps(reference, u);
+    let jumps = crate::contact::penetrations(reference, u);
     let pressure = project(study, &pressure.concat());
     let gap = project(study, &slave_gaps(reference, &jumps, u));
     TruthPressure::Profile(pressure, gap)
 }
 
-/// The gap -[u.nu] at the body-1 nodes of every piece, as (position, gap), from the
+/// The gap g0 - [u.nu] at the body-1 nodes of every piece, as (position, gap), from the
 /// normal jumps of the displacement `u`. Gaps below 1e-8 of the largest displacement are
 /// round-off of a closed contact: 0.
 fn slave_gaps(
@@ -220,7 +220,7 @@ impl TruthPressure<'_> {
 /// Everything one field of the study on Gamma_C `interface` measures there against the
 /// truth.
 pub fn contact_step(interface: &Interface, s: &P1Field, truth: &TruthPressure) -> ContactStep {
-    let jumps = crate::contact::normal_jumps(interface, &s.u);
+    let jumps = crate::contact::penetrations(interface, &s.u);
     ContactStep {
         pressure: s
             .pressure
@@ -300,12 +300,12 @@ fn pressure_step(
     out
 }
 
-/// ||[u.nu]^+||^2 in L2(Gamma_C): the normal jump is linear between the merged trace
+/// ||([u.nu] - g0)^+||^2 in L2(Gamma_C): the penetration is linear between the merged trace
 /// nodes of both bodies; its positive part squared is integrated exactly.
 pub fn penetration_l2(interface: &Interface, u: &[f64]) -> f64 {
     positive_jump_l2(
         interface.pieces.len(),
-        &crate::contact::normal_jumps(interface, u),
+        &crate::contact::penetrations(interface, u),
     )
 }
 
@@ -361,4 +361,52 @@ pub fn band(model: &Model, interface: &Interface) -> Vec<bool> {
         .iter()
         .map(|e| e.nodes.iter().any(|&n| on[n]))
         .collect()
+}
+
+/// The discrete gap's own error: ||g_h - g||_L2(Gamma_C) and ||g||_L2(Gamma_C) over the
+/// body-1 segments the rows cover (length^(3/2) each), where g is the initial gap between
+/// the two discrete traces along body 1's normal (the scene's g0 where they touch) and g_h
+/// the method's right-hand sides read in its pressure space: linear between the nodes of
+/// nodal rows (mortar, nts), constant on each macro-element (lac). A segment whose two
+/// nodes do not both carry a nodal row (a row dropped where a slave point misses the
+/// master) is left out. 4 Gauss points per segment: exact for a quadratic g0.
+pub fn discrete_gap_error(interface: &Interface, rows: &[crate::contact::Row]) -> (f64, f64) {
+    let gauss = gauss_legendre(4);
+    let (mut error, mut size) = (0.0, 0.0);
+    let mut add = |piece: &Piece, a: f64, b: f64, gh: &dyn Fn(f64) -> f64| {
+        for &(r, w) in &gauss {
+            let s = a + r * (b - a);
+            let g = piece.meet_master(s).1;
+            error += w * (b - a) * (gh(s) - g).powi(2);
+            size += w * (b - a) * g * g;
+        }
+    };
+    for (pi, piece) in interface.pieces.iter().enumerate() {
+        let on_piece: Vec<&crate::contact::Row> = rows.iter().filter(|r| r.piece == pi).collect();
+        let mut nodal = vec![None; piece.slave_s.len()];
+        for row in &on_piece {
+            match row.node() {
+                Some(i) => nodal[i] = Some(row.gap),
+                None => {
+                    let [i, j] = row.span;
+                    let (a, b) = (
+                        piece.slave_s[i].min(piece.slave_s[j]),
+                        piece.slave_s[i].max(piece.slave_s[j]),
+                    );
+                    // The macro-element's segments one by one: g0's kinks sit at nodes.
+                    for k in i.min(j)..i.max(j) {
+                        let (sa, sb) = (piece.slave_s[k].max(a), piece.slave_s[k + 1].min(b));
+                        add(piece, sa, sb, &|_| row.gap);
+                    }
+                }
+            }
+        }
+        for k in 0..piece.slave_s.len().saturating_sub(1) {
+            if let (Some(ga), Some(gb)) = (nodal[k], nodal[k + 1]) {
+                let (a, b) = (piece.slave_s[k], piece.slave_s[k + 1]);
+                add(piece, a, b, &|s| ga + (gb - ga) * (s - a) / (b - a));
+            }
+        }
+    }
+    (error.sqrt(), size.sqrt())
 }

@@ -85,11 +85,16 @@ pub enum Quantity {
     /// D in the normal jump [u.nu], L2(Gamma_C), relative as l2_penetration.
     #[serde(rename = "cone_distance_normal_jump")]
     ConeDistanceNormalJump,
+    /// ||g_h - g||_L2(Gamma_C) / ||g||_L2(Gamma_C): the method's discrete initial gap (its
+    /// rows' right-hand sides in its pressure space) against the initial gap g between the
+    /// traces, measured where a scene has one (`verify::contact_error::discrete_gap_error`).
+    #[serde(rename = "discrete_gap")]
+    DiscreteGap,
 }
 
 impl Quantity {
     /// Every quantity, in the order reports list them.
-    pub const ALL: [Quantity; 20] = [
+    pub const ALL: [Quantity; 21] = [
         Quantity::Theorem,
         Quantity::H1U,
         Quantity::L2U,
@@ -110,6 +115,7 @@ impl Quantity {
         Quantity::ConeDistanceBandStress,
         Quantity::ConeDistanceL2Pressure,
         Quantity::ConeDistanceNormalJump,
+        Quantity::DiscreteGap,
     ];
 
     /// The distances between the two cones (measured between two solutions, not against
@@ -151,7 +157,8 @@ impl Quantity {
     }
 
     /// The quantities measured on Gamma_C and next to it, where the cones differ.
-    pub const CONTACT: [Quantity; 8] = [
+    pub const CONTACT: [Quantity; 9] = [
+        Quantity::DiscreteGap,
         Quantity::BandStress,
         Quantity::ContactEdge,
         Quantity::L2Pressure,
@@ -191,7 +198,7 @@ impl Quantity {
                 "the error of the best approximation of the exact pressure in the method's own pressure space (piecewise linear on the body-1 trace for mortar and nts, constant per macro-element for lac): what no solution in that space can beat (exact studies only)."
             }
             Quantity::MaxPenetration => {
-                "the largest interpenetration [u.nu]^+ on Gamma_C, relative to max |u_ref|."
+                "the largest interpenetration ([u.nu] - g0)^+ on Gamma_C (g0 the initial gap, 0 where the bodies touch), relative to max |u_ref|."
             }
             Quantity::BandStress => {
                 "the stress's error on the one layer of triangles that touch Gamma_C, relative to the stress norm over both bodies: where a contact condition's consistency error sits (a fixed error in that layer shows as h^(1/2))."
@@ -209,7 +216,7 @@ impl Quantity {
                 "|TV(p) - TV(p_ref)|, the error of the pressure's total variation along Gamma_C, relative to max(TV(p_ref), max |p_ref|) (the second keeps it defined for a constant truth): oscillations an L2 error may hide."
             }
             Quantity::L2Penetration => {
-                "the L2(Gamma_C) norm of the interpenetration [u.nu]^+, relative to |Gamma_C|^(1/2) max |u_ref|."
+                "the L2(Gamma_C) norm of the interpenetration ([u.nu] - g0)^+, relative to |Gamma_C|^(1/2) max |u_ref|."
             }
             Quantity::Consistency => {
                 "Proposition 3.1's consistency term |int_Gamma_C sigma_nu [u_h.nu]|^(1/2) with the exact sigma_nu, relative to the exact energy norm: the part of the error a discrete contact condition adds (0 for a cone inside the continuous one)."
@@ -227,6 +234,9 @@ impl Quantity {
             }
             Quantity::ConeDistanceNormalJump => {
                 "D in the normal jump [u.nu] on Gamma_C, relative as l2_penetration."
+            }
+            Quantity::DiscreteGap => {
+                "the method's discrete initial gap (its rows' right-hand sides: linear between the body-1 nodes for mortar and nts, constant per macro-element for lac) against the initial gap between the traces, in L2(Gamma_C), relative to the gap's norm (scenes with a gap only)."
             }
         }
     }
@@ -254,6 +264,7 @@ impl Quantity {
             Quantity::ConeDistanceBandStress => "cone_distance_band_stress",
             Quantity::ConeDistanceL2Pressure => "cone_distance_l2_pressure",
             Quantity::ConeDistanceNormalJump => "cone_distance_normal_jump",
+            Quantity::DiscreteGap => "discrete_gap",
         }
     }
 }

@@ -324,6 +324,12 @@ pub struct StudyFile {
     /// report sets beside this one's, at the levels both measure (reports/COMPARE).
     #[serde(default)]
     pub compare: Option<String>,
+    /// Another built-in study on the same meshes whose committed errors (reports/BESIDE)
+    /// the report sets beside this one's, level by level and method by method: what this
+    /// study's scene adds to that one's (the `gap` study beside regularity-unaligned's
+    /// beta = 1.5).
+    #[serde(default)]
+    pub beside: Option<String>,
 }
 
 fn default_solver() -> SolverKind {
@@ -750,6 +756,16 @@ impl LoadedStudy {
             Some(name) => Some(study_scene(&path, name)?),
             None => None,
         };
+        if file.quantities.contains(&Quantity::DiscreteGap) && scene.initial_gap.is_none() {
+            return Err(Error::input(
+                &path,
+                "quantities",
+                format!(
+                    "discrete_gap measures the rows' initial gap, and scene '{}' gives none; add `gap = \"g0(x, y)\"` to its [contact] table or drop discrete_gap from the quantities",
+                    scene.name
+                ),
+            ));
+        }
         if file.reference.exact {
             check_covered(&file, &scene, &path)?;
             if let Some(ts) = &time_scene {
@@ -812,6 +828,8 @@ pub fn needs(q: Quantity) -> &'static [Field] {
         Quantity::ConeDistanceL2Stress | Quantity::ConeDistanceBandStress => &[Field::Stress],
         Quantity::ConeDistanceL2Pressure => &[Field::Pressure],
         Quantity::ConeDistanceNormalJump => &[],
+        // The scene's gap against the rows': no field of the solution.
+        Quantity::DiscreteGap => &[],
     }
 }
 

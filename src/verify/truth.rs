@@ -246,12 +246,13 @@ pub fn exact_errors(
     (errors, scale)
 }
 
-/// The largest interpenetration over a solution's history (length).
+/// The largest interpenetration [u.nu] - g0 over a solution's history (length; g0 the
+/// initial gap between the discrete traces at each trace node).
 pub fn history_penetration(history: &P1History) -> f64 {
     history
         .steps
         .iter()
-        .flat_map(|s| crate::contact::normal_jumps(history.interface, &s.u))
+        .flat_map(|s| crate::contact::penetrations(history.interface, &s.u))
         .map(|j| j.2)
         .fold(0.0f64, f64::max)
 }
@@ -301,13 +302,14 @@ pub fn relative_errors(
     (differences.relative(), differences.scale())
 }
 
-/// |int_Gamma_C sigma_nu [u_h.nu]|^(1/2) at one step, sigma_nu = nu^1 . sigma nu^1 of the
-/// exact slave stress (zero where the bodies separate) and [u_h.nu] linear between the merged
+/// |int_Gamma_C sigma_nu ([u_h.nu] - g0)|^(1/2) at one step, sigma_nu = nu^1 . sigma nu^1 of
+/// the exact slave stress (zero where the bodies separate), g0 the initial gap between the
+/// discrete traces (zero where they touch) and [u_h.nu] - g0 linear between the merged
 /// trace nodes of both bodies: 8 Gauss points per stretch between breakpoints (the traces'
 /// nodes and the exact fields' kinks).
 pub fn consistency_term(interface: &Interface, s: &P1Field, exact: &Exact) -> f64 {
     let gauss = crate::quadrature::gauss_legendre(8);
-    let jumps = crate::contact::normal_jumps(interface, &s.u);
+    let jumps = crate::contact::penetrations(interface, &s.u);
     let kinks = crate::expr::kink_functions(&exact.contact_kinks(), s.time);
     let mut total = 0.0;
     for (pi, piece) in interface.pieces.iter().enumerate() {

@@ -445,10 +445,12 @@ fn readme(res: &StudyResult) -> String {
     let mut doc = Doc::new();
     title(&mut doc, res);
     super::distance_report::lead(&mut doc, res);
+    super::beside_report::lead(&mut doc, res);
     super::lac_report::section(&mut doc, res);
     super::best_report::section(&mut doc, res);
     cones_compared(&mut doc, res);
     super::distance_report::section(&mut doc, res);
+    super::beside_report::section(&mut doc, res);
     doc.image("error against h", "error_vs_h.png");
     rates_table(&mut doc, res);
     errors_table(&mut doc, res);
