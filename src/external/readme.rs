@@ -36,7 +36,7 @@ pub fn export_readme(
     out.push_str("## Files\n\n| file | what |\n|---|---|\n");
     out.push_str("| `mesh_L.msh` | level L's mesh of both bodies, gmsh MSH 4.1 ASCII |\n");
     out.push_str("| `mesh_L.msh22.msh` | the same mesh in MSH 2.2 ASCII, for readers of the older format (GetFEM 5.4) |\n");
-    out.push_str("| `problem.toml` | the physics: materials as numbers (plane stress lambda* and mu beside E and nu), supports, tractions, Gamma_C with its normals, time steps, and the loads and exact fields as expressions (syntax in its `syntax` key) |\n");
+    out.push_str("| `problem.toml` | the physics: materials as numbers (the 2D law's lambda* and mu beside E and nu, `bodies.plane`), supports, tractions, Gamma_C with its normals, time steps, and the loads and exact fields as expressions (syntax in its `syntax` key) |\n");
     out.push_str("| `problem.py` | the same expressions as sympy expressions and callables (`pip install sympy`); `python3 problem.py` checks every derived field against sympy's own derivatives |\n");
     out.push_str("| `loads_L.csv` | the P1-consistent nodal loads of level L at every step (step, t, node, fx, fy): body forces and tractions integrated exactly across the kinks of the exact fields, as this project's solver does |\n");
     if viscoplastic {
@@ -49,7 +49,14 @@ pub fn export_readme(
         let _ = writeln!(out, "| {level} | {h:.6} | {nodes} | {triangles} |");
     }
     out.push_str(MESH_TEXT);
-    out.push_str(SOLVE_TEXT);
+    let plane = scene.bodies[0].material.elastic.plane.label();
+    out.push_str(&SOLVE_TEXT.replace(
+        "Two bodies, plane stress,",
+        &format!("Two bodies, {plane},"),
+    ));
+    if let Some(g) = &scene.initial_gap {
+        let _ = write!(out, "{}", GAP_TEXT.replace("G0", &g.text));
+    }
     out.push_str(&loading_text(family, loading, viscoplastic));
     out.push_str(SUPPORTS_TEXT);
     if viscoplastic {
@@ -147,6 +154,20 @@ choice: mortar, node-to-segment, penalty, Nitsche, augmented Lagrangian.
 
 Body 1 is the slave (its nodes carry the rows of the discrete condition in this project):
 GetFEM's slave region, MOOSE's secondary boundary. Body 2 is the master (primary).
+";
+
+const GAP_TEXT: &str = "
+### The initial gap
+
+This problem has an initial gap g0 = G0 (`contact.gap`, length) between the bodies along nu^1:
+the condition reads [u.nu] <= g0, p >= 0, p ([u.nu] - g0) = 0. The meshes are touching (the
+two contact curves coincide); pose the gap as data, per constraint, the way your code takes
+one: at the slave nodes for node-to-segment constraints, weighted by each multiplier's test
+function for mortar constraints (the weighted gap, integral of g0 psi_i), averaged over a
+patch for averaged constraints (`contact.gap_rule` in `problem.toml`). A code that takes
+geometry only must move body 2's contact curve by g0 along nu^1, away from body 1: that is a
+different mesh, graded on its own. Penetration is graded against g0 on your mesh's
+Gamma_C: the largest ([u.nu] - g0)^+ and its L2 norm.
 ";
 
 const VISCOPLASTIC_TEXT: &str = "

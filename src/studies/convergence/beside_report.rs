@@ -135,7 +135,7 @@ pub fn section(doc: &mut Doc, res: &StudyResult) {
     };
     doc.heading(2, &format!("Beside {other}, level by level"))
         .paragraph(format!(
-            "Each method's errors here and in reports/{other} (its committed errors.csv) on the same meshes (the dofs of every level checked equal), each relative to its own problem's exact solution, and their ratio: where the ratio stays near 1, what this study's scene adds is measured to cost nothing beyond the other's error."
+            "Each method's errors here and in reports/{other} (its committed errors.csv) on the same meshes (the dofs of every level checked equal), each relative to its own problem's exact solution, and their ratio. A ratio constant over the levels is the same rate, and an error that differs only by the ratio of the two problems' norms where this study's scene changes the solution's size; `-` where the other study does not measure the quantity."
         ));
     let quantities: Vec<Quantity> = BESIDE
         .into_iter()
