@@ -277,8 +277,8 @@ pub fn memory_refusal(
     // files that appear in the shared cache meanwhile are other runs' (a concurrent solve
     // refining the same family), never ours to remove.
     let cache = gmsh::cache_dir();
-    let (geo_params, geo_level) = gmsh_call(scene, params, 0);
-    let cached = gmsh::cache_path(&cache, &scene.geo, &geo_params, geo_level)?;
+    let (geo_params, geo_level, split) = gmsh_call(scene, params, 0);
+    let cached = gmsh::cache_path(&cache, &scene.geo, &geo_params, geo_level, split)?;
     let probe = if cached.exists() {
         None
     } else {
@@ -372,9 +372,14 @@ fn parameter_list(params: &[(String, f64)]) -> String {
 
 /// The gmsh parameters and the number of splits that give `scene`'s mesh at `level`: a
 /// remeshed family meshes the .geo again at each level, `level` one of its parameters.
-fn gmsh_call(scene: &Scene, params: &[(String, f64)], level: usize) -> (Vec<(String, f64)>, usize) {
+fn gmsh_call(
+    scene: &Scene,
+    params: &[(String, f64)],
+    level: usize,
+) -> (Vec<(String, f64)>, usize, gmsh::Split) {
     match scene.refinement {
-        Refinement::Split => (params.to_vec(), level),
+        Refinement::Split => (params.to_vec(), level, gmsh::Split::Chords),
+        Refinement::Curved => (params.to_vec(), level, gmsh::Split::OnCurves),
         Refinement::Remesh => (
             params
                 .iter()
@@ -382,6 +387,7 @@ fn gmsh_call(scene: &Scene, params: &[(String, f64)], level: usize) -> (Vec<(Str
                 .chain([("level".to_string(), level as f64)])
                 .collect(),
             0,
+            gmsh::Split::Chords,
         ),
     }
 }
@@ -393,9 +399,9 @@ fn mesh_or_regenerated(
     level: usize,
     cache: &std::path::Path,
 ) -> Result<(gmsh::GeneratedMesh, msh::RawMesh)> {
-    let (params, level) = gmsh_call(scene, params, level);
+    let (params, level, split) = gmsh_call(scene, params, level);
     let params = &params[..];
-    let generated = gmsh::generate_in(cache, &scene.geo, params, level)?;
+    let generated = gmsh::generate_in(cache, &scene.geo, params, level, split)?;
     match msh::read_msh(&generated.path) {
         Ok(raw) => Ok((generated, raw)),
         Err(_) => {
@@ -404,7 +410,7 @@ fn mesh_or_regenerated(
                 generated.path.display()
             );
             std::fs::remove_file(&generated.path).map_err(|e| Error::io(&generated.path, e))?;
-            let generated = gmsh::generate_in(cache, &scene.geo, params, level)?;
+            let generated = gmsh::generate_in(cache, &scene.geo, params, level, split)?;
             let raw = msh::read_msh(&generated.path)?;
             Ok((generated, raw))
         }

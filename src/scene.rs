@@ -200,6 +200,10 @@ pub enum Refinement {
     /// Level L is gmsh's own mesh of the .geo with the parameter `level = L` (the .geo
     /// scales its sizes by 2^-level itself); levels are not nested.
     Remesh,
+    /// Level L splits level 0 L times with every new boundary node on its .geo curve
+    /// ([`crate::mesh::gmsh::Split::OnCurves`]): curved traces converge to their curves;
+    /// nested but for those nodes, judged in the effective h as a remeshed family.
+    Curved,
 }
 
 /// A body of a validated scene.

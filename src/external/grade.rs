@@ -352,9 +352,10 @@ fn quantities(family: &Family, study: Option<&LoadedStudy>, pressure: bool) -> V
             .filter(|q| needs(*q).iter().all(|f| exact.gives(*f)))
             .collect(),
     };
-    // A distance between the cones is not a property of one solution.
+    // A distance between the cones is not a property of one solution, nor the discrete
+    // gap of the method's rows, which a solution's files do not carry.
     all.into_iter()
-        .filter(|q| !q.is_distance() && (pressure || !q.needs_pressure()))
+        .filter(|q| !q.is_distance() && !q.reads_rows() && (pressure || !q.needs_pressure()))
         .collect()
 }
 

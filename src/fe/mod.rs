@@ -483,7 +483,9 @@ impl Model {
     pub fn judge_h(&self) -> f64 {
         match self.scene.refinement {
             crate::scene::Refinement::Split => self.h(),
-            crate::scene::Refinement::Remesh => self.effective_h(),
+            crate::scene::Refinement::Remesh | crate::scene::Refinement::Curved => {
+                self.effective_h()
+            }
         }
     }
 

@@ -178,10 +178,22 @@ pub struct GeneratedMesh {
     pub gmsh_version: String,
 }
 
+/// How a level above 0 splits every triangle in four.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Split {
+    /// `gmsh -refine` of the cached level L - 1: new boundary nodes at edge midpoints, on
+    /// level 0's chords (exactly nested levels; right for polygonal bodies).
+    Chords,
+    /// gmsh's `RefineMesh` L times in the session that meshed the .geo: each new boundary
+    /// node is placed on its .geo curve, so a circle arc's trace converges to the arc (the
+    /// levels are nested but for those nodes).
+    OnCurves,
+}
+
 /// Generate (or fetch from the cache) the mesh of `geo` with `params` refined `level` times
 /// by uniform splitting. Level 0 is gmsh's own 2D mesh; level L splits level L-1 (nested).
 pub fn generate(geo: &Path, params: &[(String, f64)], level: usize) -> Result<GeneratedMesh> {
-    generate_in(&cache_dir(), geo, params, level)
+    generate_in(&cache_dir(), geo, params, level, Split::Chords)
 }
 
 /// The cache key of `geo` with `params`: the stem of its files' names and the hash of the
@@ -208,9 +220,18 @@ pub fn cache_path(
     geo: &Path,
     params: &[(String, f64)],
     level: usize,
+    split: Split,
 ) -> Result<PathBuf> {
     let (name, _, _) = cache_key(geo, params)?;
-    Ok(dir.join(format!("{name}-L{level}.msh")))
+    Ok(dir.join(file_name(&name, level, split)))
+}
+
+/// The cached file of `level`: level 0 is the same mesh whichever the split.
+fn file_name(name: &str, level: usize, split: Split) -> String {
+    match (split, level) {
+        (Split::OnCurves, 1..) => format!("{name}-curves-L{level}.msh"),
+        _ => format!("{name}-L{level}.msh"),
+    }
 }
 
 /// [`generate`] with the cache in the folder `dir`.
@@ -219,9 +240,21 @@ pub fn generate_in(
     geo: &Path,
     params: &[(String, f64)],
     level: usize,
+    split: Split,
 ) -> Result<GeneratedMesh> {
     let (name, geo_hash, version) = cache_key(geo, params)?;
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    if split == Split::OnCurves && level > 0 {
+        let path = dir.join(file_name(&name, level, split));
+        if !path.exists() {
+            split_on_curves(dir, geo, params, level, &path)?;
+        }
+        return Ok(GeneratedMesh {
+            path,
+            geo_hash,
+            gmsh_version: version,
+        });
+    }
     let stem = geo.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh");
     let path_of = |l: usize| dir.join(format!("{name}-L{l}.msh"));
     // Find the finest cached level at or below `level`.
@@ -289,4 +322,60 @@ pub fn generate_in(
         geo_hash,
         gmsh_version: version,
     })
+}
+
+/// Level `level` of `geo` made in one gmsh session ([`Split::OnCurves`]): a script that
+/// includes the .geo, meshes it and splits it `level` times with `RefineMesh`, which
+/// places each new boundary node on its curve while the .geo's geometry is loaded (a
+/// `-refine` of a saved .msh sees only its segments). Written to `path` through a
+/// temporary file; the script is removed afterwards.
+fn split_on_curves(
+    dir: &Path,
+    geo: &Path,
+    params: &[(String, f64)],
+    level: usize,
+    path: &Path,
+) -> Result<()> {
+    let absolute = std::fs::canonicalize(geo).map_err(|e| Error::io(geo, e))?;
+    let shown = absolute.display().to_string();
+    if shown.contains('"') {
+        return Err(Error::input(
+            geo,
+            "geo",
+            "the .geo's path holds a '\"', which a gmsh script cannot include; rename its folder",
+        ));
+    }
+    static COUNTER: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh");
+    let unique = format!("{stem}.{}-{n}", std::process::id());
+    let (script, tmp) = (
+        dir.join(format!("{unique}.tmp.geo")),
+        dir.join(format!("{unique}.tmp.msh")),
+    );
+    let text = format!(
+        "Include \"{shown}\";\nMesh 2;\n{}",
+        "RefineMesh;\n".repeat(level)
+    );
+    std::fs::write(&script, text).map_err(|e| Error::io(&script, e))?;
+    let _script = crate::interrupt::TemporaryFile::new(&script);
+    let mut args: Vec<String> = vec![script.display().to_string()];
+    for (k, v) in params {
+        args.extend(["-setnumber".into(), k.clone(), format!("{v:e}")]);
+    }
+    args.extend(["-save", "-format", "msh41", "-o"].map(String::from));
+    args.push(tmp.display().to_string());
+    let made = produce(
+        &args,
+        &tmp,
+        path,
+        geo,
+        (
+            &format!("meshing and splitting {stem} on its curves"),
+            "gmsh RefineMesh wrote an unusable mesh",
+            "; fix the .geo",
+        ),
+    );
+    let _ = std::fs::remove_file(&script);
+    made
 }

@@ -151,6 +151,13 @@ impl Quantity {
         self == Quantity::BestL2Pressure
     }
 
+    /// Whether it reads the method's constraint rows (the discrete gap on their right-hand
+    /// sides), which a field on a mesh does not carry: measured by the studies, never from
+    /// a solution alone (`Truth::errors`, grade).
+    pub fn reads_rows(self) -> bool {
+        self == Quantity::DiscreteGap
+    }
+
     /// Whether it is a distance between the two cones.
     pub fn is_distance(self) -> bool {
         Self::DISTANCES.contains(&self)
