@@ -7,8 +7,10 @@
 //! manufactured solutions with a source in every equation the fields do not satisfy).
 //!
 //! [`stacked`] derives the closed form of the `stacked-exact` scene; [`singular`] the
-//! `regularity` family, whose displacement has a part singular at a point ([`Singular`]).
+//! `regularity` family, whose displacement has a part singular at a point ([`Singular`]);
+//! [`lame`] the press fit of two annuli across a radial gap.
 
+pub mod lame;
 pub mod singular;
 pub mod stacked;
 

@@ -186,6 +186,7 @@ fn normal_through(
     p1: [f64; 2],
     n0: [f64; 2],
     n1: [f64; 2],
+    (open_start, open_end): (bool, bool),
 ) -> Option<(f64, f64)> {
     let (d, t, dn) = (sub(x, p0), sub(p1, p0), sub(n1, n0));
     // c0 + c1 xi + c2 xi^2 = 0.
@@ -203,11 +204,20 @@ fn normal_through(
         vec![q / c2, c0 / q]
     };
     let tol = 1e-9;
+    // An open end accepts a point beyond it (on the segment's line, the normal
+    // extrapolated): where a trace's end node across a gap meets the other.
+    let (lo, hi) = (
+        if open_start { -1.0 } else { -tol },
+        if open_end { 2.0 } else { 1.0 + tol },
+    );
     roots
         .into_iter()
-        .filter(|xi| xi.is_finite() && *xi >= -tol && *xi <= 1.0 + tol)
+        .filter(|xi| xi.is_finite() && *xi >= lo && *xi <= hi)
         .map(|xi| {
-            let xi = xi.clamp(0.0, 1.0);
+            let xi = match (xi < 0.0 && open_start, xi > 1.0 && open_end) {
+                (false, false) => xi.clamp(0.0, 1.0),
+                _ => xi,
+            };
             let n = unit(lerp(n0, n1, xi));
             (xi, dot(sub(x, lerp(p0, p1, xi)), n))
         })
@@ -604,8 +614,11 @@ impl Interface {
                     let tol = 1e-9 * p.length;
                     let (s0, d0) = p.through(pos(e[0]))?;
                     let (s1, d1) = p.through(pos(e[1]))?;
-                    let inside = |s: f64| s >= -tol && s <= p.length + tol;
-                    (inside(s0) && inside(s1)).then_some((k, d0.abs().max(d1.abs())))
+                    // Across a gap d a node may meet the trace up to d beyond its end
+                    // (as in `add_master`).
+                    let inside =
+                        |s: f64, d: f64| s >= -tol - d.abs() && s <= p.length + tol + d.abs();
+                    (inside(s0, d0) && inside(s1, d1)).then_some((k, d0.abs().max(d1.abs())))
                 })
                 .min_by(|a, b| a.1.total_cmp(&b.1));
             if let Some((k, _)) = best {
@@ -774,7 +787,8 @@ impl Piece {
                 .filter_map(|e| {
                     let (p0, p1) = (c.slave_points[e], c.slave_points[e + 1]);
                     let (n0, n1) = (c.slave_normals[e], c.slave_normals[e + 1]);
-                    normal_through(x, p0, p1, n0, n1).map(|(xi, d)| {
+                    let last = self.slave_s.len() - 2;
+                    normal_through(x, p0, p1, n0, n1, (e == 0, e == last)).map(|(xi, d)| {
                         let (s0, s1) = (self.slave_s[e], self.slave_s[e + 1]);
                         (s0 + xi * (s1 - s0), d)
                     })
@@ -800,10 +814,14 @@ impl Piece {
             })
             .collect();
         placed.sort_by(|x, y| x.1.total_cmp(&y.1));
+        // Across a gap d an end node of body 2 meets body 1's trace along the end
+        // segment's normal, which a curved trace tilts from the line joining the two ends:
+        // it may land up to d beyond the end (and is then placed at it).
+        let end_tol = |p: &(usize, f64, f64)| tol + p.2.abs();
         let covered = placed.len() >= 2
             && edges.len() == placed.len() - 1
-            && placed[0].1.abs() <= tol
-            && (placed.last().unwrap().1 - self.length).abs() <= tol
+            && placed[0].1.abs() <= end_tol(&placed[0])
+            && (placed.last().unwrap().1 - self.length).abs() <= end_tol(placed.last().unwrap())
             && placed.windows(2).all(|w| w[1].1 > w[0].1);
         if !covered {
             let b = self.point(self.length);
