@@ -103,3 +103,18 @@ fn levels_split_on_the_curves_converge_to_the_arcs_and_split_chords_do_not() {
         }
     }
 }
+
+/// The .geo's parameters reach the session that splits on the curves (`-setnumber` into a
+/// DefineConstant of the included .geo): g0 = 0.05 puts body 2's trace on r = 1.05 at
+/// level 2, and the mesh is not the default's.
+#[test]
+fn a_parameter_reaches_the_split_on_the_curves() {
+    let dir = tempfile::tempdir().unwrap();
+    let params = [("g0".to_string(), 0.05)];
+    let generated = gmsh::generate_in(dir.path(), GEO.as_ref(), &params, 2, Split::OnCurves)
+        .expect("gmsh meshes it");
+    let m = read_msh(&generated.path).expect("the mesh reads");
+    let off = off_the_arc(&m, "contact_outer", 1.05);
+    assert!(off < 1e-12, "{off:e} off r = 1.05");
+    assert!(off_the_arc(&m, "contact_inner", 1.0) < 1e-12);
+}

@@ -178,8 +178,9 @@ fn ray_meets_segment(x: [f64; 2], n: [f64; 2], p: [f64; 2], q: [f64; 2]) -> Opti
 }
 
 /// Where the normal field of a slave segment (ends p0, p1, nodal normals n0, n1 linear
-/// between them) passes through x: (local coordinate xi in [0, 1], signed distance along
-/// the normal). (x - p(xi)) x n(xi) = 0 is a quadratic in xi, solved in closed form.
+/// between them) passes through x: (local coordinate xi in [0, 1], or beyond an end the
+/// caller opens, down to -1 or up to 2; signed distance along the normal).
+/// (x - p(xi)) x n(xi) = 0 is a quadratic in xi, solved in closed form.
 fn normal_through(
     x: [f64; 2],
     p0: [f64; 2],
@@ -614,10 +615,11 @@ impl Interface {
                     let tol = 1e-9 * p.length;
                     let (s0, d0) = p.through(pos(e[0]))?;
                     let (s1, d1) = p.through(pos(e[1]))?;
-                    // Across a gap d a node may meet the trace up to d beyond its end
-                    // (as in `add_master`).
+                    // Across a gap d a node may meet a curved trace up to d beyond its
+                    // end (as in `add_master`); a straight one's ends are exact.
+                    let beyond = |d: f64| if p.curve.is_some() { d.abs() } else { 0.0 };
                     let inside =
-                        |s: f64, d: f64| s >= -tol - d.abs() && s <= p.length + tol + d.abs();
+                        |s: f64, d: f64| s >= -tol - beyond(d) && s <= p.length + tol + beyond(d);
                     (inside(s0, d0) && inside(s1, d1)).then_some((k, d0.abs().max(d1.abs())))
                 })
                 .min_by(|a, b| a.1.total_cmp(&b.1));
@@ -814,15 +816,19 @@ impl Piece {
             })
             .collect();
         placed.sort_by(|x, y| x.1.total_cmp(&y.1));
-        // Across a gap d an end node of body 2 meets body 1's trace along the end
-        // segment's normal, which a curved trace tilts from the line joining the two ends:
-        // it may land up to d beyond the end (and is then placed at it).
-        let end_tol = |p: &(usize, f64, f64)| tol + p.2.abs();
-        let covered = placed.len() >= 2
-            && edges.len() == placed.len() - 1
+        // Across a gap d an end node of body 2 meets a curved trace of body 1 along the
+        // end segment's normal, which the chord tilts from the line joining the two ends:
+        // it may land up to d beyond the end (and is then placed at it). Only the end
+        // nodes: every other node lies strictly inside.
+        let curved = self.curve.is_some();
+        let end_tol = |p: &(usize, f64, f64)| tol + if curved { p.2.abs() } else { 0.0 };
+        let n = placed.len();
+        let covered = n >= 2
+            && edges.len() == n - 1
             && placed[0].1.abs() <= end_tol(&placed[0])
-            && (placed.last().unwrap().1 - self.length).abs() <= end_tol(placed.last().unwrap())
-            && placed.windows(2).all(|w| w[1].1 > w[0].1);
+            && (placed[n - 1].1 - self.length).abs() <= end_tol(&placed[n - 1])
+            && placed.windows(2).all(|w| w[1].1 > w[0].1)
+            && (n == 2 || (placed[1].1 > 0.0 && placed[n - 2].1 < self.length));
         if !covered {
             let b = self.point(self.length);
             return Err(Error::input(

@@ -336,7 +336,9 @@ fn split_on_curves(
     level: usize,
     path: &Path,
 ) -> Result<()> {
-    let absolute = std::fs::canonicalize(geo).map_err(|e| Error::io(geo, e))?;
+    // Absolute, not canonical: a .geo behind a link includes what sits beside the link,
+    // as `gmsh geo -2` (level 0) does.
+    let absolute = std::path::absolute(geo).map_err(|e| Error::io(geo, e))?;
     let shown = absolute.display().to_string();
     if shown.contains('"') {
         return Err(Error::input(
