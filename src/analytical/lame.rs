@@ -46,19 +46,18 @@ pub struct PressFitSolution {
     pub pressure_outer: f64,
 }
 
-impl PressFit {
-    /// k = 2 a + b and beta = b of body `i`.
-    fn moduli(&self, i: usize) -> (f64, f64) {
-        let e = &self.elastic[i];
-        (2.0 * e.a() + e.b(), e.b())
-    }
+/// Lame's k = 2 a + b and beta = b of an elasticity (stress): sigma_rr = k A - beta B / r^2.
+fn moduli(e: &Elasticity) -> (f64, f64) {
+    (2.0 * e.a() + e.b(), e.b())
+}
 
+impl PressFit {
     /// The closed form with the contact closed: the six equations above, solved by LU.
     /// The pressures are those of a closed contact; [`PressFit::closes`] says whether they
     /// are compressive.
     pub fn solve(&self) -> PressFitSolution {
-        let (k1, b1) = self.moduli(0);
-        let (k2, b2) = self.moduli(1);
+        let (k1, b1) = moduli(&self.elastic[0]);
+        let (k2, b2) = moduli(&self.elastic[1]);
         let (a, r, rho, b) = (self.bore, self.radius, self.radius + self.gap, self.outer);
         // Unknowns (A1, B1, A2, B2, p1, p2).
         #[rustfmt::skip]
@@ -86,7 +85,7 @@ impl PressFit {
     /// The bore pressure that just closes the gap: body 1 alone, free on r = R, expands
     /// by g0 there (u_r^1(R) = g0 with sigma_rr^1(R) = 0; stress).
     pub fn closing_pressure(&self) -> f64 {
-        let (k1, b1) = self.moduli(0);
+        let (k1, b1) = moduli(&self.elastic[0]);
         let (a, r) = (self.bore, self.radius);
         // sigma_rr(a) = -p, sigma_rr(R) = 0: A = B b1 / (k1 R^2), B b1 (1/R^2 - 1/a^2) = -p;
         // u_r(R) = A R + B / R, linear in p: the p that gives g0.
@@ -112,7 +111,7 @@ impl PressFitSolution {
     /// (stress).
     pub fn radial_stress(&self, i: usize, r: f64, e: &Elasticity) -> (f64, f64) {
         let [a, b] = self.coefficients[i];
-        let (k, beta) = (2.0 * e.a() + e.b(), e.b());
+        let (k, beta) = moduli(e);
         (k * a - beta * b / (r * r), k * a + beta * b / (r * r))
     }
 

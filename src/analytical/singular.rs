@@ -355,22 +355,11 @@ impl SingularContact {
         gap: Option<&ClosingGap>,
     ) -> String {
         let [u1, u2] = [0, 1].map(|l| self.singular_text(l));
-        let [mut m1, m2] = [0, 1].map(|l| self.smooth_text(l));
-        let mut gap_line = String::new();
-        let mut gap_comment = String::new();
-        if let Some(g) = gap {
-            let [cx, cy] = g.displacement_text();
-            // cy reads "-y*...": written as a difference.
-            m1 = [
-                format!("{} + {cx}", m1[0]),
-                format!("{} - {}", m1[1], cy.trim_start_matches('-')),
-            ];
-            gap_line = format!("\ngap = \"{}\"", g.gap_text());
-            gap_comment = format!(
-                "\n# Body 1 (upper) carries the closing part {} (no factor t: it closes g0 at every t,\n# traction-free on y = 1), so that g0 - [u.nu] is the gap without g0.",
-                g.description()
-            );
-        }
+        let [m1, m2] = [0, 1].map(|l| self.smooth_text(l));
+        let (m1, gap_line, gap_comment) = match gap {
+            Some(g) => g.scene_lines(m1),
+            None => (m1, String::new(), String::new()),
+        };
         let (geo, parameters) = self.mesh_lines();
         let refinement = match self.placement {
             Placement::Graded { .. } => "\nrefinement = \"remesh\"",
@@ -495,6 +484,23 @@ impl ClosingGap {
             format!("y*(2-y)*(y-1)*x/{r:?}"),
             format!("-y*(2-y)*x^2/{:?}", 2.0 * r),
         ]
+    }
+
+    /// What the gap adds to a scene file: body 1's displacement `upper` (scene
+    /// expressions) with u_g added, the `[contact] gap` line and the comment saying why.
+    fn scene_lines(&self, upper: [String; 2]) -> ([String; 2], String, String) {
+        let [cx, cy] = self.displacement_text();
+        // cy reads "-y*...": written as a difference.
+        let displacement = [
+            format!("{} + {cx}", upper[0]),
+            format!("{} - {}", upper[1], cy.trim_start_matches('-')),
+        ];
+        let line = format!("\ngap = \"{}\"", self.gap_text());
+        let comment = format!(
+            "\n# Body 1 (upper) carries the closing part {} (no factor t: it closes g0 at every t,\n# traction-free on y = 1), so that g0 - [u.nu] is the gap without g0.",
+            self.description()
+        );
+        (displacement, line, comment)
     }
 
     /// u_g in words, for descriptions.

@@ -215,10 +215,11 @@ fn normal_through(
         .into_iter()
         .filter(|xi| xi.is_finite() && *xi >= lo && *xi <= hi)
         .map(|xi| {
-            let xi = match (xi < 0.0 && open_start, xi > 1.0 && open_end) {
-                (false, false) => xi.clamp(0.0, 1.0),
-                _ => xi,
-            };
+            // Onto the segment, but past an open end.
+            let xi = xi.clamp(
+                if open_start { lo } else { 0.0 },
+                if open_end { hi } else { 1.0 },
+            );
             let n = unit(lerp(n0, n1, xi));
             (xi, dot(sub(x, lerp(p0, p1, xi)), n))
         })
@@ -615,11 +616,10 @@ impl Interface {
                     let tol = 1e-9 * p.length;
                     let (s0, d0) = p.through(pos(e[0]))?;
                     let (s1, d1) = p.through(pos(e[1]))?;
-                    // Across a gap d a node may meet a curved trace up to d beyond its
-                    // end (as in `add_master`); a straight one's ends are exact.
-                    let beyond = |d: f64| if p.curve.is_some() { d.abs() } else { 0.0 };
-                    let inside =
-                        |s: f64, d: f64| s >= -tol - beyond(d) && s <= p.length + tol + beyond(d);
+                    let inside = |s: f64, d: f64| {
+                        let beyond = tol + p.end_allowance(d);
+                        s >= -beyond && s <= p.length + beyond
+                    };
                     (inside(s0, d0) && inside(s1, d1)).then_some((k, d0.abs().max(d1.abs())))
                 })
                 .min_by(|a, b| a.1.total_cmp(&b.1));
@@ -799,6 +799,17 @@ impl Piece {
         }
     }
 
+    /// How far beyond an end of the piece a body-2 node at gap `d` may meet it (length):
+    /// across a gap, an end node meets a curved trace along the end segment's normal, which
+    /// the chord tilts from the line joining the two ends, so up to |d| beyond; a straight
+    /// piece's ends are exact (0).
+    fn end_allowance(&self, d: f64) -> f64 {
+        match self.curve {
+            Some(_) => d.abs(),
+            None => 0.0,
+        }
+    }
+
     /// Body 2's side of the piece from the master edges facing it: its nodes ordered by
     /// where their normals meet body 1's trace, which must cover the piece with nodes at
     /// both ends (within 1e-9 of its length).
@@ -816,12 +827,9 @@ impl Piece {
             })
             .collect();
         placed.sort_by(|x, y| x.1.total_cmp(&y.1));
-        // Across a gap d an end node of body 2 meets a curved trace of body 1 along the
-        // end segment's normal, which the chord tilts from the line joining the two ends:
-        // it may land up to d beyond the end (and is then placed at it). Only the end
-        // nodes: every other node lies strictly inside.
-        let curved = self.curve.is_some();
-        let end_tol = |p: &(usize, f64, f64)| tol + if curved { p.2.abs() } else { 0.0 };
+        // An end node may land beyond the end ([`Piece::end_allowance`]) and is then placed
+        // at it; every other node lies strictly inside.
+        let end_tol = |p: &(usize, f64, f64)| tol + self.end_allowance(p.2);
         let n = placed.len();
         let covered = n >= 2
             && edges.len() == n - 1

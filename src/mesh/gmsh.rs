@@ -256,7 +256,7 @@ pub fn generate_in(
         });
     }
     let stem = geo.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh");
-    let path_of = |l: usize| dir.join(format!("{name}-L{l}.msh"));
+    let path_of = |l: usize| dir.join(file_name(&name, l, Split::Chords));
     // Find the finest cached level at or below `level`.
     let mut have = None;
     for l in (0..=level).rev() {
@@ -265,19 +265,12 @@ pub fn generate_in(
             break;
         }
     }
-    // Unique temporary names: several threads or processes may generate the same mesh.
-    static COUNTER: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let tmp = |l: usize| {
-        let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        dir.join(format!("{name}-L{l}.{}-{n}.tmp.msh", std::process::id()))
-    };
+    let tmp = |l: usize| temporary(dir, &format!("{name}-L{l}"), "msh");
     let start = match have {
         Some(l) => l + 1,
         None => {
             let mut args: Vec<String> = vec![geo.display().to_string(), "-2".into()];
-            for (k, v) in params {
-                args.extend(["-setnumber".into(), k.clone(), format!("{v:e}")]);
-            }
+            args.extend(set_numbers(params));
             args.extend(["-format".into(), "msh41".into(), "-o".into()]);
             let t = tmp(0);
             args.push(t.display().to_string());
@@ -347,14 +340,8 @@ fn split_on_curves(
             "the .geo's path holds a '\"', which a gmsh script cannot include; rename its folder",
         ));
     }
-    static COUNTER: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh");
-    let unique = format!("{stem}.{}-{n}", std::process::id());
-    let (script, tmp) = (
-        dir.join(format!("{unique}.tmp.geo")),
-        dir.join(format!("{unique}.tmp.msh")),
-    );
+    let (script, tmp) = (temporary(dir, stem, "geo"), temporary(dir, stem, "msh"));
     let text = format!(
         "Include \"{shown}\";\nMesh 2;\n{}",
         "RefineMesh;\n".repeat(level)
@@ -362,9 +349,7 @@ fn split_on_curves(
     std::fs::write(&script, text).map_err(|e| Error::io(&script, e))?;
     let _script = crate::interrupt::TemporaryFile::new(&script);
     let mut args: Vec<String> = vec![script.display().to_string()];
-    for (k, v) in params {
-        args.extend(["-setnumber".into(), k.clone(), format!("{v:e}")]);
-    }
+    args.extend(set_numbers(params));
     args.extend(["-save", "-format", "msh41", "-o"].map(String::from));
     args.push(tmp.display().to_string());
     let made = produce(
@@ -380,4 +365,20 @@ fn split_on_curves(
     );
     let _ = std::fs::remove_file(&script);
     made
+}
+
+/// A temporary file name in `dir` unique to this process and call: several threads or
+/// processes may generate the same mesh.
+fn temporary(dir: &Path, stem: &str, extension: &str) -> PathBuf {
+    static COUNTER: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    dir.join(format!("{stem}.{}-{n}.tmp.{extension}", std::process::id()))
+}
+
+/// gmsh's `-setnumber NAME VALUE` for each parameter.
+fn set_numbers(params: &[(String, f64)]) -> Vec<String> {
+    params
+        .iter()
+        .flat_map(|(k, v)| ["-setnumber".into(), k.clone(), format!("{v:e}")])
+        .collect()
 }
