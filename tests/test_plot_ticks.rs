@@ -289,7 +289,9 @@ fn figures_render() {
 
 /// Reference: issue 74 (no line hidden under another without saying so in the legend).
 /// Goal: a series that lies on an earlier one says which, and to what relative difference
-/// (rounded up to one significant digit); equal data say "="; other abscissae say "under".
+/// (rounded up to one significant digit); equal data say "="; other abscissae say "under";
+/// on a linear axis the difference is read against the axis' largest |y| (a gap profile
+/// through zero), on a log axis against each value.
 #[test]
 fn a_hidden_series_says_what_it_lies_on() {
     let at = |points: Vec<(f64, f64)>, label: &str| Series {
@@ -309,7 +311,22 @@ fn a_hidden_series_says_what_it_lies_on() {
     let close = at(hs.iter().map(|&h| (h, h * (1.0 + 3e-5))).collect(), "nts");
     let same = at(hs.iter().map(|&h| (h, h)).collect(), "lac");
     let shifted = at(hs.iter().map(|&h| (1.01 * h, h)).collect(), "code");
-    assert_eq!(plot::coincidence(&close, &mortar), " (= mortar to 3e-5)");
-    assert_eq!(plot::coincidence(&same, &mortar), " (= mortar)");
-    assert_eq!(plot::coincidence(&shifted, &mortar), " (under mortar)");
+    assert_eq!(
+        plot::coincidence(&close, &mortar, 0.0),
+        " (= mortar to 3e-5)"
+    );
+    assert_eq!(plot::coincidence(&same, &mortar, 0.0), " (= mortar)");
+    assert_eq!(plot::coincidence(&shifted, &mortar, 0.0), " (under mortar)");
+    // A profile through zero on a linear axis (a gap closed to round-off, 0.016 where it
+    // opens): +-1e-9 about zero is 2e-9 of the axis' 0.016, not a difference of 2.
+    let gap = |zero: f64| at(vec![(0.1, zero), (0.5, 0.004), (0.9, 0.016)], "lac");
+    let (mortar_gap, lac_gap) = (gap(1e-9), gap(-1e-9));
+    assert_eq!(
+        plot::coincidence(&lac_gap, &mortar_gap, 0.0),
+        " (= lac to 2e0)"
+    );
+    assert_eq!(
+        plot::coincidence(&lac_gap, &mortar_gap, 0.016),
+        " (= lac to 2e-7)"
+    );
 }

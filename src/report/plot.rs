@@ -1126,11 +1126,11 @@ fn legend_labels(series: &[Series]) -> Vec<&str> {
 /// legend entry each. A series whose every point lands within 2 pixels of an earlier
 /// series' points is drawn with outlined markers 3 pixels wider (so both show), and its
 /// legend says which one it coincides with and to what relative difference
-/// ([`coincidence`]).
+/// ([`coincidence`], against `floor`: 0 on log axes, the largest |y| on linear ones).
 fn draw_series<'b, CT>(
     chart: &mut ChartContext<'_, BitMapBackend<'b>, CT>,
     series: &[Series],
-    radius: u32,
+    (radius, floor): (u32, f64),
     path: &Path,
 ) -> Result<()>
 where
@@ -1179,7 +1179,7 @@ where
                     >= pixels[i].len().max(1)
         });
         let label = match (covered, partly_under) {
-            (Some(j), _) => format!("{}{}", s.label, coincidence(s, &series[j])),
+            (Some(j), _) => format!("{}{}", s.label, coincidence(s, &series[j], floor)),
             (None, Some(k)) => format!(
                 "{} (partly under {})",
                 s.label,
@@ -1220,7 +1220,10 @@ fn first_word(label: &str) -> &str {
 /// What a series that lies on `under` adds to its legend: " (= mortar to 1e-4)", the first
 /// word of `under`'s label and the largest relative difference of their values at the same
 /// abscissae, rounded up to one significant digit; " (under mortar)" where the abscissae differ.
-pub fn coincidence(s: &Series, under: &Series) -> String {
+/// A difference is relative to the larger of the two values and `floor`: on a log axis
+/// (`floor` 0) each value is its own scale; on a linear one a profile through zero (a gap
+/// that closes) is read against the axis' scale, its largest |y|, not against round-off.
+pub fn coincidence(s: &Series, under: &Series, floor: f64) -> String {
     let name = first_word(&under.label);
     let mut largest: Option<f64> = Some(0.0);
     for p in &s.points {
@@ -1230,7 +1233,8 @@ pub fn coincidence(s: &Series, under: &Series) -> String {
             .find(|q| (q.0 - p.0).abs() <= 1e-12 * p.0.abs().max(1.0))
         {
             Some(q) => {
-                let d = (p.1 - q.1).abs() / p.1.abs().max(q.1.abs()).max(f64::MIN_POSITIVE);
+                let scale = p.1.abs().max(q.1.abs()).max(floor);
+                let d = (p.1 - q.1).abs() / scale.max(f64::MIN_POSITIVE);
                 largest = largest.map(|l| l.max(d));
             }
             None => largest = None,
@@ -1344,7 +1348,7 @@ pub fn loglog(
         )
         .map_err(err(path))?;
     draw_axes(&mut chart, (xlabel, ylabel), (&xt, &yt), path)?;
-    draw_series(&mut chart, series, 5, path)?;
+    draw_series(&mut chart, series, (5, 0.0), path)?;
     let samples = data_samples(&chart, series, true);
     let legend = legend_place(&chart, &legend_labels(series), &samples);
     if !slopes.is_empty() {
@@ -1434,7 +1438,12 @@ pub fn lines(
         .build_cartesian_2d(LinearAxis::new(x0, x1, &xt), LinearAxis::new(y0, y1, &yt))
         .map_err(err(path))?;
     draw_axes(&mut chart, (xlabel, ylabel), (&xt, &yt), path)?;
-    draw_series(&mut chart, series, 3, path)?;
+    let largest = series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.1.abs()))
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max);
+    draw_series(&mut chart, series, (3, largest), path)?;
     let samples = data_samples(&chart, series, false);
     if let Some((pos, _)) = legend_place(&chart, &legend_labels(series), &samples) {
         draw_legend(&mut chart, pos, TICK_FONT_PX, 0.85, path)?;

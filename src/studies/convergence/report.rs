@@ -346,7 +346,7 @@ fn error_vs_time(res: &StudyResult, d: &Path) -> Result<()> {
 fn profiles(res: &StudyResult, d: &Path) -> Result<()> {
     for (name, data, ylabel) in [
         ("pressure", &res.pressure, "contact pressure (force/length)"),
-        ("gap", &res.gap, "normal gap -[u.nu] (length)"),
+        ("gap", &res.gap, "gap g0 - [u.nu] (length; g0 the initial gap, 0 without one)"),
     ] {
         let mut sources: Vec<Source> = res.file.methods.iter().map(|&m| Source::Cone(m)).collect();
         sources.push(if res.reference.is_some() {
