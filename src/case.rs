@@ -561,16 +561,7 @@ pub fn verify_exact(
         return Ok(());
     };
     let times: Vec<f64> = (1..=4).map(|k| sc.final_time * k as f64 / 4.0).collect();
-    let contact: Vec<ContactSample> = interface
-        .pieces
-        .iter()
-        .flat_map(|p| {
-            (0..=400).map(move |k| {
-                let s = p.length * k as f64 / 400.0;
-                (p.point(s), p.normal, p.tangent)
-            })
-        })
-        .collect();
+    let contact = contact_samples(interface, ex);
     let supports = support_samples(model, raw);
     let scales = exact_scales(ex, &contact, &supports, &times);
     check_singular_point(model, interface, ex)?;
@@ -602,6 +593,26 @@ pub fn verify_exact(
         }
     }
     Ok(())
+}
+
+/// The points of Gamma_C the contact conditions are checked at: 401 per piece with its
+/// normal; where the scene gives Gamma_C's exact geometry, body 1's trace nodes (which lie
+/// on its curve; the points between lie on chords, off it) with the exact normal.
+fn contact_samples(interface: &Interface, ex: &Exact) -> Vec<ContactSample> {
+    let mut out = Vec::new();
+    for p in &interface.pieces {
+        let points: Vec<[f64; 2]> = match ex.contact {
+            Some(_) => p.slave_s.iter().map(|&s| p.point(s)).collect(),
+            None => (0..=400)
+                .map(|k| p.point(p.length * k as f64 / 400.0))
+                .collect(),
+        };
+        for x in points {
+            let n = ex.normal_at(p.normal, x[0], x[1]);
+            out.push((x, n, [-n[1], n[0]]));
+        }
+    }
+    out
 }
 
 /// Refuse a singular point off Gamma_C: the singular part is the transition between
@@ -720,11 +731,18 @@ fn check_contact_point(
 ) -> std::result::Result<(), String> {
     use crate::analytical::traction;
     let mut pressure = ex.pressure.as_ref().map(|p| p.eval(x[0], x[1], t));
+    // Body 2's side at the point x faces, its traction per unit length of body 1's curve.
+    let m = ex.facing(x[0], x[1]);
+    let stretch = ex
+        .contact
+        .as_ref()
+        .map_or(1.0, |c| c.stretch_at(x[0], x[1]));
     if let (Some(s1), Some(s2)) = (
         ex.stress_at(0, x[0], x[1], t),
-        ex.stress_at(1, x[0], x[1], t),
+        ex.stress_at(1, m[0], m[1], t),
     ) {
-        let (t1, t2) = (traction(s1, n), traction(s2, [-n[0], -n[1]]));
+        let t2 = traction(s2, [-n[0], -n[1]]).map(|v| v * stretch);
+        let t1 = traction(s1, n);
         for (side, tr) in [("slave", t1), ("master", t2)] {
             if dot(tr, tau).abs() > EXACT_TOL * s_scale {
                 return Err(format!(

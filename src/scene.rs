@@ -132,6 +132,23 @@ pub struct ExactSpec {
     pub manufactured: bool,
     /// A part of the displacement singular at a point, added to `displacement`.
     pub singular: Option<SingularSpec>,
+    /// Gamma_C's exact geometry where it is curved or the bodies are meshed apart.
+    pub contact: Option<ExactContactSpec>,
+}
+
+/// `[exact.contact]`: the exact contact geometry of a curved Gamma_C or of bodies meshed
+/// apart (the press fit), as expressions in x and y on body 1's contact curve. Without it
+/// the exact fields are read at the discrete trace's own points and normal, the two bodies
+/// at one point (flat and touching).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExactContactSpec {
+    /// Body 1's outward unit normal nu(x, y) [n_x, n_y] (normalised where it is read).
+    pub normal: [String; 2],
+    /// The point m(x, y) [x, y] of body 2's contact curve that the point (x, y) of body 1's
+    /// faces along nu (length): the gap before any load is (m - x).nu, and action and
+    /// reaction balance per unit length along the map (p1 = p2 |dm/ds|).
+    pub master: [String; 2],
 }
 
 /// `[exact.singular]`: the part of a manufactured elastic displacement singular at a point
@@ -752,6 +769,11 @@ fn exact_solution(
         }
     };
     exact.asymmetry = asymmetry;
+    exact.contact = spec
+        .contact
+        .as_ref()
+        .map(|c| exact_contact(c, file))
+        .transpose()?;
     if let Some(f) = &exact.body_force {
         for (b, body) in bodies.iter_mut().enumerate() {
             body.body_force = Some(VectorExpr(f[b].clone()));
@@ -768,6 +790,20 @@ fn exact_solution(
         ));
     }
     Ok(exact)
+}
+
+/// `[exact.contact]` parsed: the normal and the map to body 2's curve, with the map's
+/// derivatives.
+fn exact_contact(spec: &ExactContactSpec, file: &Path) -> Result<crate::analytical::ContactMap> {
+    let parse = |v: &[String; 2], field: &str| -> Result<[Expr; 2]> {
+        let [a, b] =
+            [0, 1].map(|c| Expr::parse(&v[c], file, &format!("exact.contact.{field}[{c}]")));
+        Ok([a?, b?])
+    };
+    Ok(crate::analytical::ContactMap::new(
+        parse(&spec.normal, "normal")?,
+        parse(&spec.master, "master")?,
+    ))
 }
 
 /// `[exact.singular]`'s displacement per body in slave-first order, after its checks: an

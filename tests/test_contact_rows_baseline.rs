@@ -72,6 +72,11 @@ fn current() -> Vec<String> {
     let mut out = Vec::new();
     for name in scenes() {
         let scene = Scene::load(&name).expect("a committed scene loads");
+        if scene.refinement == contact_rates::scene::Refinement::Curved {
+            // A curved scene (issue 77) post-dates the baseline, and its bodies are meshed
+            // apart: its rows are measured by the press-fit tests.
+            continue;
+        }
         if scene.initial_gap.is_some() {
             // A scene with an initial gap post-dates the baseline; its rows' coefficients
             // are checked against its gap-free twin in `a_gap_moves_only_the_right_hand_side`.

@@ -52,6 +52,68 @@ pub struct Exact {
     /// The scene's initial gap g0(x, y) on Gamma_C (`[contact] gap`), part of the exact
     /// gap ([`Exact::gap_at`]).
     pub initial_gap: Option<Expr>,
+    /// Gamma_C's exact geometry (`[exact.contact]`): None, flat and touching.
+    pub contact: Option<ContactMap>,
+}
+
+/// The exact contact geometry of a curved Gamma_C or of bodies apart: body 1's outward
+/// normal nu(x) and the point m(x) of body 2's curve that x faces along it, as expressions
+/// on body 1's curve (the press fit: nu = x / |x|, m = x (R + g0) / R).
+#[derive(Debug, Clone)]
+pub struct ContactMap {
+    /// nu(x, y), normalised where it is read.
+    pub normal: [Expr; 2],
+    /// m(x, y) (length).
+    pub master: [Expr; 2],
+    /// d m_c / d x_d: `jacobian[c][d]`.
+    pub jacobian: [[Expr; 2]; 2],
+}
+
+impl ContactMap {
+    /// The map with its derivatives.
+    pub fn new(normal: [Expr; 2], master: [Expr; 2]) -> Self {
+        let jacobian = gradient(&master);
+        ContactMap {
+            normal,
+            master,
+            jacobian,
+        }
+    }
+
+    /// nu at (x, y), a unit vector.
+    pub fn normal_at(&self, x: f64, y: f64) -> [f64; 2] {
+        let n = [
+            self.normal[0].eval(x, y, 0.0),
+            self.normal[1].eval(x, y, 0.0),
+        ];
+        let len = n[0].hypot(n[1]);
+        [n[0] / len, n[1] / len]
+    }
+
+    /// m at (x, y).
+    pub fn master_at(&self, x: f64, y: f64) -> [f64; 2] {
+        [
+            self.master[0].eval(x, y, 0.0),
+            self.master[1].eval(x, y, 0.0),
+        ]
+    }
+
+    /// |dm/ds| at (x, y): the length of body 2's curve per unit length of body 1's along
+    /// the map (the tangent taken normal to nu), by which a master traction is multiplied
+    /// to balance the slave's (p1 = p2 |dm/ds|; (R + g0) / R for the radial map).
+    pub fn stretch_at(&self, x: f64, y: f64) -> f64 {
+        let n = self.normal_at(x, y);
+        let tau = [-n[1], n[0]];
+        let j = self
+            .jacobian
+            .each_ref()
+            .map(|r| r.each_ref().map(|e| e.eval(x, y, 0.0)));
+        let d = [
+            j[0][0] * tau[0] + j[0][1] * tau[1],
+            j[1][0] * tau[0] + j[1][1] * tau[1],
+        ];
+        d[0].hypot(d[1])
+    }
 }
 
 /// The part of an elastic manufactured solution singular at a point c: a displacement
@@ -219,6 +281,7 @@ impl Exact {
             asymmetry: [None, None],
             singular: None,
             initial_gap: None,
+            contact: None,
         }
     }
 
@@ -254,6 +317,7 @@ impl Exact {
             asymmetry: [None, None],
             singular: Some(singular),
             initial_gap: smooth.initial_gap,
+            contact: smooth.contact,
         }
     }
 
@@ -335,23 +399,41 @@ impl Exact {
         Some([u[0].eval(x, y, t), u[1].eval(x, y, t)])
     }
 
-    /// The gap g0 - (u^1 - u^2).n at (x, y, t) on Gamma_C with the slave's outward normal
-    /// `n`, g0 the scene's initial gap (zero where it gives none).
+    /// Body 1's outward unit normal at (x, y) on Gamma_C: the exact geometry's where the
+    /// scene gives it, else `n` (the discrete trace's).
+    pub fn normal_at(&self, n: [f64; 2], x: f64, y: f64) -> [f64; 2] {
+        self.contact.as_ref().map_or(n, |c| c.normal_at(x, y))
+    }
+
+    /// The point of body 2 that (x, y) of body 1's Gamma_C faces: the exact geometry's
+    /// m(x, y), else (x, y) itself (touching).
+    pub fn facing(&self, x: f64, y: f64) -> [f64; 2] {
+        self.contact.as_ref().map_or([x, y], |c| c.master_at(x, y))
+    }
+
+    /// The gap g0 + (m - x).nu - (u^1(x) - u^2(m)).nu at x = (x, y) and t on Gamma_C, g0 the
+    /// scene's initial gap (zero where it gives none), m and nu the exact geometry's where
+    /// the scene gives it, else x and the slave's outward normal `n`.
     pub fn gap_at(&self, n: [f64; 2], x: f64, y: f64, t: f64) -> Option<f64> {
+        let (n, m) = (self.normal_at(n, x, y), self.facing(x, y));
         let (u1, u2) = (
             self.displacement_at(0, x, y, t)?,
-            self.displacement_at(1, x, y, t)?,
+            self.displacement_at(1, m[0], m[1], t)?,
         );
-        let g0 = self.initial_gap.as_ref().map_or(0.0, |g| g.eval(x, y, 0.0));
+        let g0 = self.initial_gap.as_ref().map_or(0.0, |g| g.eval(x, y, 0.0))
+            + (m[0] - x) * n[0]
+            + (m[1] - y) * n[1];
         Some(g0 - ((u1[0] - u2[0]) * n[0] + (u1[1] - u2[1]) * n[1]))
     }
 
-    /// Contact pressure at (x, y, t) on Gamma_C with the slave's outward normal `n`: the
-    /// given pressure, or -n.sigma^1 n.
+    /// Contact pressure at (x, y, t) on Gamma_C (body 1's side) with the slave's outward
+    /// normal `n` (the exact geometry's where the scene gives it): the given pressure, or
+    /// -nu.sigma^1 nu.
     pub fn pressure_at(&self, n: [f64; 2], x: f64, y: f64, t: f64) -> Option<f64> {
         if let Some(p) = &self.pressure {
             return Some(p.eval(x, y, t));
         }
+        let n = self.normal_at(n, x, y);
         let s = self.stress_at(0, x, y, t)?;
         Some(-(n[0] * n[0] * s[0] + n[1] * n[1] * s[1] + 2.0 * n[0] * n[1] * s[2]))
     }

@@ -245,6 +245,29 @@ impl Piece {
         }
     }
 
+    /// The arc length of the point of body 1's trace nearest `x` and x's distance from it:
+    /// on a straight piece the abscissa along the chord and the distance off its line
+    /// (unclamped), on a curved one the nearest of the slave segments'.
+    pub fn abscissa_of(&self, x: [f64; 2]) -> (f64, f64) {
+        let Some(c) = &self.curve else {
+            let d = sub(x, self.a);
+            return (dot(d, self.tangent), dot(d, self.normal).abs());
+        };
+        let mut best = (0.0, f64::INFINITY);
+        for (j, w) in c.slave_points.windows(2).enumerate() {
+            let e = sub(w[1], w[0]);
+            let len2 = dot(e, e);
+            let t = (dot(sub(x, w[0]), e) / len2).clamp(0.0, 1.0);
+            let off = sub(x, lerp(w[0], w[1], t));
+            let distance = dot(off, off).sqrt();
+            if distance < best.1 {
+                let s = self.slave_s[j] + t * (self.slave_s[j + 1] - self.slave_s[j]);
+                best = (s, distance);
+            }
+        }
+        best
+    }
+
     /// Body 1's outward unit normal at slave node `j`: the piece's on a straight piece, the
     /// averaged nodal normal on a curved one.
     pub fn slave_normal(&self, j: usize) -> [f64; 2] {

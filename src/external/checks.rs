@@ -306,29 +306,65 @@ impl CheckRecord {
 }
 
 /// Gamma_C's nodes: for each, its side (0: body 1, slave) and its side's outward unit normal
-/// (the mean of its pieces'), and whether it is a corner of Gamma_C (pieces of two normals
-/// meet there: the force's direction is any in their cone, so no tangential part is read).
-struct ContactNodes(BTreeMap<usize, (usize, [f64; 2], bool)>);
+/// (the mean of its pieces'), whether it is a corner of Gamma_C (pieces of two normals
+/// meet there: the force's direction is any in their cone, so no tangential part is read),
+/// and on a curved piece the sine of the largest angle between its normal and its
+/// neighbours' (0 on a straight piece): its force, an integral over its support of
+/// normals within that cone, may lean that far off its own normal without friction (and
+/// where a support holds one of its dofs, the support takes part of it: no tangential part
+/// is read there).
+struct ContactNodes(BTreeMap<usize, ContactNode>);
+
+/// (side, normal, corner, spread): one entry of [`ContactNodes`].
+type ContactNode = (usize, [f64; 2], bool, f64);
+
+/// |sin| of the angle between two unit vectors.
+fn sine(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] * b[1] - a[1] * b[0]).abs()
+}
+
+/// The spread of each of `normals` (in trace order): the largest sine to a neighbour's.
+fn spreads(normals: &[[f64; 2]]) -> Vec<f64> {
+    (0..normals.len())
+        .map(|k| {
+            let before = k
+                .checked_sub(1)
+                .map_or(0.0, |p| sine(normals[p], normals[k]));
+            let after = normals.get(k + 1).map_or(0.0, |&n| sine(n, normals[k]));
+            before.max(after)
+        })
+        .collect()
+}
 
 impl ContactNodes {
     fn new(interface: &Interface) -> Self {
-        let mut nodes: BTreeMap<usize, (usize, [f64; 2], Vec<[f64; 2]>)> = BTreeMap::new();
+        let mut nodes: BTreeMap<usize, (usize, Vec<[f64; 2]>, f64)> = BTreeMap::new();
         for piece in &interface.pieces {
-            let n = piece.normal;
-            for (side, list, normal) in [
-                (0, &piece.slave_nodes, n),
-                (1, &piece.master_nodes, [-n[0], -n[1]]),
+            // Body 1's averaged nodal normal (the piece's on a straight piece), and at a
+            // body-2 node the opposite of body 1's normal where the normal through it meets.
+            let slave: Vec<[f64; 2]> = (0..piece.slave_nodes.len())
+                .map(|j| piece.slave_normal(j))
+                .collect();
+            let master: Vec<[f64; 2]> = piece
+                .master_s
+                .iter()
+                .map(|&s| piece.normal_at(s).map(|v| -v))
+                .collect();
+            for (side, list, normals) in [
+                (0, &piece.slave_nodes, slave),
+                (1, &piece.master_nodes, master),
             ] {
-                for &g in list {
-                    let e = nodes.entry(g).or_insert((side, [0.0; 2], Vec::new()));
-                    e.2.push(normal);
+                for ((&g, normal), spread) in list.iter().zip(&normals).zip(spreads(&normals)) {
+                    let e = nodes.entry(g).or_insert((side, Vec::new(), 0.0));
+                    e.1.push(*normal);
+                    e.2 = e.2.max(spread);
                 }
             }
         }
         ContactNodes(
             nodes
                 .into_iter()
-                .map(|(g, (side, _, normals))| {
+                .map(|(g, (side, normals, spread))| {
                     let sum = normals
                         .iter()
                         .fold([0.0; 2], |s, n| [s[0] + n[0], s[1] + n[1]]);
@@ -336,7 +372,7 @@ impl ContactNodes {
                     let corner = normals.iter().any(|n| {
                         (n[0] - normals[0][0]).abs() + (n[1] - normals[0][1]).abs() > 1e-9
                     });
-                    (g, (side, [sum[0] / len, sum[1] / len], corner))
+                    (g, (side, [sum[0] / len, sum[1] / len], corner, spread))
                 })
                 .collect(),
         )
@@ -381,7 +417,7 @@ fn force_sums(
     either_sign: bool,
 ) -> ([f64; 3], f64) {
     let (mut push, mut tangential, mut pulling) = ([0.0f64; 2], 0.0f64, 0.0f64);
-    for (&g, &(side, n, corner)) in &nodes.0 {
+    for (&g, &(side, n, corner, spread)) in &nodes.0 {
         let r = [0, 1].map(|c| match model.equation[2 * g + c] {
             FIXED => 0.0,
             _ => force[2 * g + c],
@@ -389,7 +425,16 @@ fn force_sums(
         let normal = r[0] * n[0] + r[1] * n[1];
         push[side] -= normal;
         if !corner {
-            tangential += (r[1] * n[0] - r[0] * n[1]).abs();
+            let lean = (r[1] * n[0] - r[0] * n[1]).abs();
+            // On a straight piece spread = 0: the whole tangential part. On a curved one a
+            // support that holds a dof of the node takes part of its contact force, so
+            // what is left is no contact force's direction: nothing is read there.
+            let held = (0..2).any(|c| model.equation[2 * g + c] == FIXED);
+            tangential += match (spread > 0.0, held) {
+                (true, true) => 0.0,
+                (true, false) => (lean - spread * r[0].hypot(r[1])).max(0.0),
+                (false, _) => lean,
+            };
         }
         if side == 0 {
             pulling += match either_sign {

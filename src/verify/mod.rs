@@ -9,6 +9,7 @@ pub mod contact_error;
 pub mod distance;
 pub mod exact_error;
 pub mod field;
+pub mod geometry;
 pub mod intersect;
 pub mod jobs;
 pub mod judge;

@@ -172,12 +172,7 @@ fn profile_on(interface: &Interface, piece: usize, profile: &[([f64; 2], f64)]) 
     let pc = &interface.pieces[piece];
     let mut v: Vec<(f64, f64)> = profile
         .iter()
-        .map(|(x, p)| {
-            (
-                (x[0] - pc.a[0]) * pc.tangent[0] + (x[1] - pc.a[1]) * pc.tangent[1],
-                *p,
-            )
-        })
+        .map(|(x, p)| (pc.abscissa_of(*x).0, *p))
         .collect();
     v.sort_by(|a, b| a.0.total_cmp(&b.0));
     v
@@ -223,13 +218,10 @@ pub fn eval_pl_within(f: &[(f64, f64)], x: f64, inside: f64) -> f64 {
     eval_pl(&f[k - 1..=k], x)
 }
 
-/// The abscissa of `x` along `piece` and its distance off the piece's line.
+/// The arc length of `x` along `piece` and its distance off body 1's trace there
+/// ([`Piece::abscissa_of`]).
 pub fn on_piece(piece: &Piece, x: [f64; 2]) -> (f64, f64) {
-    let d = [x[0] - piece.a[0], x[1] - piece.a[1]];
-    (
-        d[0] * piece.tangent[0] + d[1] * piece.tangent[1],
-        (d[0] * piece.normal[0] + d[1] * piece.normal[1]).abs(),
-    )
+    piece.abscissa_of(x)
 }
 
 /// Points (position, value) projected on each study piece, sorted and deduplicated.

@@ -15,6 +15,7 @@
 mod beside_report;
 mod best_report;
 mod distance_report;
+mod geometry_report;
 mod lac_report;
 pub use lac_report::best_pressure_rate;
 pub mod report;
@@ -253,6 +254,9 @@ pub struct StudyResult {
     pub pressure: Vec<ProfilePoint>,
     /// Gap profiles at T on the profile level (and the reference's).
     pub gap: Vec<ProfilePoint>,
+    /// The polygonal boundaries' geometric error per level, for a scene whose levels are
+    /// split on its curves (empty otherwise).
+    pub geometry: Vec<crate::verify::geometry::GeometryRow>,
     /// Level of the profiles.
     pub profile_level: usize,
     /// Deformed meshes on the profile level.
@@ -481,6 +485,7 @@ struct Measured {
     levels: Vec<LevelInfo>,
     pressure: Vec<ProfilePoint>,
     gap: Vec<ProfilePoint>,
+    geometry: Vec<crate::verify::geometry::GeometryRow>,
     deformed: Vec<DeformedMesh>,
     /// The mesh provenance and scene warnings of the first level.
     mesh: Option<crate::mesh::gmsh::GeneratedMesh>,
@@ -565,6 +570,21 @@ fn measure_levels(
         }
         let flagged = errors[&Quantity::Theorem] < 5.0 * truth.error();
         out.levels.push(level_info(case, sol, method, flagged));
+        let curved = case.problem.model.scene.refinement == crate::scene::Refinement::Curved;
+        if curved && out.geometry.iter().all(|g| g.level != level) {
+            let exact = match truth {
+                Truth::Exact(exact, _) => Some(*exact),
+                Truth::Solved(_) => None,
+            };
+            let model = &case.problem.model;
+            out.geometry.push(crate::verify::geometry::boundary_geometry(
+                model,
+                level,
+                model.judge_h(),
+                exact,
+                sol.last().time,
+            ));
+        }
         if level == profile_level {
             profiles(case, sol, Source::Cone(method), &mut out);
             out.deformed
@@ -1062,6 +1082,10 @@ pub fn rejudge(name: &str, dir: &Path) -> Result<StudyResult> {
         exact_quadrature: facts.exact_quadrature,
         pressure: crate::verify::table::read(&dir.join("pressure.csv"))?,
         gap: crate::verify::table::read(&dir.join("gap.csv"))?,
+        geometry: match dir.join("geometry.csv") {
+            p if p.exists() => crate::verify::table::read(&p)?,
+            _ => Vec::new(),
+        },
         profile_level: facts.profile_level,
         deformed: Vec::new(),
         time_study,
@@ -1145,6 +1169,7 @@ pub fn run_mode(name: &str, mode: Mode) -> Result<Option<StudyResult>> {
         exact_quadrature,
         pressure: measured.pressure,
         gap: measured.gap,
+        geometry: measured.geometry,
         profile_level,
         deformed: measured.deformed,
         time_study,

@@ -146,6 +146,9 @@ pub fn write_study(res: &StudyResult, dir: &Path) -> Result<()> {
         write(d, "levels.csv", &csv_bytes(&res.levels)?)?;
         write(d, "pressure.csv", &csv_bytes(&res.pressure)?)?;
         write(d, "gap.csv", &csv_bytes(&res.gap)?)?;
+        if !res.geometry.is_empty() {
+            write(d, "geometry.csv", &csv_bytes(&res.geometry)?)?;
+        }
         let facts = toml::to_string(&RunFacts::of(res))
             .map_err(|e| crate::error::Error::input(d.join("run.toml"), "facts", e.to_string()))?;
         write(d, "run.toml", facts.as_bytes())?;
@@ -456,6 +459,7 @@ fn readme(res: &StudyResult) -> String {
     errors_table(&mut doc, res);
     reference(&mut doc, res);
     alignment(&mut doc, res);
+    super::geometry_report::section(&mut doc, res);
     if let Some(ts) = &res.time_study {
         rate_in_time(&mut doc, ts);
     }
@@ -653,9 +657,14 @@ fn cones_sentence(res: &StudyResult, q: Quantity, reference: Method, other: Meth
         (Some(Verdict::NotConverging), Some(Verdict::NotConverging)) => {
             format!("neither {r} nor {o} converges")
         }
-        (_, Some(Verdict::NotConverging)) => format!(
+        (_, Some(Verdict::NotConverging)) if b >= a => format!(
             "**{o} does not converge** (stalls at {b:.3e}); {r} reaches {a:.3e}, {:.1}x smaller",
             b / a.max(floor)
+        ),
+        // The one that does not converge may still be below the other at this level.
+        (_, Some(Verdict::NotConverging)) => format!(
+            "**{o} does not converge** (at {b:.3e} here); {r}'s error {a:.3e} is {:.1}x larger at this level",
+            a / b.max(floor)
         ),
         (Some(Verdict::NotConverging), _) => {
             format!("**{r} does not converge** (stalls at {a:.3e}); {o} reaches {b:.3e}")

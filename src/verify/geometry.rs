@@ -1,0 +1,168 @@
+//! How far a level's polygonal boundary lies from the curves it approximates: the mesh's
+//! boundary edges against the circle through each edge and its neighbour along the
+//! boundary (exact for circle arcs, 0 for straight lines; turns above
+//! [`crate::contact::CORNER_ANGLE_DEGREES`] are corners, not curvature), read from the mesh
+//! alone. Used by studies whose levels are split on their curves (`refinement = "curved"`),
+//! whose exact fields are expressions on the plane evaluated on the discrete domain
+//! Omega_h: the slivers between the chords and the arcs are what Omega_h leaves out of (or
+//! adds to) Omega.
+
+use crate::analytical::Exact;
+use crate::fe::Model;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// The polygonal boundary's geometric error at one level (one row of geometry.csv).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GeometryRow {
+    /// Level.
+    pub level: usize,
+    /// The judge's h (length).
+    pub h: f64,
+    /// The largest distance between a boundary chord and its arc (the sagitta, length).
+    pub max_sagitta: f64,
+    /// The slivers' total area, both bodies (length^2).
+    pub sliver_area: f64,
+    /// `sliver_area` over the polygons' area.
+    pub relative_area: f64,
+    /// The exact solution's energy norm on the slivers over its energy norm on Omega_h
+    /// (each sliver's energy density read at its chord's midpoint): the size, in the
+    /// theorem norm's units, of what the slivers hold. Empty without exact fields.
+    pub sliver_energy: Option<f64>,
+}
+
+/// One boundary edge with the sagitta of its arc (0 on a straight part).
+struct CurvedEdge {
+    nodes: [usize; 2],
+    sagitta: f64,
+}
+
+/// The boundary edges of `model` (edges of one triangle) with their arcs' sagittas.
+fn curved_edges(model: &Model) -> Vec<CurvedEdge> {
+    let mut count: BTreeMap<[usize; 2], usize> = BTreeMap::new();
+    for e in &model.elements {
+        for k in 0..3 {
+            let (a, b) = (e.nodes[k], e.nodes[(k + 1) % 3]);
+            *count.entry([a.min(b), a.max(b)]).or_insert(0) += 1;
+        }
+    }
+    let boundary: Vec<[usize; 2]> = count
+        .into_iter()
+        .filter(|(_, n)| *n == 1)
+        .map(|(e, _)| e)
+        .collect();
+    let mut neighbours: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for e in &boundary {
+        neighbours.entry(e[0]).or_default().push(e[1]);
+        neighbours.entry(e[1]).or_default().push(e[0]);
+    }
+    let corner = crate::contact::CORNER_ANGLE_DEGREES.to_radians();
+    boundary
+        .iter()
+        .map(|&[p, q]| {
+            // The circle through the edge and its neighbour beyond each end, where the
+            // boundary turns there by less than a corner; the mean of the two curvatures.
+            let curvatures: Vec<f64> = [(p, q), (q, p)]
+                .into_iter()
+                .filter_map(|(end, other)| {
+                    let next = neighbours[&end].iter().copied().find(|&n| n != other)?;
+                    let (a, b, c) = (
+                        model.position(other),
+                        model.position(end),
+                        model.position(next),
+                    );
+                    (turn(a, b, c) < corner).then(|| curvature(a, b, c))
+                })
+                .collect();
+            let kappa = match curvatures.len() {
+                0 => 0.0,
+                n => curvatures.iter().sum::<f64>() / n as f64,
+            };
+            let (a, b) = (model.position(p), model.position(q));
+            let half = 0.5 * (b[0] - a[0]).hypot(b[1] - a[1]);
+            let sagitta = match kappa > 0.0 {
+                true => {
+                    let r = 1.0 / kappa;
+                    r - (r * r - half * half).max(0.0).sqrt()
+                }
+                false => 0.0,
+            };
+            CurvedEdge {
+                nodes: [p, q],
+                sagitta,
+            }
+        })
+        .collect()
+}
+
+/// The turn (radians) of the polyline a -> b -> c at b.
+fn turn(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+    let (u, v) = ([b[0] - a[0], b[1] - a[1]], [c[0] - b[0], c[1] - b[1]]);
+    (u[0] * v[1] - u[1] * v[0])
+        .atan2(u[0] * v[0] + u[1] * v[1])
+        .abs()
+}
+
+/// 1 / the radius of the circle through a, b, c (0 for collinear points).
+fn curvature(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+    let d = |p: [f64; 2], q: [f64; 2]| (q[0] - p[0]).hypot(q[1] - p[1]);
+    let cross = ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])).abs();
+    // Turns below 1e-10 rad are rounding of a straight line.
+    let (ab, bc, ca) = (d(a, b), d(b, c), d(c, a));
+    match cross <= 1e-10 * ab * bc {
+        true => 0.0,
+        false => 2.0 * cross / (ab * bc * ca),
+    }
+}
+
+/// The exact energy density sigma : eps at (x, y, t) in body `b`.
+fn energy_density(exact: &Exact, b: usize, x: [f64; 2], t: f64) -> Option<f64> {
+    let s = exact.stress_at(b, x[0], x[1], t)?;
+    let g = &exact.gradient.as_ref()?[b];
+    let e = |c: usize, d: usize| g[c][d].eval(x[0], x[1], t);
+    let shear = 0.5 * (e(0, 1) + e(1, 0));
+    Some(s[0] * e(0, 0) + s[1] * e(1, 1) + 2.0 * s[2] * shear)
+}
+
+/// The polygonal boundary's geometric error of `model` at `level` (judge's h `h`), with
+/// the exact fields' share on the slivers at time `t` where `exact` gives them.
+pub fn boundary_geometry(
+    model: &Model,
+    level: usize,
+    h: f64,
+    exact: Option<&Exact>,
+    t: f64,
+) -> GeometryRow {
+    let edges = curved_edges(model);
+    let body_of = |g: usize| usize::from(g >= model.node_offset[1]);
+    // A parabolic segment's area: 2/3 of chord times sagitta.
+    let sliver = |e: &CurvedEdge| {
+        let (a, b) = (model.position(e.nodes[0]), model.position(e.nodes[1]));
+        2.0 / 3.0 * (b[0] - a[0]).hypot(b[1] - a[1]) * e.sagitta
+    };
+    let sliver_area: f64 = edges.iter().map(sliver).sum();
+    let area: f64 = model.elements.iter().map(|e| e.area).sum();
+    let sliver_energy = exact.and_then(|ex| {
+        let mut on_slivers = 0.0;
+        for e in edges.iter().filter(|e| e.sagitta > 0.0) {
+            let (a, b) = (model.position(e.nodes[0]), model.position(e.nodes[1]));
+            let mid = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
+            on_slivers += sliver(e) * energy_density(ex, body_of(e.nodes[0]), mid, t)?;
+        }
+        let mut total = 0.0;
+        for e in &model.elements {
+            let p = e.nodes.map(|n| model.position(n));
+            let c = [0, 1].map(|k| (p[0][k] + p[1][k] + p[2][k]) / 3.0);
+            total += e.area * energy_density(ex, e.body, c, t)?;
+        }
+        (total > 0.0).then(|| (on_slivers.max(0.0) / total).sqrt())
+    });
+    GeometryRow {
+        level,
+        h,
+        max_sagitta: edges.iter().fold(0.0, |m, e| m.max(e.sagitta)),
+        sliver_area,
+        relative_area: sliver_area / area,
+        sliver_energy,
+    }
+}
