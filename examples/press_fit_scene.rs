@@ -7,22 +7,9 @@
 //! `cargo run --release --example press_fit_scene > scenes/press-fit.toml`
 
 use contact_rates::analytical::lame::PressFit;
-use contact_rates::material::{Elasticity, Plane};
 
 fn main() {
-    let strain = |young| Elasticity {
-        young,
-        poisson: 0.3,
-        plane: Plane::Strain,
-    };
-    let fit = PressFit {
-        bore: 0.5,
-        radius: 1.0,
-        gap: 0.02,
-        outer: 1.5,
-        bore_pressure: 6.6,
-        elastic: [strain(100.0), strain(150.0)],
-    };
+    let fit = PressFit::benchmark();
     let solution = fit.solve();
     assert!(fit.closes(), "the bore pressure closes the gap");
     let [u1, u2] = [0, 1].map(|i| solution.displacement_text(i));

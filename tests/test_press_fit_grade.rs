@@ -8,40 +8,15 @@
 //! Geometry: scenes/press-fit.toml on the quick tier's meshes (meshes/press_fit.geo).
 //! Data: E = 100 and 150, nu = 0.3, plane strain, bore pressure 6.6; one step.
 
-mod common;
 #[path = "common/graded_series.rs"]
 mod graded_series;
 
-use contact_rates::case::Case;
 use contact_rates::contact::Method;
-use contact_rates::external::export::Source;
-use contact_rates::external::grade::{GradeRequest, grade};
-use contact_rates::io::solution::FieldNames;
-use contact_rates::solve::SolverKind;
-use contact_rates::verify::solve_case;
-use contact_rates::verify::study_file::LoadedStudy;
 
 #[test]
 fn own_mortar_solves_of_the_press_fit_graded_as_an_outside_code_give_grades_own_errors() {
     contact_rates::init();
-    let study = LoadedStudy::load("press-fit-quick").unwrap();
-    let params = study.file.family_parameters();
-    let dir = tempfile::tempdir().unwrap();
-    for level in 0..=2 {
-        let case = Case::build(&study.scene, level, Method::Mortar, &params).unwrap();
-        let (sol, _) = solve_case(&case, SolverKind::Newton, study.file.steps).unwrap();
-        graded_series::write_states(dir.path(), level, &case, &sol.states, |_| ());
-    }
-    let g = grade(&GradeRequest {
-        source: Source::Study("press-fit-quick".into()),
-        solutions: dir.path().to_path_buf(),
-        levels: None,
-        name: "outside".into(),
-        threshold: None,
-        names: FieldNames::default(),
-        compare: true,
-    })
-    .unwrap();
+    let g = graded_series::grade_own_solves("press-fit-quick", Method::Mortar, 2);
     let of = |m: &str| {
         g.errors
             .iter()

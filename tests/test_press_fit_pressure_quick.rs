@@ -18,25 +18,11 @@ mod common;
 use contact_rates::analytical::lame::PressFit;
 use contact_rates::case::Case;
 use contact_rates::contact::Method;
-use contact_rates::material::{Elasticity, Plane};
 use contact_rates::scene::Scene;
 use contact_rates::solve::{self, Settings};
 
 fn closed_form() -> (f64, f64) {
-    let strain = |young| Elasticity {
-        young,
-        poisson: 0.3,
-        plane: Plane::Strain,
-    };
-    let s = PressFit {
-        bore: 0.5,
-        radius: 1.0,
-        gap: 0.02,
-        outer: 1.5,
-        bore_pressure: 6.6,
-        elastic: [strain(100.0), strain(150.0)],
-    }
-    .solve();
+    let s = PressFit::benchmark().solve();
     (s.pressure_inner, s.pressure_outer)
 }
 

@@ -52,6 +52,24 @@ fn moduli(e: &Elasticity) -> (f64, f64) {
 }
 
 impl PressFit {
+    /// The press fit of meshes/press_fit.geo and scenes/press-fit.toml: a = 0.5, R = 1,
+    /// g0 = 0.02, b = 1.5, bore pressure 6.6, E = 100 and 150, nu = 0.3, plane strain.
+    pub fn benchmark() -> Self {
+        let strain = |young| Elasticity {
+            young,
+            poisson: 0.3,
+            plane: crate::material::Plane::Strain,
+        };
+        PressFit {
+            bore: 0.5,
+            radius: 1.0,
+            gap: 0.02,
+            outer: 1.5,
+            bore_pressure: 6.6,
+            elastic: [strain(100.0), strain(150.0)],
+        }
+    }
+
     /// The closed form with the contact closed: the six equations above, solved by LU.
     /// The pressures are those of a closed contact; [`PressFit::closes`] says whether they
     /// are compressive.

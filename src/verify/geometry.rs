@@ -21,20 +21,24 @@ pub struct GeometryRow {
     pub h: f64,
     /// The largest distance between a boundary chord and its arc (the sagitta, length).
     pub max_sagitta: f64,
-    /// The slivers' total area, both bodies (length^2).
+    /// The slivers' total area, both bodies: the circular segments over the boundary
+    /// chords (length^2).
     pub sliver_area: f64,
     /// `sliver_area` over the polygons' area.
     pub relative_area: f64,
-    /// The exact solution's energy norm on the slivers over its energy norm on Omega_h
-    /// (each sliver's energy density read at its chord's midpoint): the size, in the
-    /// theorem norm's units, of what the slivers hold. Empty without exact fields.
+    /// The exact solution's theorem norm (||u||_H1 + ||sigma||_L2) on the slivers over its
+    /// theorem norm on Omega_h (each sliver's densities read at its chord's midpoint,
+    /// Omega_h's at the triangles' centroids): what the slivers hold, in the units of the
+    /// relative theorem-norm error. Empty without exact fields.
     pub sliver_energy: Option<f64>,
 }
 
-/// One boundary edge with the sagitta of its arc (0 on a straight part).
+/// One boundary edge with the sagitta of its arc and the area between them (0 on a
+/// straight part).
 struct CurvedEdge {
     nodes: [usize; 2],
     sagitta: f64,
+    area: f64,
 }
 
 /// The boundary edges of `model` (edges of one triangle) with their arcs' sagittas.
@@ -80,16 +84,23 @@ fn curved_edges(model: &Model) -> Vec<CurvedEdge> {
             };
             let (a, b) = (model.position(p), model.position(q));
             let half = 0.5 * (b[0] - a[0]).hypot(b[1] - a[1]);
-            let sagitta = match kappa > 0.0 {
+            // The circular segment over the chord: sagitta r (1 - cos(theta/2)), area
+            // r^2 (theta - sin theta) / 2, theta the chord's central angle.
+            let (sagitta, area) = match kappa > 0.0 {
                 true => {
                     let r = 1.0 / kappa;
-                    r - (r * r - half * half).max(0.0).sqrt()
+                    let theta = 2.0 * (half / r).min(1.0).asin();
+                    (
+                        r - (r * r - half * half).max(0.0).sqrt(),
+                        0.5 * r * r * (theta - theta.sin()),
+                    )
                 }
-                false => 0.0,
+                false => (0.0, 0.0),
             };
             CurvedEdge {
                 nodes: [p, q],
                 sagitta,
+                area,
             }
         })
         .collect()
@@ -115,13 +126,26 @@ fn curvature(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
     }
 }
 
-/// The exact energy density sigma : eps at (x, y, t) in body `b`.
-fn energy_density(exact: &Exact, b: usize, x: [f64; 2], t: f64) -> Option<f64> {
+/// The exact solution's squared densities at (x, y, t) in body `b`: (|u|^2 + |grad u|^2,
+/// sigma : sigma), the two parts of the theorem norm ||u||_H1 + ||sigma||_L2.
+fn densities(exact: &Exact, b: usize, x: [f64; 2], t: f64) -> Option<[f64; 2]> {
     let s = exact.stress_at(b, x[0], x[1], t)?;
+    let u = exact.displacement_at(b, x[0], x[1], t)?;
     let g = &exact.gradient.as_ref()?[b];
-    let e = |c: usize, d: usize| g[c][d].eval(x[0], x[1], t);
-    let shear = 0.5 * (e(0, 1) + e(1, 0));
-    Some(s[0] * e(0, 0) + s[1] * e(1, 1) + 2.0 * s[2] * shear)
+    let grad: f64 = g
+        .iter()
+        .flatten()
+        .map(|e| e.eval(x[0], x[1], t).powi(2))
+        .sum();
+    Some([
+        u[0] * u[0] + u[1] * u[1] + grad,
+        s[0] * s[0] + s[1] * s[1] + 2.0 * s[2] * s[2],
+    ])
+}
+
+/// The theorem norm sqrt(a) + sqrt(b) of summed squared densities [a, b].
+fn theorem_norm(d: [f64; 2]) -> f64 {
+    d[0].sqrt() + d[1].sqrt()
 }
 
 /// The polygonal boundary's geometric error of `model` at `level` (judge's h `h`), with
@@ -135,27 +159,26 @@ pub fn boundary_geometry(
 ) -> GeometryRow {
     let edges = curved_edges(model);
     let body_of = |g: usize| usize::from(g >= model.node_offset[1]);
-    // A parabolic segment's area: 2/3 of chord times sagitta.
-    let sliver = |e: &CurvedEdge| {
-        let (a, b) = (model.position(e.nodes[0]), model.position(e.nodes[1]));
-        2.0 / 3.0 * (b[0] - a[0]).hypot(b[1] - a[1]) * e.sagitta
-    };
-    let sliver_area: f64 = edges.iter().map(sliver).sum();
+    let sliver_area: f64 = edges.iter().map(|e| e.area).sum();
     let area: f64 = model.elements.iter().map(|e| e.area).sum();
     let sliver_energy = exact.and_then(|ex| {
-        let mut on_slivers = 0.0;
-        for e in edges.iter().filter(|e| e.sagitta > 0.0) {
+        // Each sliver's densities read at its chord's midpoint; Omega_h's at the centroids.
+        let mut on_slivers = [0.0; 2];
+        for e in edges.iter().filter(|e| e.area > 0.0) {
             let (a, b) = (model.position(e.nodes[0]), model.position(e.nodes[1]));
             let mid = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
-            on_slivers += sliver(e) * energy_density(ex, body_of(e.nodes[0]), mid, t)?;
+            let d = densities(ex, body_of(e.nodes[0]), mid, t)?;
+            (0..2).for_each(|k| on_slivers[k] += e.area * d[k]);
         }
-        let mut total = 0.0;
+        let mut total = [0.0; 2];
         for e in &model.elements {
             let p = e.nodes.map(|n| model.position(n));
             let c = [0, 1].map(|k| (p[0][k] + p[1][k] + p[2][k]) / 3.0);
-            total += e.area * energy_density(ex, e.body, c, t)?;
+            let d = densities(ex, e.body, c, t)?;
+            (0..2).for_each(|k| total[k] += e.area * d[k]);
         }
-        (total > 0.0).then(|| (on_slivers.max(0.0) / total).sqrt())
+        let whole = theorem_norm(total);
+        (whole > 0.0).then(|| theorem_norm(on_slivers) / whole)
     });
     GeometryRow {
         level,
