@@ -79,7 +79,7 @@ enum Command {
     /// errors, rates and verdicts beside this project's mortar, nts and lac (reports/grade-NAME).
     Grade(GradeArgs),
     /// Assemble the report of what real contact codes converge at (reports/codes) from grade
-    /// reports GRADES/PROBLEM/CODE/ (examples/codes/run.sh writes them).
+    /// reports GRADES/PROBLEM/CODE/ (the workflow in workflow/Snakefile writes them).
     Codes {
         /// The folder of PROBLEM/CODE grade reports.
         #[arg(long)]

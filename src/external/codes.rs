@@ -405,7 +405,7 @@ pub fn codes_report(grades: &Path, out: &Path) -> Result<()> {
         return Err(Error::input(
             grades,
             "--grades",
-            "holds no PROBLEM/CODE grade reports; run examples/codes/run.sh",
+            "holds no PROBLEM/CODE grade reports; run the workflow (`snakemake --cores 2`, workflow/Snakefile)",
         ));
     }
     write_folder(out, |d| {
@@ -482,7 +482,7 @@ fn readme(problems: &[Problem]) -> String {
         section(&mut doc, p);
     }
     doc.heading(2, "How it is made");
-    doc.paragraph("`bash examples/codes/run.sh` exports each problem, solves it with examples/grade_getfem.py (both bricks) and examples/grade_kratos.py, grades every solution with `contact-rates grade` beside this project's cones, and assembles this folder with `contact-rates codes --grades DIR --out reports/codes`. errors.csv, rates.csv, checks.csv and asymptotes.csv hold every row, with the problem in the `study` column.");
+    doc.paragraph("The workflow in workflow/Snakefile (`snakemake --cores 2`; docs/verify-your-code.md#the-workflow) exports each problem, solves each level with examples/grade_getfem.py (both bricks) and examples/grade_kratos.py, grades every solution with `contact-rates grade` beside this project's cones, and assembles this folder with `contact-rates codes --grades DIR --out reports/codes`; it remakes only what changed. errors.csv, rates.csv, checks.csv and asymptotes.csv hold every row, with the problem in the `study` column.");
     doc.finish()
 }
 

@@ -198,6 +198,7 @@ impl Staging {
     /// has it (Linux renameat2), two renames otherwise; then remove the previous output.
     pub fn commit(mut self) -> Result<()> {
         let old = sibling(&self.target, "old", std::process::id());
+        keep_unchanged_times(&self.path, &self.target);
         // The swap holds the registry's lock, so an interrupting signal waits for it to end
         // (see [`remove_live`]): the target is the previous output or the new one, never
         // half swapped. What is left to remove afterwards, the previous output, is
@@ -369,6 +370,29 @@ fn first_missing(dir: &Path) -> Option<PathBuf> {
         .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
         .last()
         .map(Path::to_path_buf)
+}
+
+/// Give every staged file whose bytes equal the previous output's file of that name the
+/// previous file's modification time: the swap then changes the time of a file only where its
+/// bytes change, so that a make-like tool (workflow/Snakefile) rebuilds only what depends on a
+/// changed file. Best effort: a file whose time cannot be read or set keeps the new one.
+fn keep_unchanged_times(staged: &Path, previous: &Path) {
+    let Ok(entries) = std::fs::read_dir(staged) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let (new, old) = (entry.path(), previous.join(entry.file_name()));
+        let same = match (std::fs::read(&new), std::fs::read(&old)) {
+            (Ok(a), Ok(b)) => a == b,
+            _ => false,
+        };
+        let time = std::fs::metadata(&old).and_then(|m| m.modified());
+        if let (true, Ok(time)) = (same, time) {
+            if let Ok(file) = std::fs::File::options().write(true).open(&new) {
+                let _ = file.set_modified(time);
+            }
+        }
+    }
 }
 
 /// Write a report folder all or nothing (see [`Staging`]).
