@@ -42,33 +42,13 @@ fn own_mortar_solves_across_the_gap_graded_as_an_outside_code_give_grades_own_er
         compare: true,
     })
     .unwrap();
-    let of = |m: &str| {
-        g.errors
-            .iter()
-            .filter(|r| r.method.name() == m && !r.quantity.is_distance())
-            .collect::<Vec<_>>()
-    };
-    let (outside, mortar) = (of("outside"), of("mortar"));
+    let (outside, _) = graded_series::outside_equals_mortar(&g);
     assert!(
         outside
             .iter()
             .any(|r| r.quantity == Quantity::MaxPenetration)
     );
     assert!(outside.iter().any(|r| r.quantity == Quantity::ContactEdge));
-    let mut worst = 0.0f64;
-    for r in &outside {
-        let m = mortar
-            .iter()
-            .find(|m| m.level == r.level && m.quantity == r.quantity)
-            .expect("grade's mortar has the row");
-        let d = (r.error - m.error).abs() / m.error.abs();
-        worst = worst.max(d);
-        assert!(d <= 1e-9, "{r:?} vs {m:?}");
-    }
-    println!(
-        "{} errors, largest relative difference to grade's mortar {worst:.2e}",
-        outside.len()
-    );
     // The export carries the gap and how to pose it.
     let out = tempfile::tempdir().unwrap();
     let status = common::run(

@@ -95,3 +95,32 @@ pub fn grade_own_solves(
     })
     .unwrap()
 }
+
+/// The graded code "outside"'s rows of `g` (no distances), each asserted equal to grade's own
+/// mortar row of its level and quantity to 1e-9 relative; with the largest difference.
+pub fn outside_equals_mortar(
+    g: &contact_rates::external::grade::Graded,
+) -> (Vec<&contact_rates::verify::table::ErrorRecord>, f64) {
+    let of = |m: &str| {
+        g.errors
+            .iter()
+            .filter(|r| r.method.name() == m && !r.quantity.is_distance())
+            .collect::<Vec<_>>()
+    };
+    let (outside, mortar) = (of("outside"), of("mortar"));
+    let mut worst = 0.0f64;
+    for r in &outside {
+        let m = mortar
+            .iter()
+            .find(|m| m.level == r.level && m.quantity == r.quantity)
+            .expect("grade's mortar has the row");
+        let d = (r.error - m.error).abs() / m.error.abs();
+        worst = worst.max(d);
+        assert!(d <= 1e-9, "{r:?} vs {m:?}");
+    }
+    println!(
+        "{} errors, largest relative difference to grade's mortar {worst:.2e}",
+        outside.len()
+    );
+    (outside, worst)
+}
