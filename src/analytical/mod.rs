@@ -8,8 +8,10 @@
 //!
 //! [`stacked`] derives the closed form of the `stacked-exact` scene; [`singular`] the
 //! `regularity` family, whose displacement has a part singular at a point ([`Singular`]);
-//! [`lame`] the press fit of two annuli across a radial gap.
+//! [`lame`] the press fit of two annuli across a radial gap; [`hertz`] the line contact of a
+//! cylinder on a half-space.
 
+pub mod hertz;
 pub mod lame;
 pub mod singular;
 pub mod stacked;
