@@ -518,7 +518,7 @@ fn turn(p0: [f64; 2], p1: [f64; 2], p2: [f64; 2]) -> f64 {
 
 /// Whether the turn at p1 is a corner: above [`CORNER_ANGLE_DEGREES`] (a turn backwards,
 /// above 90 degrees, always is).
-fn is_corner(p0: [f64; 2], p1: [f64; 2], p2: [f64; 2]) -> bool {
+pub fn is_corner(p0: [f64; 2], p1: [f64; 2], p2: [f64; 2]) -> bool {
     let (d1, d2) = (sub(p1, p0), sub(p2, p1));
     let angle = cross(d1, d2).atan2(dot(d1, d2)).abs();
     angle > CORNER_ANGLE_DEGREES.to_radians()

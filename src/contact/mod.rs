@@ -20,7 +20,7 @@ pub mod nts;
 
 pub use geometry::{
     CORNER_ANGLE_DEGREES, CurvedTrace, GaussPoint, Interface, Location, MortarSegment, NodeOffset,
-    Piece, locate,
+    Piece, is_corner, locate,
 };
 pub use lac::{MacroAverage, macro_averages, macro_elements, macro_elements_between};
 pub use method::{Method, MethodInfo, PressureSpace, REGISTRY};

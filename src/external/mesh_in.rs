@@ -68,27 +68,8 @@ fn curves_of_body(reference: &Model, raw: &RawMesh, b: usize) -> Vec<(String, Ve
 /// The edges of body `b`'s triangles (1-based `body` marks) that belong to one triangle
 /// only, in the order they are first met.
 fn boundary_edges(mesh: &SolutionMesh, b: usize) -> Vec<[usize; 2]> {
-    let mut count: HashMap<[usize; 2], (usize, usize)> = HashMap::new();
-    let mut order = 0;
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        if mesh.body[t] as usize != b + 1 {
-            continue;
-        }
-        for k in 0..3 {
-            let (p, q) = (tri[k], tri[(k + 1) % 3]);
-            let e = [p.min(q), p.max(q)];
-            let entry = count.entry(e).or_insert((0, order));
-            entry.0 += 1;
-            order += 1;
-        }
-    }
-    let mut edges: Vec<([usize; 2], usize)> = count
-        .into_iter()
-        .filter(|(_, (n, _))| *n == 1)
-        .map(|(e, (_, first))| (e, first))
-        .collect();
-    edges.sort_by_key(|(_, first)| *first);
-    edges.into_iter().map(|(e, _)| e).collect()
+    let of_body = (0..mesh.triangles.len()).filter(|&t| mesh.body[t] as usize == b + 1);
+    crate::mesh::boundary_edges(of_body.map(|t| mesh.triangles[t]))
 }
 
 impl OutsideModel {

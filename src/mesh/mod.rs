@@ -23,6 +23,28 @@ pub struct BodyMesh {
     local_of_raw: Vec<usize>,
 }
 
+/// The edges of `triangles` that belong to one triangle only (the boundary), each as its
+/// two nodes [smaller, larger], in the order they are first met.
+pub fn boundary_edges(triangles: impl IntoIterator<Item = [usize; 3]>) -> Vec<[usize; 2]> {
+    let mut count: std::collections::HashMap<[usize; 2], (usize, usize)> =
+        std::collections::HashMap::new();
+    for (order, (tri, k)) in triangles
+        .into_iter()
+        .flat_map(|tri| (0..3).map(move |k| (tri, k)))
+        .enumerate()
+    {
+        let (p, q) = (tri[k], tri[(k + 1) % 3]);
+        count.entry([p.min(q), p.max(q)]).or_insert((0, order)).0 += 1;
+    }
+    let mut edges: Vec<([usize; 2], usize)> = count
+        .into_iter()
+        .filter(|(_, (n, _))| *n == 1)
+        .map(|(e, (_, first))| (e, first))
+        .collect();
+    edges.sort_by_key(|(_, first)| *first);
+    edges.into_iter().map(|(e, _)| e).collect()
+}
+
 /// Signed area of a triangle (positive when counter-clockwise).
 pub fn signed_area(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
     0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]))

@@ -13,7 +13,7 @@
 //! far below the errors measured for a smooth exact pressure.
 
 use super::field::{P1Field, PressureProfile};
-use super::norms::{eval_pl, on_piece, project};
+use super::norms::{eval_pl, project};
 use crate::analytical::Exact;
 use crate::contact::{Interface, Piece};
 use crate::fe::Model;
@@ -247,7 +247,7 @@ fn pressure_step(
     for (i, (piece, profile)) in interface.pieces.iter().zip(profile).enumerate() {
         let ph: Vec<(f64, f64)> = profile
             .iter()
-            .map(|&(x, v)| (on_piece(piece, x).0, v))
+            .map(|&(x, v)| (piece.abscissa_of(x).0, v))
             .collect();
         let nodes: Vec<f64> = ph.iter().map(|q| q.0).collect();
         // The weights h_e are the body-1 segments': a profile's points are its nodes, but

@@ -41,26 +41,16 @@ struct CurvedEdge {
     area: f64,
 }
 
-/// The boundary edges of `model` (edges of one triangle) with their arcs' sagittas.
+/// The boundary edges of `model` (edges of one triangle, in node order) with their arcs'
+/// sagittas.
 fn curved_edges(model: &Model) -> Vec<CurvedEdge> {
-    let mut count: BTreeMap<[usize; 2], usize> = BTreeMap::new();
-    for e in &model.elements {
-        for k in 0..3 {
-            let (a, b) = (e.nodes[k], e.nodes[(k + 1) % 3]);
-            *count.entry([a.min(b), a.max(b)]).or_insert(0) += 1;
-        }
-    }
-    let boundary: Vec<[usize; 2]> = count
-        .into_iter()
-        .filter(|(_, n)| *n == 1)
-        .map(|(e, _)| e)
-        .collect();
+    let mut boundary = crate::mesh::boundary_edges(model.elements.iter().map(|e| e.nodes));
+    boundary.sort_unstable();
     let mut neighbours: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
     for e in &boundary {
         neighbours.entry(e[0]).or_default().push(e[1]);
         neighbours.entry(e[1]).or_default().push(e[0]);
     }
-    let corner = crate::contact::CORNER_ANGLE_DEGREES.to_radians();
     boundary
         .iter()
         .map(|&[p, q]| {
@@ -75,7 +65,7 @@ fn curved_edges(model: &Model) -> Vec<CurvedEdge> {
                         model.position(end),
                         model.position(next),
                     );
-                    (turn(a, b, c) < corner).then(|| curvature(a, b, c))
+                    (!crate::contact::is_corner(a, b, c)).then(|| curvature(a, b, c))
                 })
                 .collect();
             let kappa = match curvatures.len() {
@@ -104,14 +94,6 @@ fn curved_edges(model: &Model) -> Vec<CurvedEdge> {
             }
         })
         .collect()
-}
-
-/// The turn (radians) of the polyline a -> b -> c at b.
-fn turn(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
-    let (u, v) = ([b[0] - a[0], b[1] - a[1]], [c[0] - b[0], c[1] - b[1]]);
-    (u[0] * v[1] - u[1] * v[0])
-        .atan2(u[0] * v[0] + u[1] * v[1])
-        .abs()
 }
 
 /// 1 / the radius of the circle through a, b, c (0 for collinear points).

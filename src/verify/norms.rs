@@ -3,7 +3,7 @@
 
 use super::field::{P1Field, PressureProfile};
 use super::intersect::{Overlap, Tri, intersect};
-use crate::contact::{Interface, Piece};
+use crate::contact::Interface;
 use crate::fe::Model;
 use nalgebra::Matrix2;
 
@@ -218,12 +218,6 @@ pub fn eval_pl_within(f: &[(f64, f64)], x: f64, inside: f64) -> f64 {
     eval_pl(&f[k - 1..=k], x)
 }
 
-/// The arc length of `x` along `piece` and its distance off body 1's trace there
-/// ([`Piece::abscissa_of`]).
-pub fn on_piece(piece: &Piece, x: [f64; 2]) -> (f64, f64) {
-    piece.abscissa_of(x)
-}
-
 /// Points (position, value) projected on each study piece, sorted and deduplicated.
 pub fn project(study: &Interface, points: &[([f64; 2], f64)]) -> Vec<Vec<(f64, f64)>> {
     study
@@ -234,7 +228,7 @@ pub fn project(study: &Interface, points: &[([f64; 2], f64)]) -> Vec<Vec<(f64, f
             let mut f: Vec<(f64, f64)> = points
                 .iter()
                 .filter_map(|&(x, p)| {
-                    let (s, off) = on_piece(piece, x);
+                    let (s, off) = piece.abscissa_of(x);
                     (off <= tol && s >= -tol && s <= piece.length + tol)
                         .then_some((s.clamp(0.0, piece.length), p))
                 })

@@ -1,6 +1,6 @@
 //! The polygonal boundaries against their curves in a convergence report, for a scene
 //! whose levels are split on its curves: per level the largest sagitta, the slivers' area
-//! and the exact solution's energy on them beside each method's theorem-norm error, each
+//! and the exact solution's theorem norm on them beside each method's theorem-norm error, each
 //! series judged by the one rule ([`crate::verify::rates::assess`]). The errors are
 //! integrals over the discrete domain Omega_h, with the exact fields evaluated there as
 //! expressions on the plane: the slivers are what Omega_h leaves out of Omega (or adds),
