@@ -223,6 +223,23 @@ pub enum Refinement {
     Curved,
 }
 
+impl Refinement {
+    /// Whether the judge reads a level's largest element diameter (nested splits) rather
+    /// than its effective size (levels meshed anew, or split on curves;
+    /// [`crate::fe::Model::judge_h`]).
+    pub fn judged_by_max_diameter(self) -> bool {
+        self == Refinement::Split
+    }
+
+    /// The name of the h the judge reads, for a plot's axis.
+    pub fn h_axis(self) -> &'static str {
+        match self.judged_by_max_diameter() {
+            true => "h (max element diameter)",
+            false => "h_eff = (|Omega_h| / triangles)^(1/2)",
+        }
+    }
+}
+
 /// A body of a validated scene.
 #[derive(Debug, Clone)]
 pub struct SceneBody {

@@ -479,13 +479,12 @@ impl Model {
 
     /// The h the judge reads: the largest element diameter ([`Model::h`]) on nested
     /// (split) levels, the effective size ([`Model::effective_h`]) on levels meshed anew
-    /// (`refinement = "remesh"`), whose largest element need not shrink with the rest.
+    /// (`refinement = "remesh"`), whose largest element need not shrink with the rest, and
+    /// on levels split on their curves (`"curved"`), nested but for their boundary nodes.
     pub fn judge_h(&self) -> f64 {
-        match self.scene.refinement {
-            crate::scene::Refinement::Split => self.h(),
-            crate::scene::Refinement::Remesh | crate::scene::Refinement::Curved => {
-                self.effective_h()
-            }
+        match self.scene.refinement.judged_by_max_diameter() {
+            true => self.h(),
+            false => self.effective_h(),
         }
     }
 

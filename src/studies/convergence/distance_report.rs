@@ -364,7 +364,7 @@ pub fn plot(res: &StudyResult, d: &Path) -> Result<()> {
     plot::loglog(
         &d.join("cone_distance.png"),
         &format!("{}: the cones' errors and their distance", res.name),
-        "h (max element diameter)",
+        res.scene.refinement.h_axis(),
         "relative, Theorem 3.1's norm",
         &series,
         &[(0.5, "1/2"), (0.75, "3/4"), (1.0, "1")],

@@ -262,7 +262,7 @@ fn error_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
     plot::loglog(
         &d.join("error_vs_h.png"),
         &format!("{}: error against h", res.name),
-        "h (max element diameter)",
+        res.scene.refinement.h_axis(),
         // With the pressure's error drawn too, the legend says which is which.
         match pressure_drawn {
             true => "relative error (legend: which quantity)".to_string(),
@@ -1144,7 +1144,7 @@ fn contact_vs_h(res: &StudyResult, d: &Path) -> Result<()> {
             "{}: contact quantities against h (colour: quantity, marker: method)",
             res.name
         ),
-        "h (max element diameter)",
+        res.scene.refinement.h_axis(),
         "relative error",
         &series,
         &[(0.5, "1/2"), (1.0, "1")],
